@@ -1,0 +1,327 @@
+"""Physical parameters of a helix scene (SI) and their normalisation, Eqs. (25)-(29).
+
+Users read and write SI units only (N, m, s, Nm, rpm, Hz).  Every solver works
+in the normalised variables of the paper:
+
+    t~ = t / t_scale,  t_scale = sqrt(L0 / g)         (25)
+    s~ = s / L0,  r~ = r / L0,  v~ = v / sqrt(g L0)   (25)
+
+This module is numpy-only: both the FEniCSx path and the independent
+references (shooting, spline Galerkin) import it, and nothing else in common.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
+
+
+class ParameterError(ValueError):
+    """A parameter is outside its allowed range.
+
+    ``key`` is the dotted scene key (``helix.EA_N``) and ``allowed`` says what
+    would be accepted, so that a scene loader can name file, key and range.
+    """
+
+    def __init__(self, key: str, value, allowed: str):
+        self.key, self.value, self.allowed = key, value, allowed
+        super().__init__(f"{key} = {value!r}: {allowed}")
+
+
+def _positive(section: str, obj, *names: str) -> None:
+    for name in names:
+        value = getattr(obj, name)
+        if not (value > 0 and math.isfinite(value)):
+            raise ParameterError(f"{section}.{name}", value, "must be a finite number > 0")
+
+
+def _non_negative(section: str, obj, *names: str) -> None:
+    for name in names:
+        value = getattr(obj, name)
+        if not (value >= 0 and math.isfinite(value)):
+            raise ParameterError(f"{section}.{name}", value, "must be a finite number >= 0")
+
+
+@dataclass(frozen=True)
+class Helix:
+    """The rod: Tables 1, 2 and 4 of the paper."""
+
+    length_m: float  # L0, unstretched length [m]
+    mass_kg: float  # M, total mass [kg]
+    EA_N: float  # axial stiffness [N]
+    EI_Nm2: float  # bending stiffness [N m^2]
+    GJ_Nm2: float  # torsional stiffness [N m^2]
+    radius_m: float = 0.19  # R, helix radius [m]: drawing only (delta uses Eq. 27)
+    drag_length_m: float = 0.012  # l_a, sum of the bar diameters [m], Eq. (14)
+    drag_coefficient: float = 1.0  # C_D, Eq. (14)
+
+    def __post_init__(self):
+        _positive("helix", self, "length_m", "mass_kg", "EA_N", "EI_Nm2", "GJ_Nm2", "radius_m")
+        _non_negative("helix", self, "drag_length_m", "drag_coefficient")
+
+
+@dataclass(frozen=True)
+class Environment:
+    g_m_s2: float = 9.81  # gravity [m/s^2]
+    air_density_kg_m3: float = 1.225  # rho_0 [kg/m^3]
+    wind_speed_m_s: float = 0.0  # v_w0: wind is -v_w0 i_E [m/s]
+
+    def __post_init__(self):
+        _positive("environment", self, "g_m_s2")
+        _non_negative("environment", self, "air_density_kg_m3")
+        if not math.isfinite(self.wind_speed_m_s):
+            raise ParameterError("environment.wind_speed_m_s", self.wind_speed_m_s, "must be finite")
+
+
+@dataclass(frozen=True)
+class Ends:
+    """Prescribed end positions, Eqs. (35), (36), (66) and (70)."""
+
+    elongation: float  # eps0: chord = (1 + eps0) L0
+    elevation_deg: float  # Gamma0, elevation of the chord [deg]
+    circle_radius_m: float = 0.0  # R1, radius of the upper end's circle, Eq. (70) [m]
+    circle_frequency_Hz: float = 0.0  # f1, frequency of the upper end's circle [Hz]
+
+    def __post_init__(self):
+        # The straight-chord tension EA*eps0 must be > 0: a slack helix has no
+        # stationary state in this model (the tension law, Eq. 22, is linear).
+        if not (self.elongation > 0 and math.isfinite(self.elongation)):
+            raise ParameterError(
+                "ends.elongation", self.elongation,
+                "must be > 0 (the tension EA*elongation must be positive)")
+        if not (-90.0 <= self.elevation_deg <= 90.0):
+            raise ParameterError("ends.elevation_deg", self.elevation_deg, "must lie in [-90, 90]")
+        _non_negative("ends", self, "circle_radius_m", "circle_frequency_Hz")
+
+
+@dataclass(frozen=True)
+class Torque:
+    """Torque at the upper end, the ramp of Eq. (69)."""
+
+    top_Nm: float = 0.0  # M_N0, final torque of the rotor [Nm]
+    rise_time_s: float = 2.565  # t0 in Eq. (69) [s]
+
+    def __post_init__(self):
+        if not math.isfinite(self.top_Nm):
+            raise ParameterError("torque.top_Nm", self.top_Nm, "must be finite")
+        _positive("torque", self, "rise_time_s")
+
+
+@dataclass(frozen=True)
+class Controller:
+    """Ground-torque PD controller, Eq. (40); k1 = k2 = 0 switches it off."""
+
+    k1: float = 0.0  # proportional gain on the spin error (normalised)
+    k2: float = 0.0  # derivative gain (normalised)
+    target_rpm: float = 0.0  # alpha_dot* [rpm]
+
+    def __post_init__(self):
+        _non_negative("controller", self, "k1", "k2")
+        if not math.isfinite(self.target_rpm):
+            raise ParameterError("controller.target_rpm", self.target_rpm, "must be finite")
+
+    @property
+    def active(self) -> bool:
+        return self.k1 > 0 or self.k2 > 0
+
+
+GAMMA_TREATMENTS = ("regularised", "off")
+
+
+@dataclass(frozen=True)
+class Model:
+    """Which physics terms a scene switches on."""
+
+    gravity: bool = True
+    drag: bool = True
+    bending: bool = True
+    twist: bool = True  # twist dynamics, Eq. (31)
+    gamma: str = "regularised"  # Frenet torsion gamma, Eq. (34): see forms.rod
+    gamma_eps: float = 1.0e-3  # regularisation of |r''|^2 in gamma (normalised curvature)
+
+    def __post_init__(self):
+        if self.gamma not in GAMMA_TREATMENTS:
+            raise ParameterError("model.gamma", self.gamma, f"must be one of {GAMMA_TREATMENTS}")
+        _positive("model", self, "gamma_eps")
+
+
+SCHEMES = ("fe", "spline")
+MESHES = ("uniform", "graded")
+
+
+@dataclass(frozen=True)
+class Discretisation:
+    scheme: str = "fe"  # "fe" (FEniCSx, C0 interior penalty) or "spline" (paper, Sec. 3)
+    elements: int = 16  # N
+    degree: int = 3  # Lagrange degree p of the FE scheme (>= 2)
+    mesh: str = "uniform"  # "uniform" or "graded" (gmsh, refined toward the ends)
+    grading: float = 4.0  # graded mesh: ratio of the largest to the smallest element
+    penalty: float = 8.0  # interior-penalty factor eta: penalty = eta p^2 mu / h
+
+    def __post_init__(self):
+        if self.scheme not in SCHEMES:
+            raise ParameterError("discretisation.scheme", self.scheme, f"must be one of {SCHEMES}")
+        if self.mesh not in MESHES:
+            raise ParameterError("discretisation.mesh", self.mesh, f"must be one of {MESHES}")
+        if self.elements < 1:
+            raise ParameterError("discretisation.elements", self.elements, "must be an integer >= 1")
+        if self.scheme == "spline" and self.elements < 2:
+            raise ParameterError("discretisation.elements", self.elements,
+                                 "must be >= 2 for the spline scheme")
+        if not (2 <= self.degree <= 8):
+            raise ParameterError(
+                "discretisation.degree", self.degree,
+                "must be an integer from 2 to 8 (the bending term needs second derivatives)")
+        if not self.grading >= 1:
+            raise ParameterError("discretisation.grading", self.grading, "must be >= 1")
+        _positive("discretisation", self, "penalty")
+
+
+@dataclass(frozen=True)
+class Time:
+    """Time integration settings (dynamics and sweeps)."""
+
+    until_s: float = 30.0  # end of the simulation [s]
+    dt_s: float = 1.0e-3  # (initial) time step [s]
+    output_every_s: float = 0.05  # sampling of the time series [s]
+
+    def __post_init__(self):
+        _positive("time", self, "until_s", "dt_s", "output_every_s")
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """Everything physical and numerical about one scene, in SI units."""
+
+    helix: Helix
+    ends: Ends
+    environment: Environment = field(default_factory=Environment)
+    torque: Torque = field(default_factory=Torque)
+    controller: Controller = field(default_factory=Controller)
+    model: Model = field(default_factory=Model)
+    discretisation: Discretisation = field(default_factory=Discretisation)
+    time: Time = field(default_factory=Time)
+
+    def replace(self, **sections) -> "Parameters":
+        """A copy with some fields of some sections changed:
+        ``p.replace(discretisation={"elements": 32})``."""
+        changed = {name: dataclasses.replace(getattr(self, name), **values)
+                   for name, values in sections.items()}
+        return dataclasses.replace(self, **changed)
+
+    def normalised(self) -> "Normalised":
+        return Normalised.from_parameters(self)
+
+
+@dataclass(frozen=True)
+class Normalised:
+    """The dimensionless groups of Eqs. (25)-(29) and the scales to undo them."""
+
+    # scales
+    L0: float  # [m]
+    t_scale: float  # sqrt(L0/g) [s], Eq. (25)
+    force_scale: float  # M g [N], Eq. (29)
+    torque_scale: float  # GJ / L0 [Nm], Eqs. (38)-(39)
+    # groups
+    sigma: float  # EA / (M g), Eq. (27)
+    mu: float  # EI / (M g L0^2), Eq. (26)
+    beta: float  # GJ / (M g L0^2), Eq. (26)
+    nu: float  # rho0 l_a L0^2 C_D / (2 M), Eq. (26)
+    delta: float  # beta sigma / (2 mu), Eq. (27)
+    v_w0: float  # v_w0 / sqrt(g L0), Eq. (27)
+    # ends
+    eps0: float
+    Gamma0: float  # [rad]
+    r1: float  # R1 / L0, Eq. (70)
+    omega1: float  # 2 pi f1 t_scale, Eq. (70)
+    # torque ramp (69) and controller (40)
+    mN0: float
+    t0: float
+    k1: float
+    k2: float
+    spin_target: float  # alpha_dot* t_scale
+    # switches
+    gravity: float
+    drag: float
+    bending: float
+
+    @classmethod
+    def from_parameters(cls, p: Parameters) -> "Normalised":
+        h, e, env = p.helix, p.ends, p.environment
+        L0, M, g = h.length_m, h.mass_kg, env.g_m_s2
+        t_scale = math.sqrt(L0 / g)  # (25)
+        mu = h.EI_Nm2 / (M * g * L0**2)  # (26)
+        beta = h.GJ_Nm2 / (M * g * L0**2)  # (26)
+        sigma = h.EA_N / (M * g)  # (27)
+        return cls(
+            L0=L0, t_scale=t_scale, force_scale=M * g, torque_scale=h.GJ_Nm2 / L0,
+            sigma=sigma, mu=mu, beta=beta,
+            nu=env.air_density_kg_m3 * h.drag_length_m * L0**2 * h.drag_coefficient / (2 * M),
+            delta=beta * sigma / (2 * mu),  # (27)
+            v_w0=env.wind_speed_m_s / math.sqrt(g * L0),
+            eps0=e.elongation, Gamma0=math.radians(e.elevation_deg),
+            r1=e.circle_radius_m / L0, omega1=2 * math.pi * e.circle_frequency_Hz * t_scale,
+            mN0=p.torque.top_Nm / (h.GJ_Nm2 / L0), t0=p.torque.rise_time_s / t_scale,
+            k1=p.controller.k1, k2=p.controller.k2,
+            spin_target=p.controller.target_rpm * RPM * t_scale,
+            gravity=float(p.model.gravity), drag=float(p.model.drag),
+            bending=float(p.model.bending),
+        )
+
+    # -- units back to SI ---------------------------------------------------
+    def tension_N(self, T):
+        return np.asarray(T) * self.force_scale
+
+    def torque_Nm(self, m):
+        return np.asarray(m) * self.torque_scale
+
+    def time_s(self, t):
+        return np.asarray(t) * self.t_scale
+
+    def length_m(self, x):
+        return np.asarray(x) * self.L0
+
+    def spin_rpm(self, alpha_t):
+        return np.asarray(alpha_t) / self.t_scale / RPM
+
+    # -- boundary data ------------------------------------------------------
+    def top_position(self, t: float = 0.0) -> np.ndarray:
+        """r~(1, t~): Eq. (66), with the circle of Eq. (70) when r1 > 0."""
+        c, s = math.cos(self.Gamma0), math.sin(self.Gamma0)
+        a = 1.0 + self.eps0
+        sw, cw = math.sin(self.omega1 * t), math.cos(self.omega1 * t)
+        r1 = self.r1
+        return np.array([-(a * c + r1 * s * sw), r1 * cw, -(a * s - r1 * c * sw)])
+
+    def top_velocity(self, t: float = 0.0) -> np.ndarray:
+        """d r~(1, t~)/dt~ of Eq. (70)."""
+        c, s, w, r1 = math.cos(self.Gamma0), math.sin(self.Gamma0), self.omega1, self.r1
+        cw, sw = math.cos(w * t), math.sin(w * t)
+        return r1 * w * np.array([-s * cw, -sw, c * cw])
+
+    def top_acceleration(self, t: float = 0.0) -> np.ndarray:
+        """d^2 r~(1, t~)/dt~^2 of Eq. (70)."""
+        c, s, w, r1 = math.cos(self.Gamma0), math.sin(self.Gamma0), self.omega1, self.r1
+        cw, sw = math.cos(w * t), math.sin(w * t)
+        return r1 * w**2 * np.array([s * sw, -cw, -c * sw])
+
+    def top_torque(self, t: float) -> float:
+        """m_N(t~) = m_N0 [1 - exp(-t~/t~0)], Eq. (69)."""
+        return self.mN0 * (1.0 - math.exp(-t / self.t0))
+
+    def top_torque_rate(self, t: float) -> float:
+        """d m_N / dt~ of Eq. (69)."""
+        return self.mN0 / self.t0 * math.exp(-t / self.t0)
+
+    def top_torque_accel(self, t: float) -> float:
+        """d^2 m_N / dt~^2 of Eq. (69)."""
+        return -self.mN0 / self.t0**2 * math.exp(-t / self.t0)
+
+    def chord_tension(self) -> float:
+        """sigma eps0: the tension of the straight chord, normalised (Eq. 29)."""
+        return self.sigma * self.eps0

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs what rawehelix needs on Debian (12 or 13), idempotently:
+# Debian's FEniCSx (dolfinx, petsc4py, slepc4py), gmsh, meshio, OpenMPI,
+# then a venv with --system-site-packages and `pip install -e .` with numpy
+# pinned to the system's version.  A second run takes seconds.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PKGS="python3-dolfinx python3-petsc4py python3-slepc4py python3-scipy python3-pytest
+python3-venv python3-gmsh python3-meshio python3-h5py python3-matplotlib python3-tqdm
+openmpi-bin make"
+missing=$(dpkg-query -W -f='${Package} ${Status}\n' $PKGS 2>/dev/null \
+          | awk '$NF != "installed" {print $1}'; \
+          for p in $PKGS; do dpkg-query -W "$p" >/dev/null 2>&1 || echo "$p"; done)
+missing=$(echo $missing | tr ' ' '\n' | sort -u | tr '\n' ' ')
+if [ -n "${missing// /}" ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "install: apt-get install $missing"
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends $missing
+fi
+
+PY=/usr/bin/python3
+VENV=.venv
+if [ ! -x "$VENV/bin/python" ]; then
+  echo "install: venv $VENV (system site packages)"
+  $PY -m venv --system-site-packages "$VENV"
+fi
+stamp="$VENV/.rawehelix-installed"
+if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ scripts/install.sh -nt "$stamp" ]; then
+  numpy_version=$($PY -c 'import numpy; print(numpy.__version__)')
+  echo "install: pip install -e . (numpy==$numpy_version)"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e . "numpy==$numpy_version"
+  # pyvista renders off screen; it is optional and must not move numpy.
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check "numpy==$numpy_version" \
+      pyvista imageio || echo "install: pyvista unavailable; 3D pictures are skipped"
+  touch "$stamp"
+fi
+"$VENV/bin/python" -c 'import dolfinx, petsc4py, slepc4py, rawehelix' \
+  || { echo "install: the venv cannot import dolfinx/rawehelix" >&2; exit 1; }

@@ -1,0 +1,125 @@
+"""Scene files: TOML in SI units -> validated :class:`Parameters`.
+
+A scene has the sections of :class:`rawehelix.forms.parameters.Parameters`
+(``[helix]``, ``[ends]``, ``[environment]``, ``[torque]``, ``[controller]``,
+``[model]``, ``[discretisation]``, ``[time]``) and an optional top-level
+``title``.  ``studies/scenes/example.toml`` documents every key.
+
+Any problem raises :class:`SceneError`, whose message names the file, the key
+and what is allowed; the command line turns it into exit status 2 before any
+output is written.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from pathlib import Path
+
+from rawehelix.forms.parameters import (Controller, Discretisation, Ends, Environment,
+                                        Helix, Model, ParameterError, Parameters, Time,
+                                        Torque)
+
+SECTIONS = {
+    "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
+    "controller": Controller, "model": Model, "discretisation": Discretisation,
+    "time": Time,
+}
+REQUIRED = ("helix", "ends")
+TOP_LEVEL = {"title": str}
+SCENE_DIR = Path(__file__).parent / "scenes"
+
+
+class SceneError(ValueError):
+    """Bad scene input: ``file: key: what is allowed``."""
+
+    def __init__(self, path, key: str, allowed: str):
+        self.path, self.key, self.allowed = str(path), key, allowed
+        super().__init__(f"{self.path}: {key}: {allowed}")
+
+
+_TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "bool": "true or false"}
+
+
+def _check_type(path, key: str, value, type_name: str):
+    ok = {
+        "float": isinstance(value, (int, float)) and not isinstance(value, bool),
+        "int": isinstance(value, int) and not isinstance(value, bool),
+        "str": isinstance(value, str),
+        "bool": isinstance(value, bool),
+    }[type_name]
+    if not ok:
+        raise SceneError(path, key, f"must be {_TYPE_NAMES[type_name]}, got {value!r}")
+    return float(value) if type_name == "float" else value
+
+
+def _section(path, name: str, table) -> object:
+    cls = SECTIONS[name]
+    if not isinstance(table, dict):
+        raise SceneError(path, name, "must be a table [" + name + "]")
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    values = {}
+    for key, value in table.items():
+        if key not in fields:
+            raise SceneError(path, f"{name}.{key}",
+                             f"unknown key; allowed keys are {', '.join(fields)}")
+        values[key] = _check_type(path, f"{name}.{key}", value, fields[key].type)
+    missing = [k for k, f in fields.items()
+               if k not in values and f.default is dataclasses.MISSING
+               and f.default_factory is dataclasses.MISSING]
+    if missing:
+        raise SceneError(path, f"{name}.{missing[0]}", "is required")
+    try:
+        return cls(**values)
+    except ParameterError as err:
+        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+
+
+def parameters_from_dict(data: dict, path="<scene>") -> Parameters:
+    """Validate a parsed scene (as from TOML) and build its parameters."""
+    for key, value in data.items():
+        if key in TOP_LEVEL:
+            _check_type(path, key, value, TOP_LEVEL[key].__name__)
+        elif key not in SECTIONS:
+            raise SceneError(path, key, "unknown section; allowed are "
+                             + ", ".join(["title", *SECTIONS]))
+    for name in REQUIRED:
+        if name not in data:
+            raise SceneError(path, name, f"the section [{name}] is required")
+    sections = {name: _section(path, name, data[name]) for name in SECTIONS if name in data}
+    return Parameters(**sections)
+
+
+def resolve(path) -> Path:
+    """A scene path, or the name of a scene shipped in ``studies/scenes``."""
+    p = Path(path)
+    if not p.exists() and not p.suffix and (SCENE_DIR / f"{p.name}.toml").exists():
+        p = SCENE_DIR / f"{p.name}.toml"
+    return p
+
+
+def load(path, elements: int | None = None, degree: int | None = None,
+         scheme: str | None = None) -> Parameters:
+    """Read and validate a scene; command-line overrides of the discretisation
+    are validated like the file's own values."""
+    p = resolve(path)
+    if not p.is_file():
+        raise SceneError(p, "file", "no such scene file")
+    try:
+        data = tomllib.loads(p.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(p, "file", f"is not valid TOML ({err})") from None
+    over = {k: v for k, v in (("elements", elements), ("degree", degree), ("scheme", scheme))
+            if v is not None}
+    if over:
+        data.setdefault("discretisation", {})
+        if not isinstance(data["discretisation"], dict):
+            raise SceneError(p, "discretisation", "must be a table [discretisation]")
+        data["discretisation"] = {**data["discretisation"], **over}
+    return parameters_from_dict(data, p)
+
+
+def title(path) -> str:
+    p = resolve(path)
+    data = tomllib.loads(p.read_text())
+    return data.get("title", p.stem)
