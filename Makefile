@@ -1,0 +1,32 @@
+# rawehelix: two commands on a fresh Debian 12 machine (root or sudo):
+#   make demo   installs what is missing, then runs the Sec. 5.1 scene into results/
+#   make test   installs what is missing, then runs the tests serially and under mpirun -n 2
+
+VENV    := .venv
+PY      := $(VENV)/bin/python
+RAWE    := $(VENV)/bin/rawehelix
+NP      ?= 2
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+MPIRUN  := mpirun -n $(NP) --oversubscribe
+PYTEST_ARGS ?=
+
+.PHONY: install demo test test-serial test-mpi test-debian13 bench clean
+
+install:
+	@bash scripts/install.sh
+
+demo: install
+	$(RAWE) stationary studies/scenes/stationary_table2.toml -o results/stationary_table2/stationary
+	$(RAWE) modes studies/scenes/stationary_table2.toml --scheme spline --elements 2 -o results/stationary_table2/modes_spline_N2
+
+test: install
+	$(PY) -m pytest -q $(PYTEST_ARGS)
+	$(MPIRUN) $(PY) -m pytest -q -m mpi -p no:cacheprovider $(PYTEST_ARGS)
+
+test-debian13:
+	@bash scripts/test-debian13.sh
+
+clean:
+	rm -rf results .pytest_cache

@@ -1,0 +1,130 @@
+"""Every call that differs between DOLFINx 0.5 (Debian 12) and 0.9+ (Debian 13).
+
+Nothing else in rawehelix may test the DOLFINx version.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import dolfinx
+import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.mesh
+import ufl
+
+VERSION = tuple(int(x) for x in dolfinx.__version__.split(".")[:2])
+NEW = VERSION >= (0, 7)
+
+if NEW:
+    import basix.ufl
+
+
+def interval_coordinate_element():
+    """The P1 coordinate element of a 1D interval mesh with gdim 1."""
+    if NEW:
+        return ufl.Mesh(basix.ufl.element("Lagrange", "interval", 1, shape=(1,)))
+    return ufl.Mesh(ufl.VectorElement("Lagrange", ufl.interval, 1, dim=1))
+
+
+def create_mesh_1d(comm, cells: np.ndarray, x: np.ndarray):
+    """A dolfinx mesh from vertex coordinates ``x`` (n, 1) and cells (m, 2).
+
+    Only rank 0's arrays are used; the mesh is then partitioned."""
+    domain = interval_coordinate_element()
+    if comm.rank != 0:
+        cells = np.empty((0, 2), dtype=np.int64)
+        x = np.empty((0, 1), dtype=np.float64)
+    if NEW:
+        return dolfinx.mesh.create_mesh(comm, cells, x, domain)
+    return dolfinx.mesh.create_mesh(comm, cells, x, domain)
+
+
+def rod_element(cell, degree: int):
+    """The mixed (r, alpha) element: vector P_p with 3 components and scalar P_p."""
+    if NEW:
+        vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
+        sca = basix.ufl.element("Lagrange", "interval", degree)
+        return basix.ufl.mixed_element([vec, sca])
+    vec = ufl.VectorElement("Lagrange", cell, degree, dim=3)
+    sca = ufl.FiniteElement("Lagrange", cell, degree)
+    return ufl.MixedElement([vec, sca])
+
+
+def function_space(mesh, element):
+    if NEW:
+        return dolfinx.fem.functionspace(mesh, element)
+    return dolfinx.fem.FunctionSpace(mesh, element)
+
+
+def scalar_space(mesh, family: str, degree: int):
+    if NEW:
+        return dolfinx.fem.functionspace(mesh, (family, degree))
+    return dolfinx.fem.FunctionSpace(mesh, (family, degree))
+
+
+def vector_space(mesh, family: str, degree: int, dim: int = 3):
+    if NEW:
+        return dolfinx.fem.functionspace(mesh, (family, degree, (dim,)))
+    return dolfinx.fem.VectorFunctionSpace(mesh, (family, degree), dim=dim)
+
+
+def petsc_vec(u):
+    """The PETSc vector behind a Function."""
+    return u.x.petsc_vec if NEW else u.vector
+
+
+def interpolation_points(V):
+    ip = V.element.interpolation_points
+    return ip() if callable(ip) else ip
+
+
+def expression(ufl_expr, V):
+    """A dolfinx Expression evaluated at the interpolation points of ``V``."""
+    return dolfinx.fem.Expression(ufl_expr, interpolation_points(V))
+
+
+def create_vector(form):
+    if NEW:
+        try:
+            return dolfinx.fem.petsc.create_vector(form)
+        except TypeError:  # 0.10 takes a list of spaces
+            return dolfinx.fem.petsc.create_vector(form.function_spaces)
+    return dolfinx.fem.petsc.create_vector(form)
+
+
+def create_matrix(form):
+    return dolfinx.fem.petsc.create_matrix(form)
+
+
+def locate_boundary_vertices(mesh, marker):
+    return dolfinx.mesh.locate_entities_boundary(mesh, 0, marker)
+
+
+def cell_count(mesh) -> int:
+    """Number of cells owned by this rank."""
+    return mesh.topology.index_map(mesh.topology.dim).size_local
+
+
+def xdmf_file(comm, path, mode: str = "w"):
+    return dolfinx.io.XDMFFile(comm, str(path), mode)
+
+
+def apply_lifting_and_bc(b, J_form, bcs, x, scale: float = -1.0):
+    """b <- b - scale*A(x - g) lifting, ghost accumulation, then the bc rows of a
+    Newton residual: b_bc = scale*(g - x) (positional arguments: 0.5 calls the
+    factor ``scale``, 0.9 ``alpha``)."""
+    from petsc4py import PETSc
+    dolfinx.fem.petsc.apply_lifting(b, [J_form], [bcs], [x], scale)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    dolfinx.fem.petsc.set_bc(b, bcs, x, scale)
+
+
+def collapse(V_sub):
+    """(collapsed space, map to parent dofs)."""
+    out = V_sub.collapse()
+    return out if isinstance(out, tuple) else (out, None)
+
+
+def meshtags(mesh, dim, indices, values):
+    return dolfinx.mesh.meshtags(mesh, dim, indices, values)

@@ -1,0 +1,140 @@
+"""Weak forms of the rod equations (30)-(31) in pure UFL.
+
+Unknowns on a mixed Lagrange space of degree p >= 2 over s in [0, 1]:
+centre line r (3 components) and twist angle alpha.  With test functions
+(v, psi), v = 0 at both ends (Dirichlet, Eqs. 35-36):
+
+    int r_tt.v + int F_NL.v' + mu B(r, v) - int (k_E + F_A).v = 0        (30)
+    int alpha_tt psi + delta int tau psi' - delta [tau psi]_0^1 = 0       (31)
+
+with F_NL of Eq. (32), tau = gamma + alpha' (34), tau(0) = m0 and
+tau(1) = mN (38)-(39) as natural boundary terms, and B the C0
+interior-penalty form of int r''.v'' (the -F_L' = -mu r'''' term, Eq. 33).
+The zero-curvature ends r'' = 0 (37) are natural: B has no boundary terms.
+
+No solver code here: functions take UFL objects and numbers (or constants)
+and return UFL.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import ufl
+
+from rawehelix.forms.kinematics import d, internal_force, tension, twist
+
+K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
+I_E = ufl.as_vector((1.0, 0.0, 0.0))  # i_E: the wind blows along -i_E
+
+
+@dataclass
+class Coefficients:
+    """The normalised groups of Eqs. (26)-(27) as UFL-ready values.
+
+    Each field is a number or a constant (for instance ``dolfinx.fem.Constant``)
+    so that a solver can change it (torques in time) without recompiling.
+    """
+
+    sigma: Any
+    mu: Any
+    beta: Any
+    nu: Any
+    delta: Any
+    v_w0: Any
+    m0: Any = 0.0  # torque at s = 0, Eq. (38)
+    mN: Any = 0.0  # torque at s = 1, Eq. (39)
+    gravity: Any = 1.0  # 1 switches gravity on, 0 off
+    drag: Any = 1.0
+    bending: Any = 1.0
+    gamma_eps: Any = 1.0e-3
+    gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
+
+    @classmethod
+    def from_normalised(cls, q, model, make=float):
+        """From :class:`rawehelix.forms.parameters.Normalised` and a scene's
+        ``model``; ``make`` wraps each number (e.g. into a dolfinx Constant)."""
+        return cls(
+            sigma=make(q.sigma), mu=make(q.mu), beta=make(q.beta), nu=make(q.nu),
+            delta=make(q.delta), v_w0=make(q.v_w0), m0=make(0.0), mN=make(0.0),
+            gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
+            gamma_eps=make(model.gamma_eps),
+            gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
+        )
+
+
+def jump_d(f, n):
+    """[[f']] = f'(+) n(+) + f'(-) n(-): the jump of the normal derivative at a node."""
+    return d(f)("+") * n("+")[0] + d(f)("-") * n("-")[0]
+
+
+def avg_d2(f):
+    """{{f''}}: the average of the second derivative at a node."""
+    return 0.5 * (d(f, 2)("+") + d(f, 2)("-"))
+
+
+def bending(r, v, degree: int, penalty, dx, dS):
+    """C0 interior-penalty form of int r''.v'' (the dolfinx biharmonic demo, in 1D).
+
+    The penalty eta p^2 / h_avg scales with the degree and the element size;
+    eta is ``discretisation.penalty``.
+    """
+    mesh = dS.ufl_domain()
+    n = ufl.FacetNormal(mesh)
+    h = ufl.CellDiameter(mesh)
+    h_avg = 0.5 * (h("+") + h("-"))
+    alpha_ip = penalty * degree**2 / h_avg
+    return (ufl.inner(d(r, 2), d(v, 2)) * dx
+            - ufl.inner(avg_d2(r), jump_d(v, n)) * dS
+            - ufl.inner(jump_d(r, n), avg_d2(v)) * dS
+            + alpha_ip * ufl.inner(jump_d(r, n), jump_d(v, n)) * dS)
+
+
+def aerodynamic_force(r_t, c: Coefficients):
+    """F~_A = -nu |v_A| v_A with v_A = r_t + v_w0 i_E, Eqs. (14) and (28).
+
+    |v_A| is smoothed by 1e-14 under the root so that its derivative exists at
+    v_A = 0 (it is then zero, as the exact one-sided limits agree)."""
+    v_a = r_t + c.v_w0 * I_E
+    return -c.nu * ufl.sqrt(ufl.dot(v_a, v_a) + 1e-14) * v_a
+
+
+def body_force(r_t, c: Coefficients):
+    """Gravity k_E plus drag F_A per unit length, the right side of Eq. (30)."""
+    return c.gravity * K_E + c.drag * aerodynamic_force(r_t, c)
+
+
+def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx, dS, ds):
+    """Internal forces and end torques of Eqs. (30)-(31): everything but inertia and loads."""
+    x = ufl.SpatialCoordinate(ds.ufl_domain())
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
+    F_NL = internal_force(r, tau, c.sigma, c.mu, c.beta)  # (32)
+    return (ufl.inner(F_NL, d(v)) * dx
+            + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS)  # (33)
+            + c.delta * tau * d(psi) * dx  # (31)
+            # (38)-(39): tau(0) = m0, tau(1) = mN; x = 0 or 1 on the two ends
+            - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)
+
+
+def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures):
+    """The full residual of Eqs. (30)-(31): inertia + elastic - loads.
+
+    ``w``, ``w_t``, ``w_tt``: mixed (r, alpha) fields or their time
+    derivatives; ``w_tt = None`` gives the stationary residual (and ``w_t =
+    None`` zero velocity).  ``measures`` = (dx, dS, ds)."""
+    dx, dS, ds = measures
+    r, alpha = ufl.split(w)
+    v, psi = ufl.split(test)
+    r_t = ufl.split(w_t)[0] if w_t is not None else ufl.as_vector((0.0, 0.0, 0.0))
+    F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds)
+         - ufl.inner(body_force(r_t, c), v) * dx)
+    if w_tt is not None:
+        r_tt, alpha_tt = ufl.split(w_tt)
+        F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
+    return F
+
+
+def tension_of(w, c: Coefficients):
+    """The normalised tension field of a mixed state, Eq. (29)."""
+    return tension(ufl.split(w)[0], c.sigma)

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Runs the test suite against DOLFINx 0.9 (Debian 13) in a debootstrap chroot.
+# Needs root.  The chroot is made once (a few minutes) and reused:
+#   RAWEHELIX_CHROOT=/var/tmp/rawehelix-trixie (default)
+# The working tree is copied in fresh every run (tracked and untracked files,
+# not the venv).  Not part of CI.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=${RAWEHELIX_CHROOT:-/var/tmp/rawehelix-trixie}
+[ "$(id -u)" -eq 0 ] || { echo "test-debian13: needs root (chroot)" >&2; exit 2; }
+
+if [ ! -x "$ROOT/usr/bin/apt-get" ]; then
+  command -v debootstrap >/dev/null || { apt-get update -q; apt-get install -y -q debootstrap; }
+  echo "test-debian13: debootstrap trixie into $ROOT"
+  debootstrap --variant=minbase trixie "$ROOT" http://deb.debian.org/debian
+fi
+mounted=()
+cleanup() { for m in "${mounted[@]}"; do umount -l "$m" || true; done; }
+trap cleanup EXIT
+for m in proc sys dev/shm; do
+  mkdir -p "$ROOT/$m"
+  if ! mountpoint -q "$ROOT/$m"; then
+    case "$m" in
+      proc) mount -t proc proc "$ROOT/proc" ;;
+      sys) mount -t sysfs sysfs "$ROOT/sys" ;;
+      *) mount -t tmpfs tmpfs "$ROOT/$m" ;;
+    esac
+    mounted+=("$ROOT/$m")
+  fi
+done
+cp /etc/resolv.conf "$ROOT/etc/resolv.conf" 2>/dev/null || true
+
+PKGS="python3-dolfinx python3-slepc4py python3-petsc4py python3-scipy python3-pytest
+python3-meshio python3-gmsh python3-matplotlib python3-h5py python3-tqdm openmpi-bin"
+stamp="$ROOT/var/lib/rawehelix-packages"
+if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$PKGS" ]; then
+  chroot "$ROOT" /usr/bin/env DEBIAN_FRONTEND=noninteractive bash -c \
+    "apt-get update -q && apt-get install -y -q --no-install-recommends $(echo $PKGS)"
+  echo "$PKGS" > "$stamp"
+fi
+
+# The package is this folder mapped to the name rawehelix (as pyproject does).
+rm -rf "$ROOT/src" && mkdir -p "$ROOT/src/pkgs"
+git ls-files -co --exclude-standard -z | tar --null -T - -cf - | tar -xf - -C "$ROOT/src" --one-top-level=rawehelix
+ln -s /src/rawehelix "$ROOT/src/pkgs/rawehelix"
+chroot "$ROOT" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root \
+  PYTHONPATH=/src/pkgs OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+  bash -c "cd /src/rawehelix && python3 -c 'import dolfinx; print(\"DOLFINx\", dolfinx.__version__)' \
+    && python3 -m pytest -q -p no:cacheprovider $* \
+    && { mpirun -n 2 --oversubscribe python3 -m pytest -q -m mpi -p no:cacheprovider $*; rc=\$?; \
+         [ \$rc -eq 0 ] || [ \$rc -eq 5 ]; }"  # 5: no test selected

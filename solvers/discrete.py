@@ -1,0 +1,91 @@
+"""The discrete rod: mesh, mixed (r, alpha) space, constants, measures and end conditions.
+
+Shared by the stationary, dynamic and modal solvers.  Built from validated
+:class:`~rawehelix.forms.parameters.Parameters`; reads no files.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from rawehelix import compat
+from rawehelix.forms import rod
+from rawehelix.forms.parameters import Parameters
+from rawehelix.meshes import interval
+
+
+class RodDiscretisation:
+    """Everything a solver needs to assemble Eqs. (30)-(31) on one mesh."""
+
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, pin_twist: bool = True):
+        disc = params.discretisation
+        if disc.scheme != "fe":
+            raise ValueError(f"discretisation.scheme = {disc.scheme!r}: this solver is the FE scheme")
+        self.params = params
+        self.q = params.normalised()
+        self.comm = comm
+        self.degree = disc.degree
+        self.penalty = disc.penalty
+        self.mesh = interval.mesh_from_parameters(comm, params)
+        self.W = compat.function_space(self.mesh, compat.rod_element(self.mesh.ufl_cell(), self.degree))
+        self.w = dolfinx.fem.Function(self.W, name="state")
+        self.test = ufl.TestFunction(self.W)
+        self.trial = ufl.TrialFunction(self.W)
+        self.c = rod.Coefficients.from_normalised(
+            self.q, params.model, make=lambda v: dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(v)))
+        self.measures = (ufl.dx(domain=self.mesh), ufl.dS(domain=self.mesh), ufl.ds(domain=self.mesh))
+        self._set_up_end_conditions(pin_twist)
+
+    # -- end conditions, Eqs. (35), (36), (66), (70) ------------------------------
+    def _set_up_end_conditions(self, pin_twist: bool):
+        mesh = self.mesh
+        bottom = compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 0.0))
+        top = compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 1.0))
+        self.V_r, _ = compat.collapse(self.W.sub(0))
+        self.r_bottom = dolfinx.fem.Function(self.V_r)  # r(0) = 0, Eq. (35)
+        self.r_top = dolfinx.fem.Function(self.V_r)  # r(1) = r_N(t), Eq. (36)
+        self.set_top_position(self.q.top_position(0.0))
+        dofs_b = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, bottom)
+        dofs_t = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, top)
+        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_b, self.W.sub(0)),
+                    dolfinx.fem.dirichletbc(self.r_top, dofs_t, self.W.sub(0))]
+        if pin_twist:
+            # alpha(0) = 0 removes the free rigid rotation (torque-free ends)
+            self.V_a, _ = compat.collapse(self.W.sub(1))
+            self.alpha_bottom = dolfinx.fem.Function(self.V_a)
+            dofs_a = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, bottom)
+            self.bcs.append(dolfinx.fem.dirichletbc(self.alpha_bottom, dofs_a, self.W.sub(1)))
+
+    def set_top_position(self, position):
+        position = np.asarray(position, dtype=float)
+        self.r_top.interpolate(lambda x: np.outer(position, np.ones(x.shape[1])))
+
+    # -- states ------------------------------------------------------------------
+    def set_chord(self, w=None):
+        """w <- the straight chord r = s r_N, alpha = 0: the default first guess."""
+        w = w or self.w
+        top = self.q.top_position(0.0)
+        w.sub(0).interpolate(lambda x: np.outer(top, x[0]))
+        w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
+        w.x.scatter_forward()
+
+    def set_centre_line(self, centre_line, w=None):
+        """w <- (r(s) from a callable s -> (n, 3), alpha = 0)."""
+        w = w or self.w
+        w.sub(0).interpolate(lambda x: np.asarray(centre_line(x[0])).T)
+        w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
+        w.x.scatter_forward()
+
+    def stationary_residual(self, w=None):
+        w = w or self.w
+        return rod.residual(w, None, None, self.test, self.c, self.degree, self.penalty,
+                            self.measures)
+
+    def dof_count(self) -> int:
+        im = self.W.dofmap.index_map
+        return im.size_global * self.W.dofmap.index_map_bs

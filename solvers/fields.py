@@ -1,0 +1,37 @@
+"""Gather finite element fields to rank 0 as arrays over the arc length."""
+
+from __future__ import annotations
+
+import numpy as np
+import dolfinx.fem
+
+from rawehelix import compat
+
+
+def gather(u: "dolfinx.fem.Function", comm=None):
+    """(s, values) of a Lagrange or DG field on rank 0, sorted by s.
+
+    ``s`` holds the dof coordinates (normalised arc length), ``values`` has
+    shape (n, bs).  Other ranks get (None, None).  DG fields repeat the nodes
+    shared by two cells; a stable sort keeps the left cell's value first."""
+    V = u.function_space
+    comm = comm or V.mesh.comm
+    n_owned = V.dofmap.index_map.size_local
+    bs = V.dofmap.index_map_bs
+    s = V.tabulate_dof_coordinates()[:n_owned, 0]
+    vals = u.x.array[: n_owned * bs].reshape(-1, bs)
+    s_all = comm.gather(s, root=0)
+    v_all = comm.gather(vals, root=0)
+    if comm.rank != 0:
+        return None, None
+    s = np.concatenate(s_all)
+    vals = np.concatenate(v_all)
+    order = np.argsort(s, kind="stable")
+    return s[order], vals[order]
+
+
+def interpolate_expression(ufl_expr, V) -> "dolfinx.fem.Function":
+    """A Function on V interpolating a UFL expression."""
+    u = dolfinx.fem.Function(V)
+    u.interpolate(compat.expression(ufl_expr, V))
+    return u

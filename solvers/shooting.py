@@ -1,0 +1,227 @@
+"""Independent reference for the stationary state with fixed ends: Sec. 5.1.
+
+The planar ansatz r~(s~) = x i_E + z k_E, alpha = 0 turns the stationary form of
+Eq. (30),
+
+    mu r'''' = [(T - mu kappa^2) r']' + k_E + F_A,   T = sigma (|r'| - 1)   (29)-(33)
+
+with F_A = -nu v_w0^2 i_E (drag on the full relative velocity v_A = v_w0 i_E,
+Eq. 28) into the first-order system (67)-(68) for the state
+
+    y = (x, z, x_s, z_s, x_ss, z_ss, x_sss, z_sss).
+
+It is solved by (multiple) shooting: the state at s~ = 0 is
+(0, 0, x_s0, z_s0, 0, 0, x_sss0, z_sss0) (Eqs. 35, 37) and the conditions at
+s~ = 1 are x, z = the top end of Eq. (66) and x_ss = z_ss = 0 (Eq. 37).
+
+The axial mode of (67) grows like exp(sqrt(sigma/mu) s~) (exp(27) for the
+scene of Table 2), so one shooting interval would need a Jacobian with a
+condition number ~1e11.  The interval [0, 1] is therefore cut into segments of
+length ~4 sqrt(mu/sigma); the unknowns are the four free values at s~ = 0 and
+the full state at every interior breakpoint, the conditions are continuity at
+the breakpoints and the four conditions at s~ = 1.  With one segment this is
+the plain shooting of the paper.
+
+This module deliberately shares no code with the finite-element path: it uses
+numpy, scipy and the (numpy-only) parameter module, nothing else.  Everything
+is normalised as in Eqs. (25)-(29): lengths by L0, forces by M g.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import root
+
+from rawehelix.forms.parameters import Normalised
+
+__all__ = ["ShootingSolution", "solve", "rhs", "load_vector", "default_segments"]
+
+
+def load_vector(normalised: Normalised) -> np.ndarray:
+    """Distributed load (x, z) per unit normalised length: k_E + F_A.
+
+    Gravity is +k_E (k_E points down, Eq. 30); the stationary drag is
+    F_A = -nu v_w0^2 i_E (Eq. 28 with v_A = v_w0 i_E, since the wind is
+    -v_w0 i_E and the rod is at rest).  Both are scaled by the model switches.
+    """
+    q = normalised
+    return np.array([-q.drag * q.nu * q.v_w0**2, q.gravity])
+
+
+def _bending_modulus(normalised: Normalised) -> float:
+    mu = normalised.mu * normalised.bending
+    if not mu > 0:
+        raise ValueError("the shooting reference needs bending (mu > 0): "
+                         "System (67) is singular for mu = 0")
+    return mu
+
+
+def rhs(normalised: Normalised):
+    """The right-hand side of System (67)-(68) as f(s, y) for solve_ivp.
+
+    ``y`` may be (8,) or (8, n) (vectorised evaluation)."""
+    sigma = normalised.sigma
+    mu = _bending_modulus(normalised)
+    qx, qz = load_vector(normalised)
+
+    def f(s, y):
+        x_s, z_s, x_ss, z_ss, x_sss, z_sss = y[2:8]
+        stretch = np.sqrt(x_s**2 + z_s**2)  # |r'|
+        tension = sigma * (stretch - 1.0)  # T, Eq. (29)
+        kappa2 = x_ss**2 + z_ss**2  # kappa^2, Eq. (34)
+        # f_s = d/ds (T - mu kappa^2), Eq. (68)
+        f_s = sigma / stretch * (x_s * x_ss + z_s * z_ss) - 2.0 * mu * (x_ss * x_sss + z_ss * z_sss)
+        x_4 = (f_s * x_s + (tension - mu * kappa2) * x_ss + qx) / mu  # (67), drag -nu v_w0^2
+        z_4 = (f_s * z_s + (tension - mu * kappa2) * z_ss + qz) / mu  # (67), gravity +1
+        return np.array([x_s, z_s, x_ss, z_ss, x_sss, z_sss, x_4, z_4])
+
+    return f
+
+
+def default_segments(normalised: Normalised) -> int:
+    """Number of shooting segments: each no longer than 4 sqrt(mu/sigma), so the
+    axial mode grows at most by e^4 over a segment."""
+    k = math.sqrt(normalised.sigma / _bending_modulus(normalised))
+    return max(1, math.ceil(k / 4.0))
+
+
+def _top_conditions(normalised: Normalised) -> np.ndarray:
+    top = normalised.top_position(0.0)  # Eq. (66)
+    if abs(top[1]) > 0:
+        raise ValueError("the shooting reference is planar: the top end must have y = 0 "
+                         "(no circle, r1 = 0)")
+    return np.array([top[0], top[2]])
+
+
+@dataclass
+class ShootingSolution:
+    """Stationary centre line from shooting; all quantities normalised."""
+
+    normalised: Normalised
+    initial_state: np.ndarray  # the 8 values of y at s~ = 0
+    boundary_residual: float  # max |mismatch| at s~ = 1 (and at the breakpoints)
+    breakpoints: np.ndarray = field(repr=False, default=None)  # segment ends, [0, ..., 1]
+    _dense: list = field(repr=False, default_factory=list)  # OdeSolution per segment
+
+    def _state(self, s) -> np.ndarray:
+        """y(s) of shape (8, n)."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        if np.any(s < -1e-12) or np.any(s > 1 + 1e-12):
+            raise ValueError("s must lie in [0, 1]")
+        seg = np.clip(np.searchsorted(self.breakpoints, s, side="right") - 1,
+                      0, len(self._dense) - 1)
+        y = np.empty((8, s.size))
+        for k in np.unique(seg):
+            sel = seg == k
+            y[:, sel] = self._dense[k](s[sel])
+        return y
+
+    def derivatives(self, s, order: int) -> np.ndarray:
+        """r~^(order)(s~) as (n, 3) with y = 0; order 0..4 (4 from Eq. 67)."""
+        if order not in (0, 1, 2, 3, 4):
+            raise ValueError("order must be 0, 1, 2, 3 or 4")
+        y = self._state(s)
+        if order == 4:
+            xz = rhs(self.normalised)(0.0, y)[6:8]
+        else:
+            xz = y[2 * order:2 * order + 2]
+        out = np.zeros((y.shape[1], 3))
+        out[:, 0], out[:, 2] = xz[0], xz[1]
+        return out
+
+    def centre_line(self, s) -> np.ndarray:
+        """Normalised positions [x, 0, z], shape (n, 3)."""
+        return self.derivatives(s, 0)
+
+    def tension(self, s) -> np.ndarray:
+        """Normalised tension T~ = sigma (|r~'| - 1), Eq. (29); times M g gives N."""
+        d1 = self.derivatives(s, 1)
+        return self.normalised.sigma * (np.linalg.norm(d1, axis=1) - 1.0)
+
+
+def _integrate(f, s0, s1, y0, rtol, atol, dense=False):
+    sol = solve_ivp(f, (s0, s1), y0, method="DOP853", rtol=rtol, atol=atol,
+                    dense_output=dense)
+    if not sol.success:
+        raise RuntimeError(f"shooting: integration on [{s0}, {s1}] failed: {sol.message}")
+    return sol
+
+
+def solve(normalised: Normalised, rtol: float = 1e-11, atol: float = 1e-13,
+          segments: int | None = None, tol: float = 1e-10) -> ShootingSolution:
+    """Solve System (67)-(68) with the boundary conditions (35)-(37), (66).
+
+    Parameters
+    ----------
+    normalised : Normalised
+        The dimensionless groups; the top end comes from ``top_position()``.
+    rtol, atol : float
+        Tolerances of the DOP853 integration.
+    segments : int, optional
+        Number of shooting segments (1 = simple shooting as in the paper);
+        by default :func:`default_segments`.
+    tol : float
+        Largest accepted boundary (and continuity) mismatch.
+
+    Raises
+    ------
+    RuntimeError
+        If the root finder does not meet the boundary conditions; the message
+        gives the mismatch.
+    """
+    f = rhs(normalised)
+    target = _top_conditions(normalised)
+    m = default_segments(normalised) if segments is None else int(segments)
+    if m < 1:
+        raise ValueError("segments must be >= 1")
+    nodes = np.linspace(0.0, 1.0, m + 1)
+
+    # First guess: the straight chord, r' = (1 + eps0) * chord direction (Eq. 66).
+    slope = target  # r(1) - r(0) with r(0) = 0: already (1 + eps0) times the direction
+    def chord_state(s):
+        return np.array([slope[0] * s, slope[1] * s, slope[0], slope[1], 0, 0, 0, 0], float)
+    guess = [np.array([slope[0], slope[1], 0.0, 0.0])]
+    guess += [chord_state(s) for s in nodes[1:-1]]
+    u0 = np.concatenate(guess)
+
+    def unpack(u):
+        xs0, zs0, xsss0, zsss0 = u[:4]
+        starts = [np.array([0.0, 0.0, xs0, zs0, 0.0, 0.0, xsss0, zsss0])]
+        starts += list(u[4:].reshape(m - 1, 8))
+        return starts
+
+    last = {"mismatch": math.inf}
+
+    def residual(u):
+        starts = unpack(u)
+        res = []
+        for k in range(m):
+            end = _integrate(f, nodes[k], nodes[k + 1], starts[k], rtol, atol).y[:, -1]
+            if k < m - 1:
+                res.append(end - starts[k + 1])  # continuity at the breakpoint
+            else:
+                res.append([end[0] - target[0], end[1] - target[1], end[4], end[5]])
+        res = np.concatenate(res)
+        last["mismatch"] = float(np.max(np.abs(res)))
+        return res
+
+    try:
+        sol = root(residual, u0, method="hybr", options={"xtol": 1e-14})
+    except RuntimeError as err:  # an iterate made the integration blow up
+        raise RuntimeError(f"shooting did not converge: boundary mismatch "
+                           f"{last['mismatch']:.3e} at the last complete iterate ({err}); "
+                           f"try more segments") from None
+    mismatch = float(np.max(np.abs(residual(sol.x))))
+    if not np.isfinite(mismatch) or mismatch > tol:
+        raise RuntimeError(
+            f"shooting did not converge: boundary mismatch {mismatch:.3e} > {tol:.1e} "
+            f"({sol.message})")
+    starts = unpack(sol.x)
+    dense = [_integrate(f, nodes[k], nodes[k + 1], starts[k], rtol, atol, dense=True).sol
+             for k in range(m)]
+    return ShootingSolution(normalised=normalised, initial_state=starts[0],
+                            boundary_residual=mismatch, breakpoints=nodes, _dense=dense)

@@ -1,0 +1,104 @@
+"""A Newton solver (PETSc SNES) for a nonlinear form with Dirichlet conditions."""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+import ufl
+from petsc4py import PETSc
+
+from rawehelix import compat
+
+SNES_DEFAULTS = {
+    "snes_type": "newtonls",
+    # Full Newton steps: near convergence the residual of the fourth-order
+    # bending term reaches a round-off floor that grows like N^3 (its Jacobian
+    # entries grow like mu p^4 / h^3), where a backtracking line search gives
+    # up.  Convergence is then declared on the step: |dx| < stol |x|.
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1.0e-10,
+    "snes_atol": 1.0e-12,
+    "snes_stol": 1.0e-12,
+    "snes_max_it": 50,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+class SolverError(RuntimeError):
+    """A solve failed; the message says what, where and what to try."""
+
+
+def set_default_options(prefix: str, defaults: dict):
+    """Put defaults into the PETSc options database unless the user set them
+    (on the command line, ``-rawehelix_snes_max_it 100`` etc.)."""
+    opts = PETSc.Options()
+    for key, value in defaults.items():
+        if not opts.hasName(prefix + key):
+            opts[prefix + key] = value
+
+
+class NewtonSolver:
+    """SNES on F(u; v) = 0 with bcs; the Jacobian is the UFL derivative of F."""
+
+    def __init__(self, F: ufl.Form, u: dolfinx.fem.Function, bcs, prefix="rawehelix_",
+                 J: ufl.Form | None = None, options: dict | None = None):
+        self.u, self.bcs = u, bcs
+        self.F = dolfinx.fem.form(F)
+        self.J = dolfinx.fem.form(J if J is not None else ufl.derivative(F, u))
+        self.b = compat.create_vector(self.F)
+        self.A = compat.create_matrix(self.J)
+        self.x = compat.petsc_vec(u).copy()
+        self.snes = PETSc.SNES().create(u.function_space.mesh.comm)
+        self.snes.setOptionsPrefix(prefix)
+        set_default_options(prefix, {**SNES_DEFAULTS, **(options or {})})
+        self.snes.setFunction(self._residual, self.b)
+        self.snes.setJacobian(self._jacobian, self.A)
+        self.snes.setFromOptions()
+        self.snes.getKSP().setFromOptions()
+        self.prefix = prefix
+
+    def _update(self, x):
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        x.copy(compat.petsc_vec(self.u))
+        self.u.x.scatter_forward()
+
+    def _residual(self, snes, x, b):
+        self._update(x)
+        with b.localForm() as b_local:
+            b_local.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(b, self.F)
+        compat.apply_lifting_and_bc(b, self.J, self.bcs, x, -1.0)
+
+    def _jacobian(self, snes, x, A, P):
+        A.zeroEntries()
+        dolfinx.fem.petsc.assemble_matrix(A, self.J, self.bcs)
+        A.assemble()
+
+    def residual_norm(self) -> float:
+        """|F(u)| at the current u with the bc rows (u - g)."""
+        x = compat.petsc_vec(self.u).copy()
+        self._residual(self.snes, x, self.b)
+        return self.b.norm()
+
+    def solve(self, what: str = "Newton solve") -> int:
+        """Solve from the current u; return the iteration count or raise SolverError."""
+        compat.petsc_vec(self.u).copy(self.x)
+        self.snes.solve(None, self.x)
+        reason = self.snes.getConvergedReason()
+        its = self.snes.getIterationNumber()
+        if reason <= 0:
+            fnorm = self.snes.getFunctionNorm()
+            raise SolverError(
+                f"{what}: SNES did not converge (reason {reason_name(reason)}) after {its} "
+                f"iterations, last residual norm {fnorm:.3e}. Try more elements (--elements), "
+                f"a better first guess, or PETSc options such as -{self.prefix}snes_max_it 200 "
+                f"-{self.prefix}snes_linesearch_type l2.")
+        self._update(self.x)
+        return its
+
+
+def reason_name(reason: int) -> str:
+    names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if isinstance(v, int)}
+    return f"{names.get(reason, '?')} ({reason})"

@@ -1,0 +1,83 @@
+"""Stationary state with fixed ends (Sec. 5.1) by Newton's method (PETSc SNES).
+
+Ends fixed by Eqs. (35), (36) and (66); alpha(0) = 0 pins the free rotation.
+The first guess is the straight chord, or any state the caller sets.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import dolfinx.fem
+from mpi4py import MPI
+
+from rawehelix import compat
+from rawehelix.forms import kinematics, rod
+from rawehelix.forms.parameters import Parameters
+from rawehelix.solvers import fields
+from rawehelix.solvers.discrete import RodDiscretisation
+from rawehelix.solvers.snes import NewtonSolver, SolverError
+
+
+@dataclass
+class StationaryResult:
+    """A converged stationary state, gathered on rank 0 (None elsewhere)."""
+
+    s: np.ndarray  # nodes of the centre line, normalised arc length
+    centre_line: np.ndarray  # (n, 3) normalised positions
+    s_tension: np.ndarray  # nodes of the tension field
+    tension: np.ndarray  # normalised tension, Eq. (29)
+    newton_iterations: int
+    wall_s: float
+
+
+class StationarySolver:
+    """Newton for the stationary residual of Eqs. (30)-(31) on one discretisation."""
+
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene"):
+        self.params, self.scene = params, scene
+        self.rod = RodDiscretisation(params, comm)
+        self.F = self.rod.stationary_residual()
+        self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
+        p = self.rod.degree
+        self.V_T = compat.scalar_space(self.rod.mesh, "DG", p - 1)
+        self.tension_expr = rod.tension_of(self.rod.w, self.rod.c)
+
+    def solve(self, first_guess=None) -> StationaryResult:
+        """Solve from the chord (or ``first_guess``: s -> (n, 3) centre line)."""
+        start = time.perf_counter()
+        if first_guess is None:
+            self.rod.set_chord()
+        else:
+            self.rod.set_centre_line(first_guess)
+        try:
+            its = self.newton.solve(f"stationary state of {self.scene}")
+        except SolverError as err:
+            raise SolverError(f"{self.scene}: {err}") from None
+        result = self.gather()
+        result.newton_iterations = its
+        result.wall_s = time.perf_counter() - start
+        return result
+
+    def gather(self) -> StationaryResult:
+        r = self.rod.w.sub(0).collapse()
+        r = r[0] if isinstance(r, tuple) else r
+        s, x = fields.gather(r)
+        T = fields.interpolate_expression(self.tension_expr, self.V_T)
+        sT, Tv = fields.gather(T)
+        return StationaryResult(s, x, sT, None if Tv is None else Tv[:, 0], 0, 0.0)
+
+    def residual_at(self, centre_line) -> float:
+        """|F| at the state (r = centre_line(s), alpha = 0): the FE residual of
+        an outside solution such as the shooting one (paper Sec. 5.1)."""
+        self.rod.set_centre_line(centre_line)
+        return self.newton.residual_norm()
+
+
+def sag(centre_line: np.ndarray, top: np.ndarray) -> float:
+    """Largest distance of the centre line from the chord 0 -> top."""
+    e = top / np.linalg.norm(top)
+    along = centre_line @ e
+    return float(np.max(np.linalg.norm(centre_line - np.outer(along, e), axis=1)))

@@ -1,0 +1,104 @@
+"""Writers: summary.json, PNG figures and XDMF files.  Writers never solve.
+
+Every function here runs on one rank (the caller picks rank 0)."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
+def write_json(path: Path, data: dict) -> Path:
+    """Write JSON atomically: a reader never sees half a file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    with os.fdopen(fd, "w") as f:
+        json.dump(_jsonable(data), f, indent=2)
+        f.write("\n")
+    os.replace(tmp, path)
+    return path
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _deflection(x_m):
+    """Signed in-plane distance from the chord and out-of-plane y, along the chord."""
+    chord = x_m[-1] - x_m[0]
+    e = chord / np.linalg.norm(chord)
+    normal = np.cross(e, [0.0, 1.0, 0.0])  # in the x-z plane, normal to the chord
+    d = x_m - x_m[0]
+    return d @ e, d @ normal, d[:, 1]
+
+
+def centre_line_png(path: Path, s_m, x_m, tension_s_m, tension_N, title: str,
+                    reference_x_m=None, reference_label="shooting") -> Path:
+    """Three panels: the centre line in the x-z plane (z down, as in the paper),
+    its deflection from the chord (the sag is too small to see in the first),
+    and the tension along s."""
+    plt = _pyplot()
+    fig, (ax0, ax1, ax2) = plt.subplots(1, 3, figsize=(15, 4.2))
+    ax0.plot(x_m[:, 0], x_m[:, 2], "-", lw=2, label="FE centre line")
+    ax0.plot([x_m[0, 0], x_m[-1, 0]], [x_m[0, 2], x_m[-1, 2]], "k:", lw=1, label="chord")
+    ax0.invert_yaxis()
+    ax0.set_xlabel("x [m]")
+    ax0.set_ylabel("z [m] (down)")
+    ax0.set_aspect("equal", adjustable="datalim")
+    ax0.legend(loc="best")
+    ax0.set_title("centre line")
+    along, normal, y = _deflection(x_m)
+    ax1.plot(along, 1e3 * normal, "-", lw=2, label="FE, in plane")
+    if np.any(np.abs(y) > 1e-9):
+        ax1.plot(along, 1e3 * y, "-", lw=1, label="FE, out of plane (y)")
+    if reference_x_m is not None:
+        r_along, r_normal, _ = _deflection(reference_x_m)
+        ax1.plot(r_along, 1e3 * r_normal, "--", lw=1.5, label=reference_label)
+    ax1.set_xlabel("distance along the chord [m]")
+    ax1.set_ylabel("deflection from the chord [mm]")
+    ax1.set_title("deflection (normal to the chord)")
+    ax1.grid(True, alpha=0.3)
+    ax1.legend(loc="best")
+    ax2.plot(tension_s_m, tension_N, "-")
+    ax2.set_xlabel("s [m]")
+    ax2.set_ylabel("tension T [N]")
+    ax2.set_title("tension, Eq. (22)")
+    ax2.grid(True, alpha=0.3)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def centre_line_xdmf(path: Path, x_m, point_data: dict) -> Path:
+    """The deformed centre line as a polyline in 3D with point data, for ParaView."""
+    import meshio
+    n = len(x_m)
+    cells = [("line", np.stack([np.arange(n - 1), np.arange(1, n)], axis=1))]
+    mesh = meshio.Mesh(np.asarray(x_m, dtype=float), cells,
+                       point_data={k: np.asarray(v, dtype=float) for k, v in point_data.items()})
+    meshio.write(str(path), mesh)
+    return path

@@ -1,0 +1,101 @@
+"""Scenes: the shipped files, their normalisation, and every kind of bad input.
+
+Bad input exits with status 2, one message naming file, key and what is
+allowed, and no output directory."""
+
+import math
+import tomllib
+
+import pytest
+
+from rawehelix.studies import cli, scene
+from tests_util import write_scene
+
+SHIPPED = ("stationary_table2", "nominal_operation", "mobile_end", "example")
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_shipped_scenes_load(name):
+    p = scene.load(name)
+    assert p.discretisation.scheme == "fe"
+    assert p.normalised().chord_tension() > 0
+
+
+def test_table2_normalisation_matches_paper():
+    """Sec. 5.2: m_N0 = 2.88 and t0 = 2 correspond to 25 Nm and 2.6 s; Sec. 5.1:
+    the torsional period 2 sqrt(L0/(delta g)) is about 0.4 s."""
+    q = scene.load("nominal_operation").normalised()
+    assert q.mN0 == pytest.approx(2.88, abs=0.005)
+    assert q.t0 == pytest.approx(2.0, abs=0.01)
+    assert 2 * math.sqrt(16.12 / (q.delta * 9.81)) == pytest.approx(0.4, abs=0.01)
+    assert q.tension_N(q.chord_tension()) == pytest.approx(200.2, abs=0.1)  # EA eps0
+
+
+def test_mobile_end_top_follows_eq70():
+    q = scene.load("mobile_end").normalised()
+    r0 = q.top_position(0.0)
+    assert r0[1] == pytest.approx(0.1 / 7.9)  # r1 cos(0) j_E
+    # the circle has radius R1 about the chord end
+    centre = q.top_position(0.0) - q.r1 * (q.top_position(0.0) - q.top_position(math.pi / q.omega1)) / (2 * q.r1)
+    for t in (0.1, 0.37, 1.2):
+        assert abs(abs(sum((q.top_position(t) - centre) ** 2)) ** 0.5 - q.r1) < 1e-12
+
+
+BAD = [
+    # (section, key, value, words expected in the message)
+    ("helix", "colour", "red", "unknown key"),
+    ("helix", "length_m", "long", "must be a number"),
+    ("discretisation", "elements", 2.5, "must be an integer"),
+    ("model", "gravity", 1, "true or false"),
+    ("helix", "length_m", 0.0, "> 0"),
+    ("helix", "mass_kg", -1.0, "> 0"),
+    ("helix", "EA_N", 0.0, "> 0"),
+    ("helix", "EI_Nm2", -5.0, "> 0"),
+    ("helix", "GJ_Nm2", 0.0, "> 0"),
+    ("ends", "elongation", 0.0, "tension"),
+    ("ends", "elongation", -0.01, "tension"),
+    ("discretisation", "elements", 0, ">= 1"),
+    ("discretisation", "degree", 1, "2 to 8"),
+    ("discretisation", "scheme", "hermite", "one of"),
+]
+
+
+@pytest.mark.parametrize("section,key,value,words", BAD)
+def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, section, key, value, words):
+    path = write_scene(tmp_path / "bad.toml", {section: {key: value}})
+    out = tmp_path / "out"
+    assert cli.main(["stationary", str(path), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert str(path) in err and f"{section}.{key}" in err and words in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("flag,value,key", [("--elements", "0", "discretisation.elements"),
+                                            ("--degree", "1", "discretisation.degree")])
+def test_bad_override_exits_2(tmp_path, capsys, flag, value, key):
+    out = tmp_path / "out"
+    assert cli.main(["stationary", "stationary_table2", flag, value, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "stationary_table2.toml" in err
+    assert not out.exists()
+
+
+def test_missing_file(tmp_path, capsys):
+    out = tmp_path / "out"
+    missing = tmp_path / "nowhere.toml"
+    assert cli.main(["stationary", str(missing), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert str(missing) in err and "no such scene file" in err
+    assert not out.exists()
+
+
+def test_unknown_section_and_missing_section(tmp_path, capsys):
+    path = write_scene(tmp_path / "s.toml", {"weather": {"rain": True}})
+    assert cli.main(["stationary", str(path), "-o", str(tmp_path / "o")]) == 2
+    assert "weather" in capsys.readouterr().err
+    data = tomllib.loads(scene.resolve("stationary_table2").read_text())
+    del data["ends"]
+    path = write_scene(tmp_path / "t.toml", {}, base=data)
+    assert cli.main(["stationary", str(path), "-o", str(tmp_path / "o")]) == 2
+    assert "[ends]" in capsys.readouterr().err
