@@ -35,9 +35,13 @@ def create_mesh_1d(comm, cells: np.ndarray, x: np.ndarray):
     if comm.rank != 0:
         cells = np.empty((0, 2), dtype=np.int64)
         x = np.empty((0, 1), dtype=np.float64)
+    # Interior-facet integrals (the interior-penalty terms) need the facets on
+    # process boundaries ghosted: GhostMode.shared_facet (not 0.9's default).
     if NEW:
-        return dolfinx.mesh.create_mesh(comm, cells, x, domain)
-    return dolfinx.mesh.create_mesh(comm, cells, x, domain)
+        partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet)
+        return dolfinx.mesh.create_mesh(comm, cells, x, domain, partitioner=partitioner)
+    return dolfinx.mesh.create_mesh(comm, cells, x, domain,
+                                    ghost_mode=dolfinx.mesh.GhostMode.shared_facet)
 
 
 def rod_element(cell, degree: int):
@@ -128,3 +132,26 @@ def collapse(V_sub):
 
 def meshtags(mesh, dim, indices, values):
     return dolfinx.mesh.meshtags(mesh, dim, indices, values)
+
+
+def rod_pair_element(cell, degree: int):
+    """The first-order (r, alpha, r_t, alpha_t) element: two copies of :func:`rod_element`'s
+    fields, flattened into one mixed element of four sub-elements."""
+    if NEW:
+        vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
+        sca = basix.ufl.element("Lagrange", "interval", degree)
+        return basix.ufl.mixed_element([vec, sca, vec, sca])
+    vec = ufl.VectorElement("Lagrange", cell, degree, dim=3)
+    sca = ufl.FiniteElement("Lagrange", cell, degree)
+    return ufl.MixedElement([vec, sca, vec, sca])
+
+
+def set_bc_rows(b, bcs, x, scale: float = -1.0):
+    """Only the Dirichlet rows of a Newton residual: b_bc = scale*(g - x)."""
+    dolfinx.fem.petsc.set_bc(b, bcs, x, scale)
+
+
+def vertex_tags(mesh, vertices, value: int = 1):
+    """Meshtags marking the given (sorted) vertices, dim 0, for dS/ds subdomains."""
+    vertices = np.asarray(vertices, dtype=np.int32)
+    return dolfinx.mesh.meshtags(mesh, 0, vertices, np.full(len(vertices), value, dtype=np.int32))

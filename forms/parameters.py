@@ -195,6 +195,40 @@ class Time:
 
 
 @dataclass(frozen=True)
+class Sweep:
+    """A sweep over the frequency f1 of the upper end's circle (Sec. 5.3, Fig. 8)."""
+
+    f1_start_Hz: float = 0.5  # first f1 [Hz]
+    f1_stop_Hz: float = 15.0  # last f1 (included when on the step) [Hz]
+    f1_step_Hz: float = 0.5  # step [Hz]
+    lead_in_s: float = 10.0  # simulated time before the first point of a chunk is judged [s]
+    periodic_tolerance: float = 1.0e-3  # relative change of the per-period maximum tension
+    min_periods: int = 4  # periods integrated at each f1 before judging periodicity
+    max_periods: int = 200  # cap; a point that hits it is flagged not periodic
+    record_periods: int = 4  # periods over which max, min and mean tension are taken
+    samples_per_period: int = 64  # tension samples per forcing period
+
+    def __post_init__(self):
+        _positive("sweep", self, "f1_start_Hz", "f1_stop_Hz", "f1_step_Hz", "periodic_tolerance")
+        _non_negative("sweep", self, "lead_in_s")
+        if self.f1_stop_Hz < self.f1_start_Hz:
+            raise ParameterError("sweep.f1_stop_Hz", self.f1_stop_Hz, "must be >= sweep.f1_start_Hz")
+        for name in ("min_periods", "max_periods", "record_periods"):
+            if getattr(self, name) < 1:
+                raise ParameterError(f"sweep.{name}", getattr(self, name), "must be an integer >= 1")
+        if self.max_periods < self.min_periods or self.record_periods > self.max_periods:
+            raise ParameterError("sweep.max_periods", self.max_periods,
+                                 "must be >= sweep.min_periods and >= sweep.record_periods")
+        if self.samples_per_period < 8:
+            raise ParameterError("sweep.samples_per_period", self.samples_per_period,
+                                 "must be an integer >= 8")
+
+    def frequencies(self) -> list[float]:
+        n = int(math.floor((self.f1_stop_Hz - self.f1_start_Hz) / self.f1_step_Hz + 1e-9))
+        return [round(self.f1_start_Hz + k * self.f1_step_Hz, 10) for k in range(n + 1)]
+
+
+@dataclass(frozen=True)
 class Parameters:
     """Everything physical and numerical about one scene, in SI units."""
 
@@ -206,6 +240,7 @@ class Parameters:
     model: Model = field(default_factory=Model)
     discretisation: Discretisation = field(default_factory=Discretisation)
     time: Time = field(default_factory=Time)
+    sweep: Sweep = field(default_factory=Sweep)
 
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:
@@ -239,6 +274,7 @@ class Normalised:
     Gamma0: float  # [rad]
     r1: float  # R1 / L0, Eq. (70)
     omega1: float  # 2 pi f1 t_scale, Eq. (70)
+    phase0: float  # phase of the circle at t~ = 0: omega1 t~ + phase0 in Eq. (70) [rad]
     # torque ramp (69) and controller (40)
     mN0: float
     t0: float
@@ -266,6 +302,7 @@ class Normalised:
             v_w0=env.wind_speed_m_s / math.sqrt(g * L0),
             eps0=e.elongation, Gamma0=math.radians(e.elevation_deg),
             r1=e.circle_radius_m / L0, omega1=2 * math.pi * e.circle_frequency_Hz * t_scale,
+            phase0=0.0,
             mN0=p.torque.top_Nm / (h.GJ_Nm2 / L0), t0=p.torque.rise_time_s / t_scale,
             k1=p.controller.k1, k2=p.controller.k2,
             spin_target=p.controller.target_rpm * RPM * t_scale,
@@ -294,20 +331,32 @@ class Normalised:
         """r~(1, t~): Eq. (66), with the circle of Eq. (70) when r1 > 0."""
         c, s = math.cos(self.Gamma0), math.sin(self.Gamma0)
         a = 1.0 + self.eps0
-        sw, cw = math.sin(self.omega1 * t), math.cos(self.omega1 * t)
+        sw, cw = math.sin(self.phase(t)), math.cos(self.phase(t))
         r1 = self.r1
         return np.array([-(a * c + r1 * s * sw), r1 * cw, -(a * s - r1 * c * sw)])
+
+    def phase(self, t: float) -> float:
+        """omega1 t~ + phase0, the angle of the upper end on its circle, Eq. (70)."""
+        return self.omega1 * t + self.phase0
+
+    def at_frequency(self, f1_Hz: float, t_start: float = 0.0) -> "Normalised":
+        """The same scene with the circle at f1, at phase 0 at time t~ = t_start.
+
+        A sweep keeps time running (torque ramp, controller) and restarts the
+        circle's phase at each new frequency, so the end does not jump."""
+        omega1 = 2 * math.pi * f1_Hz * self.t_scale
+        return dataclasses.replace(self, omega1=omega1, phase0=-omega1 * t_start)
 
     def top_velocity(self, t: float = 0.0) -> np.ndarray:
         """d r~(1, t~)/dt~ of Eq. (70)."""
         c, s, w, r1 = math.cos(self.Gamma0), math.sin(self.Gamma0), self.omega1, self.r1
-        cw, sw = math.cos(w * t), math.sin(w * t)
+        cw, sw = math.cos(self.phase(t)), math.sin(self.phase(t))
         return r1 * w * np.array([-s * cw, -sw, c * cw])
 
     def top_acceleration(self, t: float = 0.0) -> np.ndarray:
         """d^2 r~(1, t~)/dt~^2 of Eq. (70)."""
         c, s, w, r1 = math.cos(self.Gamma0), math.sin(self.Gamma0), self.omega1, self.r1
-        cw, sw = math.cos(w * t), math.sin(w * t)
+        cw, sw = math.cos(self.phase(t)), math.sin(self.phase(t))
         return r1 * w**2 * np.array([s * sw, -cw, -c * sw])
 
     def top_torque(self, t: float) -> float:

@@ -2,6 +2,8 @@
 
     rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
+    rawehelix simulate SCENE [-o DIR] [--until T] [--elements N] [--degree p] [PETSc options]
+    rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
 
 SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
 ``nominal_operation``, ``mobile_end``).  Options that argparse does not know
@@ -19,14 +21,16 @@ from pathlib import Path
 
 from rawehelix.studies import scene as scenes
 
-COMMANDS = ("stationary", "modes")
+COMMANDS = ("stationary", "modes", "simulate", "sweep")
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rawehelix", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
     for name, help_text in (("stationary", "stationary state with fixed ends (Sec. 5.1)"),
-                            ("modes", "natural modes about the stationary state (Table 3)")):
+                            ("modes", "natural modes about the stationary state (Table 3)"),
+                            ("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)"),
+                            ("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)")):
         p = sub.add_parser(name, help=help_text)
         p.add_argument("scene", help="scene TOML file, or the name of a shipped scene")
         p.add_argument("-o", "--output", type=Path, default=None,
@@ -37,12 +41,36 @@ def _parser() -> argparse.ArgumentParser:
                        help="discretisation scheme (default: the scene's)")
         if name == "modes":
             p.add_argument("--count", type=int, default=None, help="number of modes to report")
+        if name == "simulate":
+            p.add_argument("--until", type=float, default=None,
+                           help="end of the simulation [s] (default: the scene's time.until_s)")
+        if name == "sweep":
+            p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
+                           help="frequencies in Hz (default: the scene's [sweep] section)")
+            p.add_argument("--series", action="store_true",
+                           help="also write each point's tension time series (CSV)")
     return parser
 
 
 def _fail(message: str) -> int:
     print(f"rawehelix: error: {message}", file=sys.stderr)
     return 2
+
+
+def _frequencies(spec: str | None, params) -> list[float]:
+    """START:STOP:STEP in Hz, or the scene's [sweep] section."""
+    if spec is None:
+        return params.sweep.frequencies()
+    try:
+        start, stop, step = (float(v) for v in spec.split(":"))
+    except ValueError:
+        raise ValueError(f"{spec!r} is not START:STOP:STEP (numbers in Hz)") from None
+    if not (start > 0 and stop >= start and step > 0):
+        raise ValueError(f"{spec!r}: needs 0 < START <= STOP and STEP > 0")
+    from rawehelix.forms.parameters import Sweep
+    import dataclasses
+    return dataclasses.replace(Sweep(), f1_start_Hz=start, f1_stop_Hz=stop,
+                               f1_step_Hz=step).frequencies()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -58,8 +86,18 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(str(err))
     if args.command == "modes" and args.count is not None and args.count < 1:
         return _fail("--count: must be an integer >= 1")
+    if args.command == "simulate" and args.until is not None and not args.until > 0:
+        return _fail("--until: must be a number of seconds > 0")
+    if args.command == "simulate" and params.discretisation.scheme != "fe":
+        return _fail(f"{scenes.resolve(args.scene)}: discretisation.scheme: 'simulate' runs the FE "
+                     "scheme (the spline reference is solvers.spline_galerkin.dynamics)")
     path = scenes.resolve(args.scene)
     name = path.stem
+    if args.command == "sweep":
+        try:
+            frequencies = _frequencies(args.f1, params)
+        except ValueError as err:
+            return _fail(f"--f1: {err}")
     outdir = args.output or Path("results") / name / args.command
 
     # PETSc reads its options once, at initialisation: before any import of PETSc.
@@ -79,6 +117,16 @@ def main(argv: list[str] | None = None) -> int:
         elif args.command == "modes":
             from rawehelix.studies import modes
             modes.run(params, outdir, count=args.count, log=log)
+        elif args.command == "simulate":
+            from rawehelix.studies import simulate
+            simulate.run(params, outdir, name=name, title=scenes.title(path), until_s=args.until,
+                         log=log)
+        elif args.command == "sweep":
+            from rawehelix.studies import sweep
+            try:
+                sweep.run(params, outdir, frequencies, name=name, log=log, series=args.series)
+            except sweep.SweepError as err:
+                return _fail(str(err))
     except SolverError as err:
         print(f"rawehelix: {err}", file=sys.stderr)
         return 1

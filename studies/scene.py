@@ -17,13 +17,13 @@ import tomllib
 from pathlib import Path
 
 from rawehelix.forms.parameters import (Controller, Discretisation, Ends, Environment,
-                                        Helix, Model, ParameterError, Parameters, Time,
-                                        Torque)
+                                        Helix, Model, ParameterError, Parameters, Sweep,
+                                        Time, Torque)
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
     "controller": Controller, "model": Model, "discretisation": Discretisation,
-    "time": Time,
+    "time": Time, "sweep": Sweep,
 }
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}

@@ -1,0 +1,104 @@
+"""Periodic response to the circular motion of the upper end (Sec. 5.3, Eq. 70).
+
+At one forcing frequency f1, integrate whole forcing periods until the
+response is periodic: the maximum of the tension at s = 0 over one period
+changes by less than ``sweep.periodic_tolerance`` (relative) from one period
+to the next, for ``sweep.record_periods`` periods in a row.  A point that reaches ``sweep.max_periods`` first is flagged
+``periodic = False``, never silently accepted.
+
+Time keeps running across frequencies (the torque ramp (69) and the
+controller (40) see one clock), and the circle restarts at phase 0 at every
+new frequency; since every point ends after whole periods, the upper end
+never jumps: continuation as in the paper.
+
+A *backend* integrates the rod; it works in normalised units and provides
+
+    backend.stationary()                     -> state at t = 0 (stationary, top at phase 0)
+    backend.advance(state, q, t0, t1, t_out) -> (state at t1, tension at s = 0 at t_out)
+    backend.pack(state) -> dict of arrays;  backend.unpack(dict) -> state
+
+with ``q`` the :class:`~rawehelix.forms.parameters.Normalised` of the current
+frequency (``Normalised.at_frequency``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rawehelix.forms.parameters import Normalised, Sweep
+
+
+@dataclass
+class PointResult:
+    """The periodic response at one f1, in SI units."""
+
+    f1_Hz: float
+    tension_max_N: float
+    tension_min_N: float
+    tension_mean_N: float
+    periods: int  # periods integrated at this f1 (lead-in not counted)
+    periodic: bool
+    wall_s: float
+    start: str  # "stationary" (with lead-in) or "continuation"
+    period_maxima_N: list = field(default_factory=list)
+    series_t_s: np.ndarray | None = None  # tension at s = 0 over the recorded periods
+    series_tension_N: np.ndarray | None = None
+
+    def entry(self) -> dict:
+        """The summary.json entry."""
+        return {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
+                "tension_min_N": self.tension_min_N, "tension_mean_N": self.tension_mean_N,
+                "periods": self.periods, "periodic": self.periodic, "wall_s": self.wall_s,
+                "start": self.start}
+
+
+def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start: float,
+                      sweep: Sweep, lead_in: bool):
+    """Integrate at f1 from ``state`` at normalised time ``t_start``.
+
+    Returns (PointResult, final state, final normalised time)."""
+    start_wall = time.perf_counter()
+    q = q_base.at_frequency(f1_Hz, t_start)
+    period = 2 * math.pi / q.omega1
+    n = sweep.samples_per_period
+    t = t_start
+    if lead_in and sweep.lead_in_s > 0:
+        n_lead = math.ceil(sweep.lead_in_s / q.t_scale / period)
+        for _ in range(n_lead):
+            state, _ = backend.advance(state, q, t, t + period, np.array([t + period]))
+            t += period
+    maxima, history = [], []
+    periodic = False
+    for k in range(1, sweep.max_periods + 1):
+        t_out = t + period * np.arange(1, n + 1) / n
+        state, tension = backend.advance(state, q, t, t + period, t_out)
+        if not np.all(np.isfinite(tension)):
+            raise FloatingPointError(f"f1 = {f1_Hz} Hz: the tension is not finite at "
+                                     f"t = {q.time_s(t):.3f} s")
+        t += period
+        maxima.append(float(np.max(tension)))
+        history.append((t_out, tension))
+        history = history[-sweep.record_periods:]
+        # periodic: the per-period maximum changed by less than the tolerance
+        # between each of the last record_periods + 1 periods (one small change
+        # alone can be the flat top of a slow beat)
+        window = np.array(maxima[-(sweep.record_periods + 1):])
+        if k >= max(sweep.min_periods, sweep.record_periods + 1):
+            changes = np.abs(np.diff(window))
+            if np.all(changes <= sweep.periodic_tolerance * np.abs(window[1:])):
+                periodic = True
+                break
+    t_rec = np.concatenate([h[0] for h in history])
+    T_rec = q.tension_N(np.concatenate([h[1] for h in history]))
+    result = PointResult(
+        f1_Hz=f1_Hz, tension_max_N=float(T_rec.max()), tension_min_N=float(T_rec.min()),
+        tension_mean_N=float(T_rec.mean()), periods=len(maxima), periodic=periodic,
+        wall_s=time.perf_counter() - start_wall,
+        start="stationary" if lead_in else "continuation",
+        period_maxima_N=[float(v) for v in q.tension_N(np.array(maxima))],
+        series_t_s=q.time_s(t_rec), series_tension_N=T_rec)
+    return result, state, t

@@ -1,0 +1,252 @@
+"""`rawehelix sweep`: the frequency sweep of Sec. 5.3 (Fig. 8), resumable and MPI-parallel.
+
+For each f1 the response is integrated until periodic (see
+:mod:`rawehelix.solvers.periodic`) and the maximum, minimum and mean tension at
+s = 0 over the last periods are recorded.  Each f1 continues from the final
+state of the previous one, as in the paper.
+
+Under ``mpirun -n k`` the sorted frequency list is cut into k contiguous
+chunks; each rank runs its chunk on its own communicator (COMM_SELF), with
+continuation inside the chunk; the first point of a chunk starts from the
+stationary state with a lead-in (``sweep.lead_in_s``).  Rank 0 gathers.
+
+Output directory:
+
+    sweep.json          the results file: fingerprint and finished points,
+                        rewritten atomically after every point
+    points/f1_*.json    one finished point (entry and its tension series)
+    points/f1_*.npz     its final state, for continuation and resuming
+    computed.log        one line per point computed (to check resuming)
+    summary.json        points, resonance_Hz, elements, degree, ranks, wall_s
+    sweep.png           Fig. 8: maximum tension against f1, inset T(t) near 10 Hz
+
+Re-running the same command skips finished points; a run with another scene
+or discretisation into the same directory is refused.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.forms.parameters import Parameters
+from rawehelix.solvers.periodic import periodic_response
+from rawehelix.studies import writers
+
+RESULTS = "sweep.json"
+
+
+class SweepError(ValueError):
+    """The output directory belongs to another sweep."""
+
+
+def fingerprint(params: Parameters) -> str:
+    """A hash of everything that changes the points: not f1 itself, the f1
+    list, nor the time section."""
+    data = dataclasses.asdict(params)
+    data["ends"].pop("circle_frequency_Hz")
+    data.pop("time")
+    for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
+        data["sweep"].pop(key)
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def make_backend(params: Parameters, comm):
+    """The integrator for the scene's scheme."""
+    q = params.normalised()
+    disc = params.discretisation
+    if disc.scheme == "spline":
+        from rawehelix.solvers.spline_galerkin.forced import SplineBackend
+        return SplineBackend(q, disc.elements)
+    from rawehelix.solvers.forced import FEBackend
+    return FEBackend(params, comm)
+
+
+def _key(f1: float) -> str:
+    return f"f1_{f1:010.5f}"
+
+
+def _write_npz(path: Path, arrays: dict):
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+
+
+def _finished(outdir: Path, f1: float) -> dict | None:
+    path = outdir / "points" / f"{_key(f1)}.json"
+    if not path.exists():
+        return None
+    return json.loads(path.read_text())
+
+
+def merge_results(outdir: Path, header: dict) -> dict:
+    """Rewrite sweep.json from the finished points (atomic; any rank may call it)."""
+    points = []
+    for path in sorted((outdir / "points").glob("f1_*.json")):
+        try:
+            points.append(json.loads(path.read_text())["entry"])
+        except (json.JSONDecodeError, KeyError):
+            continue
+    data = {**header, "points": sorted(points, key=lambda p: p["f1_Hz"])}
+    writers.write_json(outdir / RESULTS, data)
+    return data
+
+
+def check_directory(outdir: Path, header: dict):
+    """Refuse an output directory that holds another sweep."""
+    path = outdir / RESULTS
+    if not path.exists():
+        return
+    try:
+        old = json.loads(path.read_text())
+    except json.JSONDecodeError:
+        return  # cannot happen with atomic writes; treat as empty
+    if old.get("fingerprint") != header["fingerprint"]:
+        raise SweepError(
+            f"{path}: holds a sweep of another scene or discretisation (scene "
+            f"{old.get('scene')!r}, scheme {old.get('scheme')!r}, N = {old.get('elements')}, "
+            f"p = {old.get('degree')}); use another -o directory or delete it")
+
+
+def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict,
+              backend=None, log=print) -> int:
+    """Run one rank's contiguous chunk with continuation; return the points computed."""
+    backend = backend or make_backend(params, MPI.COMM_SELF)
+    q = params.normalised()
+    (outdir / "points").mkdir(parents=True, exist_ok=True)
+    state, t, computed = None, 0.0, 0
+    for i, f1 in enumerate(chunk):
+        if _finished(outdir, f1) is not None:
+            state = None  # the next unfinished point reloads its predecessor's state
+            continue
+        lead_in = True
+        if state is None:
+            prev = outdir / "points" / f"{_key(chunk[i - 1])}.npz" if i > 0 else None
+            if prev is not None and prev.exists():
+                with np.load(prev) as data:
+                    state, t = backend.unpack(data), float(data["t"])
+                lead_in = False
+            else:
+                state, t = backend.stationary(), 0.0
+        else:
+            lead_in = False
+        result, state, t = periodic_response(backend, q, f1, state, t, params.sweep, lead_in)
+        key = _key(f1)
+        _write_npz(outdir / "points" / f"{key}.npz", {**backend.pack(state), "t": t})
+        writers.write_json(outdir / "points" / f"{key}.json", {
+            "entry": result.entry(), "period_maxima_N": result.period_maxima_N,
+            "series_t_s": result.series_t_s, "series_tension_N": result.series_tension_N})
+        with open(outdir / "computed.log", "a") as f:
+            f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}\n")
+        merge_results(outdir, header)
+        computed += 1
+        flag = "" if result.periodic else "  NOT PERIODIC (hit max_periods)"
+        log(f"  f1 = {f1:6.2f} Hz: T max {result.tension_max_N:8.2f} N, min "
+            f"{result.tension_min_N:8.2f} N, {result.periods:3d} periods, "
+            f"{result.wall_s:6.1f} s ({result.start}){flag}")
+    return computed
+
+
+def chunks(frequencies: list[float], k: int) -> list[list[float]]:
+    """k contiguous chunks of the sorted list, sizes differing by at most one."""
+    return [list(c) for c in np.array_split(np.array(sorted(frequencies)), k)]
+
+
+def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = "scene",
+        comm=MPI.COMM_WORLD, log=print, series: bool = False) -> dict:
+    """The whole sweep; returns the summary on every rank."""
+    start = time.perf_counter()
+    outdir = Path(outdir)
+    disc = params.discretisation
+    header = {"scene": name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
+              "elements": disc.elements, "degree": disc.degree if disc.scheme == "fe" else None}
+    error = None
+    if comm.rank == 0:
+        try:
+            check_directory(outdir, header)
+        except SweepError as err:
+            error = str(err)
+    error = comm.bcast(error, root=0)
+    if error:
+        raise SweepError(error)
+    if comm.rank == 0:
+        outdir.mkdir(parents=True, exist_ok=True)
+        merge_results(outdir, header)
+    comm.Barrier()
+    mine = chunks(frequencies, comm.size)[comm.rank]
+    rank_log = log if comm.size == 1 else (lambda m: print(f"[rank {comm.rank}]{m}", flush=True))
+    if mine:
+        rank_log(f"  chunk {mine[0]:.2f}-{mine[-1]:.2f} Hz ({len(mine)} points)")
+    computed = run_chunk(params, outdir, mine, header, log=rank_log)
+    computed = comm.allreduce(computed, op=MPI.SUM)
+    comm.Barrier()
+    summary = None
+    if comm.rank == 0:
+        data = merge_results(outdir, header)
+        wanted = {round(f, 5) for f in frequencies}
+        points = [p for p in data["points"] if round(p["f1_Hz"], 5) in wanted]
+        peak = max(points, key=lambda p: p["tension_max_N"]) if points else None
+        summary = {**header, "points": points,
+                   "resonance_Hz": peak["f1_Hz"] if peak else None,
+                   "peak_tension_N": peak["tension_max_N"] if peak else None,
+                   "not_periodic_Hz": [p["f1_Hz"] for p in points if not p["periodic"]],
+                   "ranks": comm.size, "computed_now": computed,
+                   "wall_s": time.perf_counter() - start}
+        writers.write_json(outdir / "summary.json", summary)
+        sweep_png(outdir, points, name)
+        if series:
+            write_series(outdir, points)
+        log(f"  resonance (largest T max) at f1 = {summary['resonance_Hz']} Hz, "
+            f"T max = {summary['peak_tension_N']:.1f} N; wrote {outdir}/summary.json, sweep.png")
+    return comm.bcast(summary, root=0)
+
+
+def write_series(outdir: Path, points: list[dict]):
+    """Per-point time series of the tension at s = 0 (CSV) over the recorded periods."""
+    for p in points:
+        data = _finished(outdir, p["f1_Hz"])
+        path = outdir / "points" / f"{_key(p['f1_Hz'])}_tension.csv"
+        np.savetxt(path, np.column_stack([data["series_t_s"], data["series_tension_N"]]),
+                   delimiter=",", header="t_s,tension_s0_N", comments="")
+
+
+def sweep_png(outdir: Path, points: list[dict], title: str, inset_Hz: float = 10.0):
+    """Fig. 8: maximum tension at s = 0 against f1; the inset shows T(t) near 10 Hz."""
+    if not points:
+        return
+    plt = writers._pyplot()
+    f = np.array([p["f1_Hz"] for p in points])
+    tmax = np.array([p["tension_max_N"] for p in points])
+    tmin = np.array([p["tension_min_N"] for p in points])
+    ok = np.array([p["periodic"] for p in points])
+    fig, ax = plt.subplots(figsize=(8, 5))
+    ax.fill_between(f, tmin, tmax, color="C0", alpha=0.15, label="min-max over the last periods")
+    ax.plot(f, tmax, "-", color="C0")
+    ax.plot(f[ok], tmax[ok], "o", color="C0", label="T max (periodic)")
+    if np.any(~ok):
+        ax.plot(f[~ok], tmax[~ok], "x", color="C3", ms=9, label="T max (not periodic: cap hit)")
+    ax.set_xlabel("forcing frequency f1 [Hz]")
+    ax.set_ylabel("tension at s = 0 [N]")
+    ax.set_title(f"{title}: maximum tension against f1 (Fig. 8)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left")
+    near = points[int(np.argmin(np.abs(f - inset_Hz)))]
+    data = _finished(outdir, near["f1_Hz"])
+    if data and data.get("series_t_s"):
+        ins = ax.inset_axes([0.1, 0.36, 0.38, 0.3])  # above the flat low-f1 part
+        t = np.array(data["series_t_s"])
+        ins.plot(t - t[0], data["series_tension_N"], "-", lw=1)
+        ins.set_title(f"T(t) at f1 = {near['f1_Hz']:g} Hz", fontsize=8)
+        ins.set_xlabel("t [s]", fontsize=8)
+        ins.set_ylabel("T [N]", fontsize=8)
+        ins.tick_params(labelsize=7)
+    fig.tight_layout()
+    fig.savefig(outdir / "sweep.png", dpi=120)
+    plt.close(fig)

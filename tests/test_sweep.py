@@ -1,0 +1,136 @@
+"""The f1 sweep of Sec. 5.3: periodicity, continuation, resuming, refusal, MPI chunks.
+
+These run the spline reference at N = 2 (the paper's method, seconds per
+point); the FE backend shares the driver."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from rawehelix.studies import cli, scene, sweep
+from tests_util import write_scene
+
+FAST = {"sweep": {"lead_in_s": 1.0, "min_periods": 3, "periodic_tolerance": 2e-3}}
+
+
+@pytest.fixture
+def fast_scene(tmp_path):
+    return write_scene(tmp_path / "mobile_fast.toml", {**FAST, "discretisation": {
+        "scheme": "spline", "elements": 2}}, name="mobile_end")
+
+
+def entries(path):
+    data = json.loads(Path(path).read_text())
+    return {p["f1_Hz"]: p for p in data["points"]}
+
+
+def run_cli(scene_path, outdir, f1="8:10:0.5", extra=()):
+    return subprocess.Popen([sys.executable, "-m", "rawehelix.studies.cli", "sweep",
+                             str(scene_path), "--f1", f1, "-o", str(outdir), *extra],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+def test_kill_and_resume_equals_uninterrupted(tmp_path, fast_scene):
+    """SIGKILL mid-sweep leaves a readable results file; re-running finishes
+    without recomputing finished points, and the file equals an uninterrupted run's."""
+    whole, resumed = tmp_path / "whole", tmp_path / "resumed"
+    assert run_cli(fast_scene, whole).wait() == 0
+    proc = run_cli(fast_scene, resumed)
+    log = resumed / "computed.log"
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if log.exists() and len(log.read_text().splitlines()) >= 2:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the sweep finished before it could be killed"
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    done_before = [float(line.split()[0]) for line in log.read_text().splitlines()]
+    partial = entries(resumed / "sweep.json")  # readable after SIGKILL
+    assert 2 <= len(partial) < 5 and set(partial) == set(done_before)
+    assert run_cli(fast_scene, resumed).wait() == 0
+    computed = [float(line.split()[0]) for line in log.read_text().splitlines()]
+    assert sorted(computed) == sorted(set(computed)), "a finished point was recomputed"
+    a, b = entries(whole / "sweep.json"), entries(resumed / "sweep.json")
+    assert set(a) == set(b) == {8.0, 8.5, 9.0, 9.5, 10.0}
+    for f1 in a:
+        for key in ("tension_max_N", "tension_min_N", "tension_mean_N", "periods", "periodic"):
+            assert a[f1][key] == b[f1][key], (f1, key)
+    # and a third run computes nothing
+    assert run_cli(fast_scene, resumed).wait() == 0
+    assert len(log.read_text().splitlines()) == len(computed)
+
+
+def test_other_discretisation_is_refused(tmp_path, fast_scene, capsys):
+    out = tmp_path / "out"
+    assert cli.main(["sweep", str(fast_scene), "--f1", "9:9:1", "-o", str(out)]) == 0
+    before = (out / "sweep.json").read_text()
+    assert cli.main(["sweep", str(fast_scene), "--f1", "9:9:1", "--elements", "3",
+                     "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "sweep.json" in err and "another scene or discretisation" in err
+    assert (out / "sweep.json").read_text() == before
+
+
+@pytest.mark.parametrize("spec", ["9:8:1", "a:b:c", "0:5:1", "1:5:0"])
+def test_bad_f1_range(tmp_path, fast_scene, capsys, spec):
+    assert cli.main(["sweep", str(fast_scene), "--f1", spec, "-o", str(tmp_path / "o")]) == 2
+    assert "--f1" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_cap_is_flagged(tmp_path):
+    """A point that hits max_periods before it is periodic is flagged, not accepted."""
+    path = write_scene(tmp_path / "s.toml", {"sweep": {
+        "lead_in_s": 0.0, "min_periods": 2, "max_periods": 2, "record_periods": 1,
+        "periodic_tolerance": 1e-9}, "discretisation": {"scheme": "spline", "elements": 2}},
+        name="mobile_end")
+    params = scene.load(path)
+    summary = sweep.run(params, tmp_path / "out", [10.0], comm=MPI.COMM_SELF, log=lambda *a: None)
+    (point,) = summary["points"]
+    assert point["periodic"] is False and point["periods"] == 2
+    assert summary["not_periodic_Hz"] == [10.0]
+
+
+def test_resonance_of_the_paper_at_n2(tmp_path):
+    """Fig. 8 at N = 2: flat up to ~8 Hz, a rise above about 9 Hz, peak (> 900 N)
+    near 13 Hz, collapse above."""
+    params = scene.load("mobile_end", scheme="spline", elements=2)
+    summary = sweep.run(params, tmp_path / "out", [2.0, 6.0, 9.0, 11.0, 12.0, 13.0, 13.5, 14.5],
+                        comm=MPI.COMM_SELF, log=lambda *a: None)
+    T = {p["f1_Hz"]: p["tension_max_N"] for p in summary["points"]}
+    assert T[2.0] == pytest.approx(T[6.0], rel=0.1)  # flat
+    assert T[9.0] > 1.5 * T[2.0]
+    assert 12.0 <= summary["resonance_Hz"] <= 14.0
+    assert summary["peak_tension_N"] > 800
+    assert T[14.5] < 0.5 * summary["peak_tension_N"]
+    assert (tmp_path / "out" / "sweep.png").stat().st_size > 10_000
+
+
+@pytest.mark.mpi
+def test_two_ranks_match_one(tmp_path_factory):
+    """Chunks on 2 ranks give the points of 1 rank to the periodicity tolerance
+    (the second chunk starts from the stationary state with a lead-in instead of
+    continuing).  Low f1, where the response is single-valued."""
+    comm = MPI.COMM_WORLD
+    base = comm.bcast(str(tmp_path_factory.mktemp("sweep")) if comm.rank == 0 else None, root=0)
+    # the default lead-in (10 s) covers the spin-up under the torque ramp (t0 = 1.8 s)
+    params = scene.load("mobile_end", scheme="spline", elements=2)
+    freqs = [3.0, 4.0, 5.0, 6.0]
+    world = sweep.run(params, Path(base) / "world", freqs, comm=comm, log=lambda *a: None)
+    if comm.rank == 0:
+        serial = sweep.run(params, Path(base) / "serial", freqs, comm=MPI.COMM_SELF,
+                           log=lambda *a: None)
+        assert world["ranks"] == comm.size
+        for a, b in zip(serial["points"], world["points"]):
+            assert a["f1_Hz"] == b["f1_Hz"]
+            assert a["tension_max_N"] == pytest.approx(b["tension_max_N"], rel=3e-3)
+            assert a["tension_mean_N"] == pytest.approx(b["tension_mean_N"], rel=3e-3)
