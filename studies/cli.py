@@ -4,6 +4,7 @@
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
     rawehelix simulate SCENE [-o DIR] [--until T] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
+    rawehelix converge SCENE --quantity Q [-o DIR]
 
 SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
 ``nominal_operation``, ``mobile_end``).  Options that argparse does not know
@@ -30,7 +31,8 @@ def _parser() -> argparse.ArgumentParser:
     for name, help_text in (("stationary", "stationary state with fixed ends (Sec. 5.1)"),
                             ("modes", "natural modes about the stationary state (Table 3)"),
                             ("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)"),
-                            ("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)")):
+                            ("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)"),
+                            ("converge", "refinement study and work-precision figure")):
         p = sub.add_parser(name, help=help_text)
         p.add_argument("scene", help="scene TOML file, or the name of a shipped scene")
         p.add_argument("-o", "--output", type=Path, default=None,
@@ -44,6 +46,9 @@ def _parser() -> argparse.ArgumentParser:
         if name == "simulate":
             p.add_argument("--until", type=float, default=None,
                            help="end of the simulation [s] (default: the scene's time.until_s)")
+        if name == "converge":
+            p.add_argument("--quantity", required=True,
+                           help="quantity of interest: tension_s0, eigenvalues, ...")
         if name == "sweep":
             p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
                            help="frequencies in Hz (default: the scene's [sweep] section)")
@@ -121,6 +126,12 @@ def main(argv: list[str] | None = None) -> int:
             from rawehelix.studies import simulate
             simulate.run(params, outdir, name=name, title=scenes.title(path), until_s=args.until,
                          log=log)
+        elif args.command == "converge":
+            from rawehelix.studies import converge
+            if args.quantity not in converge.quantities():
+                return _fail(f"--quantity: {args.quantity!r} is not one of "
+                             f"{', '.join(converge.quantities())}")
+            converge.run(params, args.quantity, outdir, name=name, log=log)
         elif args.command == "sweep":
             from rawehelix.studies import sweep
             try:

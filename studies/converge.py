@@ -1,0 +1,270 @@
+"""`rawehelix converge`: refinement studies and work-precision figures.
+
+For one quantity of interest, runs every method over its refinement ladder
+(elements N for the space discretisations, time step dt for the time
+integrators), and records for each run the value, the error, the observed
+order and the wall time.
+
+Error: relative to the **finest run of the reference method** (the most
+accurate one: FE with the highest degree at the largest N for stationary and
+modal quantities), not a Richardson extrapolation; the reference's own
+distance to an independent reference (shooting, where one exists) is printed
+so that the floor of the table is known.  For a vector of values (the lowest
+eigenvalue of each family) the error is the largest relative error.
+
+Under ``mpirun -n k`` the runs are dealt round-robin to the ranks, each on
+its own communicator; rank 0 gathers and writes ``converge.csv``,
+``converge.md``, ``work_precision.png`` and ``summary.json``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.forms.parameters import Parameters
+from rawehelix.studies import writers
+
+
+@dataclass(frozen=True)
+class Method:
+    """One curve of the work-precision figure."""
+
+    label: str  # "FE p=3", "spline", ...
+    scheme: str  # "fe" or "spline"
+    degree: int | None = None
+    ladder: tuple = ()  # refinement values: elements N (or dt in s for time schemes)
+    variable: str = "elements"  # what the ladder refines: "elements" or "dt_s"
+
+    def resolution(self, value) -> float:
+        """A mesh size h (or dt) whose ratio gives the observed order."""
+        return 1.0 / value if self.variable == "elements" else float(value)
+
+
+@dataclass
+class Run:
+    method: Method
+    value_of_ladder: float
+    result: np.ndarray
+    wall_s: float
+    error: float = math.nan
+    order: float = math.nan
+
+
+@dataclass
+class Quantity:
+    name: str
+    unit: str
+    methods: list
+    reference: str  # label of the reference method (its finest run is the reference)
+    evaluate: object  # (params, method, ladder value) -> np.ndarray of values
+    components: list = field(default_factory=list)
+    independent: object = None  # params -> independent reference value, or None
+
+
+# -- quantities ------------------------------------------------------------------
+
+def _with(params: Parameters, method: Method, value) -> Parameters:
+    if method.variable == "elements":
+        disc = {"scheme": method.scheme, "elements": int(value)}
+        if method.degree is not None:
+            disc["degree"] = method.degree
+        return params.replace(discretisation=disc)
+    return params.replace(time={"dt_s": float(value)})
+
+
+def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
+    """Stationary tension at s = 0 [N] (Sec. 5.1)."""
+    p = _with(params, method, value)
+    q = p.normalised()
+    if method.scheme == "spline":
+        from rawehelix.solvers.spline_galerkin import stationary
+        from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
+        system = SplineGalerkin(q, p.discretisation.elements)
+        x = stationary.solve(system).x
+        return np.array([q.tension_N(system.tension(x, 0.0, s=np.array([0.0]))[0])])
+    from rawehelix.solvers.stationary import StationarySolver
+    result = StationarySolver(p, MPI.COMM_SELF).solve()
+    return np.array([q.tension_N(result.tension[0])])
+
+
+def _shooting_tension_s0(params: Parameters):
+    from rawehelix.solvers import shooting
+    q = params.normalised()
+    return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
+
+
+FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional")
+
+
+def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
+    """|lambda| [1/s] of the lowest mode of each family (Sec. 5.1, Table 3)."""
+    p = _with(params, method, value)
+    if method.scheme == "spline":
+        from rawehelix.studies.modes import spline_modes
+        modes = spline_modes(p)
+    else:
+        from rawehelix.studies.modes import fe_modes
+        modes = fe_modes(p, None, comm=MPI.COMM_SELF, log=lambda *a: None)["modes"]
+    lowest = {}
+    for m in modes:
+        lam = complex(*m["eigenvalue_per_s"])
+        if m["family"] in FAMILIES and abs(lam) > 1e-9:
+            lowest[m["family"]] = min(lowest.get(m["family"], math.inf), abs(lam))
+    return np.array([lowest.get(f, math.nan) for f in FAMILIES])
+
+
+FE_LADDER = (2, 4, 8, 16, 32, 64)
+SPLINE_LADDER = (2, 4, 8, 16, 32)
+
+
+def quantities() -> dict:
+    fe = [Method(f"FE p={p}", "fe", p, FE_LADDER) for p in (2, 3, 4)]
+    spline = Method("spline", "spline", None, SPLINE_LADDER)
+    return {
+        "tension_s0": Quantity("tension_s0", "N", fe + [spline], "FE p=4", tension_s0,
+                               ["T(0)"], _shooting_tension_s0),
+        "eigenvalues": Quantity("eigenvalues", "1/s",
+                                [Method(f"FE p={p}", "fe", p, (2, 4, 8, 16, 32)) for p in (2, 3, 4)]
+                                + [Method("spline", "spline", None, (2, 4, 8, 16))],
+                                "FE p=4", eigenvalues, list(FAMILIES)),
+    }
+
+
+# -- the study ---------------------------------------------------------------------
+
+def _errors_and_orders(runs: list[Run], reference: np.ndarray):
+    for run in runs:
+        rel = np.abs(run.result - reference) / np.abs(reference)
+        run.error = float(np.nanmax(rel)) if np.any(np.isfinite(rel)) else math.nan
+    by_method = {}
+    for run in runs:
+        by_method.setdefault(run.method.label, []).append(run)
+    for series in by_method.values():
+        series.sort(key=lambda r: r.method.resolution(r.value_of_ladder), reverse=True)
+        for a, b in zip(series[:-1], series[1:]):
+            ha, hb = a.method.resolution(a.value_of_ladder), b.method.resolution(b.value_of_ladder)
+            if a.error > 0 and b.error > 0:
+                b.order = math.log(a.error / b.error) / math.log(ha / hb)
+    return by_method
+
+
+def _timed(evaluate, params, method, value, budget_s: float = 1.0, repeats: int = 3):
+    """(value, wall time): the fastest of up to ``repeats`` runs, repeating only
+    while the runs together stay under ``budget_s`` (cheap runs are noisy)."""
+    walls, spent = [], 0.0
+    while True:
+        t0 = time.perf_counter()
+        result = np.atleast_1d(np.asarray(evaluate(params, method, value), dtype=float))
+        walls.append(time.perf_counter() - t0)
+        spent += walls[-1]
+        if len(walls) >= repeats or spent + walls[-1] > budget_s:
+            return result, min(walls)
+
+
+def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "scene",
+        comm=MPI.COMM_WORLD, log=print, methods: list | None = None) -> dict:
+    """Run the refinement study of ``quantity``; returns the summary on every rank."""
+    start = time.perf_counter()
+    qty = quantities()[quantity]
+    methods = methods or qty.methods
+    jobs = [(m, v) for m in methods for v in m.ladder]
+    mine, warm = [], set()
+    for k, (method, value) in enumerate(jobs):
+        if k % comm.size != comm.rank:
+            continue
+        if method.label not in warm:  # just-in-time compilation is not part of the cost
+            qty.evaluate(params, method, value)
+            warm.add(method.label)
+        result, wall = _timed(qty.evaluate, params, method, value)
+        mine.append((k, result, wall))
+        log(f"  {method.label:>10} {method.variable} = {value:<8g} "
+            f"{np.array2string(result, precision=8)} ({mine[-1][2]:.2f} s)")
+    gathered = comm.gather(mine, root=0)
+    summary = None
+    if comm.rank == 0:
+        results = sorted((item for part in gathered for item in part), key=lambda i: i[0])
+        runs = [Run(jobs[k][0], jobs[k][1], result, wall) for k, result, wall in results]
+        ref_runs = [r for r in runs if r.method.label == qty.reference]
+        ref_run = max(ref_runs, key=lambda r: 1.0 / r.method.resolution(r.value_of_ladder))
+        reference = ref_run.result
+        by_method = _errors_and_orders(runs, reference)
+        independent = qty.independent(params) if qty.independent else None
+        summary = {
+            "scene": name, "quantity": quantity, "unit": qty.unit,
+            "components": qty.components,
+            "reference": {"method": qty.reference, qty.methods[0].variable: ref_run.value_of_ladder,
+                          "value": reference,
+                          "independent": independent,
+                          "independent_rel_diff": None if independent is None else
+                          float(np.max(np.abs(reference - independent) / np.abs(independent)))},
+            "runs": [{"method": r.method.label, r.method.variable: r.value_of_ladder,
+                      "value": r.result, "error": r.error, "order": r.order, "wall_s": r.wall_s}
+                     for r in runs],
+            "ranks": comm.size, "wall_s": time.perf_counter() - start,
+        }
+        if outdir is not None:
+            write_outputs(Path(outdir), summary, by_method, qty, name)
+            log(f"  wrote {outdir}/converge.csv, converge.md, work_precision.png, summary.json")
+        for label, series in by_method.items():
+            orders = [f"{r.order:.2f}" for r in series if np.isfinite(r.order)]
+            log(f"  {label:>10}: errors {' '.join(f'{r.error:.1e}' for r in series)}; "
+                f"observed orders {' '.join(orders)}")
+    return comm.bcast(summary, root=0)
+
+
+def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: Quantity, name: str):
+    outdir.mkdir(parents=True, exist_ok=True)
+    writers.write_json(outdir / "summary.json", summary)
+    var = qty.methods[0].variable
+    with open(outdir / "converge.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["method", var, *[f"{c} [{qty.unit}]" for c in qty.components],
+                    "rel_error", "observed_order", "wall_s"])
+        for r in summary["runs"]:
+            w.writerow([r["method"], r[var], *[f"{v:.12g}" for v in r["value"]],
+                        f"{r['error']:.3e}", "" if not np.isfinite(r["order"]) else f"{r['order']:.2f}",
+                        f"{r['wall_s']:.3f}"])
+    ref = summary["reference"]
+    lines = [f"# Convergence of `{qty.name}` ({name})", "",
+             f"Error: relative to the finest run of {ref['method']} ({var} = {ref[var]}), "
+             f"value {np.array2string(np.asarray(ref['value']), precision=10)} {qty.unit}."]
+    if ref["independent"] is not None:
+        lines.append(f"That reference differs from the independent one by "
+                     f"{ref['independent_rel_diff']:.1e} (relative).")
+    lines += ["", f"| method | {var} | value [{qty.unit}] | rel. error | observed order | wall [s] |",
+              "| --- | --- | --- | --- | --- | --- |"]
+    for r in summary["runs"]:
+        value = ", ".join(f"{v:.8g}" for v in r["value"])
+        order = "" if not np.isfinite(r["order"]) else f"{r['order']:.2f}"
+        lines.append(f"| {r['method']} | {r[var]} | {value} | {r['error']:.2e} | {order} | "
+                     f"{r['wall_s']:.3f} |")
+    (outdir / "converge.md").write_text("\n".join(lines) + "\n")
+    work_precision_png(outdir / "work_precision.png", by_method, qty, name)
+
+
+def work_precision_png(path: Path, by_method: dict, qty: Quantity, name: str):
+    """Error against wall time, one curve per method."""
+    plt = writers._pyplot()
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    for label, series in by_method.items():
+        pts = [(r.wall_s, r.error) for r in series if r.error > 0 and np.isfinite(r.error)]
+        if pts:
+            w, e = zip(*pts)
+            ax.loglog(w, e, "o-", label=label)
+    for level in (1e-2, 1e-3, 1e-4):
+        ax.axhline(level, color="0.7", lw=0.8, ls=":")
+    ax.set_xlabel("wall time per run [s]")
+    ax.set_ylabel("relative error")
+    ax.set_title(f"work-precision: {qty.name} ({name})")
+    ax.grid(True, which="both", alpha=0.2)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
