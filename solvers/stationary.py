@@ -21,6 +21,10 @@ from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.snes import NewtonSolver, SolverError
 
 
+class SlackError(SolverError):
+    """The solution has tension <= 0 somewhere."""
+
+
 @dataclass
 class StationaryResult:
     """A converged stationary state, gathered on rank 0 (None elsewhere)."""
@@ -57,9 +61,24 @@ class StationarySolver:
         except SolverError as err:
             raise SolverError(f"{self.scene}: {err}") from None
         result = self.gather()
+        self._check_taut(result)
         result.newton_iterations = its
         result.wall_s = time.perf_counter() - start
         return result
+
+    def _check_taut(self, result):
+        """Eq. (22) is Hooke's law for a taut helix; a compressed one is slack
+        (bars and tethers cannot carry it) and the model does not hold."""
+        where = None
+        if result.tension is not None and result.tension.min() <= 0:
+            k = int(result.tension.argmin())
+            where = (float(result.s_tension[k]), float(self.rod.q.tension_N(result.tension[k])))
+        where = self.rod.comm.bcast(where, root=0)
+        if where is not None:
+            raise SlackError(
+                f"{self.scene}: the stationary tension falls to {where[1]:.4g} N at "
+                f"s = {self.rod.q.length_m(where[0]):.4g} m: the helix is slack, and the "
+                f"tension law (22) does not hold for compression; increase ends.elongation")
 
     def gather(self) -> StationaryResult:
         r = self.rod.w.sub(0).collapse()

@@ -149,3 +149,13 @@ def test_same_on_one_and_two_ranks(N, p):
         assert np.allclose(serial.s, world.s)
         assert np.max(np.abs(serial.centre_line - world.centre_line)) < 1e-10
         assert np.max(np.abs(serial.tension - world.tension)) < 1e-6
+
+
+def test_slack_is_detected():
+    """A vertical helix whose pre-tension EA eps0 (0.7 N) is less than its weight
+    (5 N) is compressed at the bottom: a SlackError, not a silent answer."""
+    from rawehelix.solvers.stationary import SlackError
+    params = table2(16).replace(ends={"elevation_deg": 90.0, "elongation": 2e-5},
+                                model={"drag": False})
+    with pytest.raises(SlackError, match="slack"):
+        StationarySolver(params, MPI.COMM_SELF).solve()
