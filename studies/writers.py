@@ -102,3 +102,58 @@ def centre_line_xdmf(path: Path, x_m, point_data: dict) -> Path:
                        point_data={k: np.asarray(v, dtype=float) for k, v in point_data.items()})
     meshio.write(str(path), mesh)
     return path
+
+
+def mode_shapes_png(path: Path, s_m, shapes: dict, title: str) -> Path:
+    """One panel per mode: displacement along the chord, normal to it in the x-z
+    plane and along y, and the twist, against the arc length.
+
+    ``shapes``: label -> (u_chord, u_normal, u_y, alpha) arrays over ``s_m``."""
+    plt = _pyplot()
+    n = max(len(shapes), 1)
+    cols = 2 if n > 1 else 1
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(5.5 * cols, 3.2 * rows), squeeze=False)
+    for ax, (label, (ut, un, uy, alpha)) in zip(axes.ravel(), shapes.items()):
+        ax.plot(s_m, ut, label="along chord")
+        ax.plot(s_m, un, label="normal, x-z plane")
+        ax.plot(s_m, uy, label="y")
+        ax.plot(s_m, alpha, "k--", label="twist alpha (own scale)")
+        ax.set_title(label, fontsize=10)
+        ax.set_xlabel("s [m]")
+        ax.grid(True, alpha=0.3)
+    for ax in axes.ravel()[len(shapes):]:
+        ax.axis("off")
+    axes.ravel()[0].legend(loc="best", fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def dynamics_png(path: Path, rows: np.ndarray, target_rpm: float, title: str) -> Path:
+    """Fig. 6 of the paper: (a) spins at s = 0, ~L0/2, L0 and the target, (b) ground
+    torque, (c) tensions at the ends.  ``rows`` as in studies.simulate.COLUMNS."""
+    plt = _pyplot()
+    t = rows[:, 0]
+    fig, ax = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
+    for k, (style, label) in enumerate(((":", "s = 0"), ("--", "s = L0/2"), ("-", "s = L0"))):
+        ax[0].plot(t, rows[:, 1 + k], style, label=label)
+    ax[0].axhline(target_rpm, color="k", lw=2.5, alpha=0.5, label="target")
+    ax[0].set_ylabel("spin dα/dt [rpm]")
+    ax[0].legend(loc="lower right")
+    ax[1].plot(t, rows[:, 4], "-")
+    ax[1].set_ylabel("ground torque M0 [Nm]")
+    ax[2].plot(t, rows[:, 5], "-", label="s = 0")
+    ax[2].plot(t, rows[:, 6], "--", label="s = L0")
+    ax[2].set_ylabel("tension T [N]")
+    ax[2].set_xlabel("t [s]")
+    ax[2].legend(loc="best")
+    for a in ax:
+        a.grid(True, alpha=0.3)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

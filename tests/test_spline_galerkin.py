@@ -216,9 +216,16 @@ def test_modes_run_writes_summary(tmp_path):
     assert len(few["modes"]) == 3
 
 
-def test_modes_run_fe_not_yet_and_no_output(tmp_path):
+def test_modes_run_fe_failure_leaves_no_output(tmp_path, monkeypatch):
+    """The FE branch (issue 4, tests/test_modal.py) writes nothing when a solve fails."""
+    from rawehelix.solvers import modal
+    from rawehelix.solvers.snes import SolverError
+
+    def boom(*a, **k):
+        raise SolverError("SLEPc PEP found 0 of 20 eigenpairs")
+    monkeypatch.setattr(modal.ModalSolver, "solve", boom)
     params = scene.load("stationary_table2", scheme="fe", elements=2)
-    with pytest.raises(NotImplementedError, match="issue 4"):
+    with pytest.raises(SolverError):
         modes_study.run(params, tmp_path / "fe")
     assert not (tmp_path / "fe").exists()
 
