@@ -141,7 +141,13 @@ class Model:
     drag: bool = True
     bending: bool = True
     twist: bool = True  # twist dynamics, Eq. (31)
-    gamma: str = "regularised"  # Frenet torsion gamma, Eq. (34): see forms.rod
+    # Frenet torsion gamma, Eq. (34): "off" (the paper's own code) or
+    # "regularised" (see forms.kinematics.frenet_torsion).  "off" is the default:
+    # at the planar stationary states the regularised coupling shifts the
+    # out-of-plane and torsional frequencies by ~0.2 % and makes torsional
+    # modes grow (Re lambda ~ +1.5e-4 and more), an artefact of the Frenet frame
+    # of an almost straight curve (docs/modal_convergence.md).
+    gamma: str = "off"
     gamma_eps: float = 1.0e-3  # regularisation of |r''|^2 in gamma (normalised curvature)
 
     def __post_init__(self):
