@@ -123,14 +123,30 @@ def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures
     ``w``, ``w_t``, ``w_tt``: mixed (r, alpha) fields or their time
     derivatives; ``w_tt = None`` gives the stationary residual (and ``w_t =
     None`` zero velocity).  ``measures`` = (dx, dS, ds)."""
-    dx, dS, ds = measures
     r, alpha = ufl.split(w)
-    v, psi = ufl.split(test)
-    r_t = ufl.split(w_t)[0] if w_t is not None else ufl.as_vector((0.0, 0.0, 0.0))
+    r_t = ufl.split(w_t)[0] if w_t is not None else None
+    r_tt, alpha_tt = ufl.split(w_tt) if w_tt is not None else (None, None)
+    return residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, test_fields(test), c, degree,
+                              penalty, measures)
+
+
+def test_fields(test):
+    """(v, psi) of a mixed (r, alpha) test function."""
+    return ufl.split(test)
+
+
+def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, degree: int,
+                       penalty, measures):
+    """:func:`residual` on fields given one by one, so that (r, alpha) and
+    their rates may live in a larger mixed space (the first-order form of the
+    dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero)."""
+    dx, dS, ds = measures
+    v, psi = tests
+    if r_t is None:
+        r_t = ufl.as_vector((0.0, 0.0, 0.0))
     F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds)
          - ufl.inner(body_force(r_t, c), v) * dx)
-    if w_tt is not None:
-        r_tt, alpha_tt = ufl.split(w_tt)
+    if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
     return F
 

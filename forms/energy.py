@@ -1,0 +1,54 @@
+"""Energy of the rod, Eqs. (30)-(31), in pure UFL.
+
+With the twist equation (31) multiplied by beta/delta (= 2 mu/sigma), the
+conservative part of the residual of :mod:`rawehelix.forms.rod` is the
+variation of
+
+    E = K + U,
+    K = 1/2 int |r_t|^2 + beta/(2 delta) int alpha_t^2                   kinetic
+    U = int sigma (|r'|^3/3 - |r'|^2/2) + mu/2 B(r, r)
+        + beta/2 int tau^2 - int k_E . r                                   elastic + gravity
+
+since d/dr' [sigma (|r'|^3/3 - |r'|^2/2)] = sigma (|r'| - 1) r' = T r' (Eq. 29:
+the paper's tension force is exactly variational with this density), B is
+the symmetric interior-penalty bending form (so d(B(r, r)/2) = B(r, v)), and
+gravity +k_E has the potential -k_E . r.  What is *not* the variation of E:
+
+- the -mu kappa^2 r' part of F_NL (Eq. 32), from the inextensibility
+  assumption of Sec. 2;
+- beta tau (r' x r'') in the centre-line equation, whose energy partner would
+  be beta tau d(gamma)/dr; with gamma off (tau = alpha') it is a one-way coupling;
+- drag (Eq. 28) and the end torques, which do work.
+
+All normalised: energies in units of M g L0.
+"""
+
+from __future__ import annotations
+
+import ufl
+
+from rawehelix.forms.kinematics import d, stretch, twist
+from rawehelix.forms.rod import K_E, Coefficients, bending
+
+
+def kinetic(r_t, alpha_t, c: Coefficients, dx):
+    """K = 1/2 int |r_t|^2 + beta/(2 delta) int alpha_t^2."""
+    return (0.5 * ufl.inner(r_t, r_t) + 0.5 * c.beta / c.delta * alpha_t**2) * dx
+
+
+def potential(r, alpha, c: Coefficients, degree: int, penalty, measures):
+    """U = int sigma (l^3/3 - l^2/2) + mu/2 B(r, r) + beta/2 int tau^2 - int k_E.r, l = |r'|."""
+    dx, dS, _ = measures
+    lam = stretch(r)
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
+    return ((c.sigma * (lam**3 / 3 - lam**2 / 2) + 0.5 * c.beta * tau**2
+             - c.gravity * ufl.dot(K_E, r)) * dx
+            + 0.5 * c.bending * c.mu * bending(r, r, degree, penalty, dx, dS))
+
+
+def non_variational_power(r, alpha, r_t, c: Coefficients, dx):
+    """Power of the parts of F_NL that are not the variation of E (see above):
+    P = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t'."""
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)
+    f = c.mu * ufl.dot(d(r, 2), d(r, 2)) * d(r) - c.beta * tau * ufl.cross(d(r), d(r, 2))
+    return ufl.inner(f, d(r_t)) * dx

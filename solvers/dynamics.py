@@ -1,0 +1,321 @@
+"""Dynamics of the rod, Eqs. (30)-(40), with PETSc TS from the stationary state.
+
+Default: generalised-alpha for second-order systems (TSALPHA2, Chung and
+Hulbert 1993) with spectral radius 0.9 at infinite frequency: second order,
+and the unresolved axial modes (period ~0.03 s, far below the usual step)
+are damped instead of ringing, while a mode resolved with 20 steps per
+period loses less than 1e-4 of its amplitude per period.  Options (prefix
+``rawehelix_``; the TS's nonlinear solver has ``rawehelix_ts_``):
+
+    -rawehelix_ts_type alpha2|theta|cn|beuler|bdf|arkimex|...
+    -rawehelix_ts_alpha_radius 0.9     spectral radius of alpha2, in [0, 1]
+    -rawehelix_ts_adapt_type basic|none
+    -rawehelix_ts_rtol, -rawehelix_ts_atol   local error tolerances (normalised)
+    -rawehelix_ts_max_snes_failures 8  retries of a failed step (dt x 0.25 each)
+    -rawehelix_ts_snes_lag_jacobian 2, -rawehelix_ts_snes_monitor, ...
+
+TSALPHA2 solves the second-order form; every other type gets the first-order
+form on (U, V) (implicit types: theta, cn, beuler, bdf, alpha, arkimex with
+-ts_arkimex_fully_implicit; explicit types such as rk are not useful here:
+the IP bending term is far too stiff).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from rawehelix import compat
+from rawehelix.forms.parameters import Parameters
+from rawehelix.solvers.probes import Probes
+from rawehelix.solvers.snes import SolverError, reason_name, set_default_options
+from rawehelix.solvers.stationary import StationarySolver
+from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
+
+PREFIX = "rawehelix_"
+TS_DEFAULTS = {
+    "ts_type": "alpha2",
+    "ts_alpha_radius": 0.9,
+    "ts_adapt_type": "basic",
+    "ts_rtol": 1.0e-4,
+    "ts_atol": 1.0e-4,
+    "ts_max_snes_failures": 8,
+    "ts_max_reject": 20,
+    "ts_max_steps": 10_000_000,
+    "ts_error_if_step_fails": "false",  # we raise SolverError with the reason
+}
+SNES_DEFAULTS = {  # under the prefix rawehelix_ts_
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1.0e-8,
+    "snes_stol": 1.0e-10,  # |dx| < stol |x|: below the round-off floor of F
+    # snes_atol: see residual_floor()
+    "snes_max_it": 12,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+class NonFiniteState(ArithmeticError):
+    """The state has a NaN or Inf after a step."""
+
+
+def ts_reason_name(reason: int) -> str:
+    names = {v: k for k, v in vars(PETSc.TS.ConvergedReason).items() if isinstance(v, int)}
+    return f"{names.get(reason, '?')} ({reason})"
+
+
+class _TemporaryOptions:
+    """Set PETSc options for one set-up, remove them afterwards (tests, sweeps)."""
+
+    def __init__(self, prefix: str, options: dict | None):
+        self.prefix, self.options = prefix, options or {}
+
+    def __enter__(self):
+        opts = PETSc.Options()
+        self.added = []
+        for key, value in self.options.items():
+            name = self.prefix + key
+            self.added.append((name, opts.getString(name) if opts.hasName(name) else None))
+            opts[name] = value
+        return self
+
+    def __exit__(self, *exc):
+        opts = PETSc.Options()
+        for name, old in self.added:
+            opts.delValue(name)
+            if old is not None:
+                opts[name] = old
+
+
+class DynamicsSolver:
+    """PETSc TS on the FE rod, started from the stationary state (Sec. 5.1).
+
+    Parameters
+    ----------
+    params
+        A validated scene.  ``params.time.dt_s`` is the first step.
+    comm
+        MPI communicator.
+    options
+        Extra PETSc options for this solver only, without the ``rawehelix_``
+        prefix: ``{"ts_type": "cn", "ts_adapt_type": "none"}``.
+    initial
+        Optional callable ``(solver) -> None`` that changes the initial state
+        (``solver.rod.w``; velocities start at zero) after the stationary solve.
+    """
+
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, options: dict | None = None,
+                 initial=None):
+        self.params, self.comm = params, comm
+        self.q = params.normalised()
+        stationary = StationarySolver(params, comm)
+        stationary.solve()
+        self.rod = stationary.rod  # its alpha(0) = 0 condition is the last bc
+        self.rod.c.m0.value = 0.0
+        if initial is not None:
+            initial(self)
+        bcs = self.rod.bcs[:2]  # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free
+        set_default_options(PREFIX, TS_DEFAULTS)
+        set_default_options(PREFIX + "ts_", {**SNES_DEFAULTS, "snes_atol": self.residual_floor()})
+        with _TemporaryOptions(PREFIX, options):
+            ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
+            self.form = SecondOrder(self.rod, bcs) if ts_type == "alpha2" else FirstOrder(self.rod, bcs)
+            self.ts = self._create_ts(ts_type)
+        self.probes = Probes(self.form)
+        self._fix_controller_offset()
+        self.newton_iterations = 0
+        self.steps = 0
+
+    def residual_floor(self) -> float:
+        """An absolute Newton tolerance ten times the round-off floor of |F|.
+
+        The floor is set by the IP bending term, whose Jacobian entries grow
+        like mu eta p^4 N^3: measured (Sec. 5.2, p = 3) 3e-8, 3e-7 and 4e-6 at
+        N = 8, 16 and 32, matched within a factor 10 by
+        1e-14 (sigma + mu eta p^4 N^3) sqrt(dofs)."""
+        q, d = self.q, self.params.discretisation
+        scale = q.sigma + q.mu * d.penalty * d.degree**4 * d.elements**3
+        return 1e-14 * scale * math.sqrt(self.rod.dof_count())
+
+    def _create_ts(self, ts_type: str):
+        ts = PETSc.TS().create(self.comm)
+        ts.setOptionsPrefix(PREFIX)
+        ts.setType(ts_type)
+        ts.setProblemType(PETSc.TS.ProblemType.NONLINEAR)
+        self.form.attach(ts)
+        U, V = self.form.initial_vectors()
+        if self.form.second_order:
+            ts.setSolution2(U, V)
+        else:
+            ts.setSolution(U)
+        ts.setTime(0.0)
+        ts.setTimeStep(self.params.time.dt_s / self.q.t_scale)
+        ts.setExactFinalTime(PETSc.TS.ExactFinalTime.MATCHSTEP)
+        ts.setFromOptions()
+        snes = ts.getSNES()
+        snes.setOptionsPrefix(PREFIX + "ts_")
+        snes.setFromOptions()
+        snes.getKSP().setFromOptions()
+        snes.getKSP().getPC().setFromOptions()
+        return ts
+
+    def _fix_controller_offset(self):
+        """C in m0 = mN + k1 (alpha(0) - alpha_dot* t) + k2 alpha_t(0) + C: m0(0) = m0 of
+        the initial state (zero: the stationary state has no torques)."""
+        self.form.set_time(0.0)
+        self.form.load_solution(self.ts)
+        v = self.probes.values()
+        self.form.offset.value = 0.0 - (v["m0"] - float(self.form.offset.value))
+
+    # -- stepping ---------------------------------------------------------------
+    @property
+    def t(self) -> float:
+        """Simulated time [normalised]."""
+        return self.ts.getTime()
+
+    def advance(self, t_end: float, on_step=None, on_output=None, output_every: float | None = None):
+        """Integrate to ``t_end`` (normalised), calling ``on_output(solver)`` at
+        t = 0 (if it is the start) and every ``output_every`` (steps are cut to
+        land on those times), and ``on_step(solver)`` after every step.
+
+        Raises SolverError if a step cannot be completed within the retries;
+        the state is then the last good one (see :meth:`save_state`)."""
+        ts = self.ts
+        t0 = ts.getTime()
+        eps = 1e-9 * max(1.0, t_end)
+        outputs = []
+        if output_every:
+            n = int(math.floor((t_end - t0) / output_every + 1e-9))
+            outputs = [t0 + k * output_every for k in range(1, n + 1)]
+            if not outputs or outputs[-1] < t_end - eps:
+                outputs.append(t_end)
+        self._pending = outputs
+        self._dt_wanted = None
+        self._good = None
+        self._on_step, self._on_output = on_step, on_output
+
+        def prestep(ts_):
+            t, dt = ts_.getTime(), ts_.getTimeStep()
+            if self._dt_wanted is not None:  # undo the last cut
+                dt, self._dt_wanted = max(dt, self._dt_wanted), None
+            while self._pending and self._pending[0] <= t + eps:
+                self._pending.pop(0)
+            if self._pending and t + dt > self._pending[0] - 1e-3 * dt:
+                self._dt_wanted = dt
+                dt = self._pending[0] - t
+            ts_.setTimeStep(dt)
+
+        def monitor(ts_, step, t, X):
+            if step == 0 and self.steps == 0:
+                self._accepted(t, first=True)
+                return
+            if step > 0:
+                self._accepted(t)
+
+        ts.setPreStep(prestep)
+        ts.setMonitor(monitor)
+        ts.setMaxTime(t_end)
+        snes_before = ts.getSNESIterations()
+        steps_before = ts.getStepNumber()
+        try:
+            ts.solve(ts.getSolution())
+        except NonFiniteState:
+            raise self._failure("the state became NaN or Inf") from None
+        except PETSc.Error as err:
+            if isinstance(getattr(self, "_callback_error", None), NonFiniteState):
+                raise self._failure("the state became NaN or Inf") from None
+            raise self._failure(f"PETSc error {err}") from None
+        finally:
+            ts.cancelMonitor()
+            self.newton_iterations += ts.getSNESIterations() - snes_before
+            self.steps += ts.getStepNumber() - steps_before
+        reason = ts.getConvergedReason()
+        if reason < 0:
+            raise self._failure(f"TS stopped with {ts_reason_name(reason)}")
+        self._restore_good()
+
+    def _accepted(self, t, first=False):
+        self.form.load_solution(self.ts)
+        vec = compat.petsc_vec(self.form.u if self.form.second_order else self.form.x)
+        finite = np.isfinite(vec.norm())
+        if self.form.second_order:
+            finite = finite and np.isfinite(compat.petsc_vec(self.form.v).norm())
+        if not finite:
+            self._callback_error = NonFiniteState()
+            raise self._callback_error
+        self._good = (t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
+        if self._on_step is not None and not first:
+            self._on_step(self)
+        eps = 1e-9 * max(1.0, t)
+        if self._on_output is not None and (first or (self._pending and abs(t - self._pending[0]) <= eps)):
+            self.form.set_time(t)
+            self._on_output(self)
+
+    def _state_functions(self):
+        return (self.form.u, self.form.v) if self.form.second_order else (self.form.x,)
+
+    def _restore_good(self):
+        """Functions <- the last accepted state (after a failure PETSc may leave a bad one)."""
+        if self._good is None:
+            return
+        t, vecs = self._good
+        for f, v in zip(self._state_functions(), vecs):
+            v.copy(compat.petsc_vec(f))
+            f.x.scatter_forward()
+        self.form.set_time(t)
+        self.good_time = t
+
+    def _failure(self, why: str) -> SolverError:
+        self._restore_good()
+        t_s = self.q.time_s((self._good or (0.0,))[0])
+        snes = self.ts.getSNES()
+        return SolverError(
+            f"dynamics stopped at t = {float(t_s):.6g} s (simulated): {why}; last SNES reason "
+            f"{reason_name(snes.getConvergedReason())}, time step {self.q.time_s(self.ts.getTimeStep()):.3g} s. "
+            f"Try a smaller first step (time.dt_s), more retries "
+            f"(-{PREFIX}ts_max_snes_failures 20), adaptive steps (-{PREFIX}ts_adapt_type basic), "
+            f"more Newton iterations (-{PREFIX}ts_snes_max_it 30) or more elements.")
+
+    # -- state file ---------------------------------------------------------------
+    def state_arrays(self) -> dict | None:
+        """The current state along s (normalised), on rank 0 (None elsewhere)."""
+        f = self.probes.fields()
+        if f is None:
+            return None
+        return {"t": self.t if self._good is None else self._good[0],
+                "s": f["s"], "r": f["r"], "alpha": f["alpha"], "r_t": f["r_t"],
+                "alpha_t": f["alpha_t"]}
+
+    def save_state(self, path: Path) -> Path | None:
+        """Write the last good state to ``path`` (.npz, normalised, with SI scales); collective."""
+        a = self.state_arrays()
+        if self.comm.rank != 0:
+            return None
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.stem + ".tmp.npz")
+        q = self.q
+        np.savez(tmp, **a, t_s=q.time_s(a["t"]), L0_m=q.L0, t_scale_s=q.t_scale,
+                 elements=self.params.discretisation.elements, degree=self.rod.degree)
+        tmp.replace(path)
+        return path
+
+    # -- energy (normalised) ----------------------------------------------------------
+    def energy(self) -> dict:
+        """Kinetic, potential and non-variational power of the current state (collective)."""
+        out = {}
+        for name in ("kinetic", "potential", "power_nv"):
+            out[name] = self.comm.allreduce(
+                dolfinx.fem.assemble_scalar(getattr(self.form, name)), op=MPI.SUM)
+        return out
+
+
+

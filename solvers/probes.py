@@ -1,0 +1,84 @@
+"""What a dynamic run records: point values at s = 0, ~1/2, 1 and fields along s.
+
+Point values are scalar forms on the end points (ds, weighted by 1 - s or s)
+and on the vertex nearest the middle (dS), so they are exact point
+evaluations and need no search for the owning rank: assemble, then sum over
+ranks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+import dolfinx.fem
+
+from rawehelix import compat
+from rawehelix.forms import kinematics
+from rawehelix.solvers import fields as fe_fields
+
+
+def middle_vertex(mesh) -> tuple[float, np.ndarray]:
+    """(s, local vertex indices) of the mesh vertex nearest s = 1/2 (normalised)."""
+    x = mesh.geometry.x[:, 0]
+    local = x[np.argmin(np.abs(x - 0.5))] if len(x) else np.inf
+    candidates = mesh.comm.allgather(local)
+    s_mid = float(min(candidates, key=lambda v: abs(v - 0.5)))
+    vertices = dolfinx.mesh.locate_entities(mesh, 0, lambda y: np.isclose(y[0], s_mid))
+    return s_mid, vertices
+
+
+class Probes:
+    """Scalar forms for the time series and interpolations for the fields."""
+
+    def __init__(self, formulation):
+        rod = formulation.rod
+        mesh, c = rod.mesh, rod.c
+        f = formulation.fields
+        self.comm = mesh.comm
+        s = ufl.SpatialCoordinate(mesh)[0]
+        ds = ufl.ds(domain=mesh)
+        self.s_mid, vertices = middle_vertex(mesh)
+        dS_mid = ufl.dS(domain=mesh, subdomain_data=compat.vertex_tags(mesh, vertices), subdomain_id=1)
+        T = kinematics.tension(f.r, c.sigma)  # (29)
+        at0 = lambda e: e * (1 - s) * ds  # noqa: E731  value at s = 0
+        at1 = lambda e: e * s * ds  # noqa: E731  value at s = 1
+        atm = lambda e: ufl.avg(e) * dS_mid  # noqa: E731  value at the middle vertex
+        forms = {
+            "spin0": at0(f.alpha_t), "spin_mid": atm(f.alpha_t), "spin1": at1(f.alpha_t),
+            "alpha0": at0(f.alpha), "m0": at0(formulation.m0),
+            "tension0": at0(T), "tension1": at1(T),
+            "x_mid": atm(f.r[0]), "y_mid": atm(f.r[1]), "z_mid": atm(f.r[2]),
+        }
+        self.forms = {k: dolfinx.fem.form(v) for k, v in forms.items()}
+        # fields along s, interpolated at the Lagrange nodes
+        V_r = rod.V_r
+        V_s, _ = compat.collapse(rod.W.sub(1))
+        self.field_exprs = {
+            "r": (compat.expression(f.r, V_r), dolfinx.fem.Function(V_r)),
+            "alpha": (compat.expression(f.alpha, V_s), dolfinx.fem.Function(V_s)),
+            "alpha_t": (compat.expression(f.alpha_t, V_s), dolfinx.fem.Function(V_s)),
+            "r_t": (compat.expression(f.r_t, V_r), dolfinx.fem.Function(V_r)),
+            "tension": (compat.expression(T, V_s), dolfinx.fem.Function(V_s)),
+            "twist": (compat.expression(
+                kinematics.twist(f.r, f.alpha, c.gamma_eps, c.gamma_coupling), V_s),
+                dolfinx.fem.Function(V_s)),
+        }
+
+    def values(self) -> dict:
+        """Normalised point values (collective; every rank gets them)."""
+        local = np.array([dolfinx.fem.assemble_scalar(f) for f in self.forms.values()])
+        total = self.comm.allreduce(local, op=MPI.SUM)
+        return dict(zip(self.forms, total))
+
+    def fields(self) -> dict | None:
+        """Normalised fields at the Lagrange nodes, sorted by s, on rank 0 (None elsewhere)."""
+        out = {}
+        for name, (expr, u) in self.field_exprs.items():
+            u.interpolate(expr)
+            s, vals = fe_fields.gather(u)
+            if s is not None:
+                out["s"] = s
+                out[name] = vals if vals.shape[1] > 1 else vals[:, 0]
+        return out if self.comm.rank == 0 else None

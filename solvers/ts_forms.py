@@ -1,0 +1,252 @@
+"""The rod equations (30)-(31) as PETSc TS residuals: second- and first-order forms.
+
+Second order (TSALPHA2), unknown U = (r, alpha) on the mixed space W:
+
+    F(t, U, V, A) = rod.residual(U, V, A)                 (30)-(31)
+    J = dF/dU + v_shift dF/dV + a_shift dF/dA             (I2Jacobian)
+
+First order (theta, bdf, arkimex, ... : IFunction), unknown X = (r, alpha,
+r_t, alpha_t) on a doubled mixed space:
+
+    G(t, X, X_t) = int (r_t - v_r).w + (alpha_t - omega) chi + rod.residual(r, alpha; v_r, v_r_t, omega_t)
+    J = dG/dX + shift dG/dX_t                            (IJacobian)
+
+Both put the ground torque of the controller into the form as a UFL
+expression of the state at s = 0 (Eq. 40 integrated once in time):
+
+    m0 = mN + k1 (alpha(0) - alpha_dot* t) + k2 alpha_t(0) + C,
+
+with C fixed by the initial state, so the Jacobian contains dm0/dU and
+dm0/dV.  The alpha and alpha_t in the boundary term -delta m0 psi ds are
+evaluated on the end point s = 0 (the term is weighted by 1 - s).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import ufl
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from rawehelix import compat
+from rawehelix.forms import energy, rod
+from rawehelix.solvers.discrete import RodDiscretisation
+
+
+class Fields:
+    """UFL views (r, alpha, r_t, alpha_t) of a formulation's state."""
+
+    def __init__(self, r, alpha, r_t, alpha_t):
+        self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
+
+
+def controller_torque(c: rod.Coefficients, q, fields: Fields, time, offset):
+    """m0 = mN + k1 (alpha - alpha_dot* t) + k2 alpha_t + C: Eq. (40) integrated in time."""
+    return (c.mN + q.k1 * (fields.alpha - q.spin_target * time)
+            + q.k2 * fields.alpha_t + offset)
+
+
+class _Formulation:
+    """Shared set-up: time, torque constants, controller and energy forms."""
+
+    second_order: bool
+
+    def __init__(self, rod_: RodDiscretisation, bcs):
+        self.rod = rod_
+        mesh = rod_.mesh
+        self.time = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))  # t~
+        self.offset = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))  # C of Eq. (40)
+        self.moving_top = rod_.q.r1 > 0 and rod_.q.omega1 > 0  # Eq. (70)
+        self.bcs = bcs
+
+    def _coefficients(self, fields: Fields) -> rod.Coefficients:
+        c = self.rod.c
+        self.m0 = controller_torque(c, self.rod.q, fields, self.time, self.offset)
+        return dataclasses.replace(c, m0=self.m0)
+
+    def _compile(self, F, J, fields: Fields, c_dyn):
+        self.F = dolfinx.fem.form(F)
+        self.J = dolfinx.fem.form(J)
+        self.fields = fields
+        dx = self.rod.measures[0]
+        self.kinetic = dolfinx.fem.form(energy.kinetic(fields.r_t, fields.alpha_t, self.rod.c, dx))
+        self.potential = dolfinx.fem.form(energy.potential(
+            fields.r, fields.alpha, self.rod.c, self.rod.degree, self.rod.penalty,
+            self.rod.measures))
+        self.power_nv = dolfinx.fem.form(energy.non_variational_power(
+            fields.r, fields.alpha, fields.r_t, self.rod.c, dx))
+        self.b = compat.create_vector(self.F)
+        self.A = compat.create_matrix(self.J)
+
+    def set_time(self, t: float):
+        """Time-dependent data: torque ramp (69), end motion (36)/(70)."""
+        q = self.rod.q
+        self.time.value = t
+        self.rod.c.mN.value = q.top_torque(t)  # (69)
+        if self.moving_top:
+            self._set_top(t)
+
+    def assemble_residual(self, x, b):
+        with b.localForm() as b_local:
+            b_local.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(b, self.F)
+        # Dirichlet rows x - g, and the lifting b += J_bc (g - x), which makes the
+        # first Newton step exact for a moving end (70) (the bc columns of J are
+        # zero); it touches only the cells at the ends, and is zero when g = x.
+        compat.apply_lifting_and_bc(b, self.J, self.bcs, x, -1.0)
+
+    def assemble_jacobian(self, A):
+        A.zeroEntries()
+        dolfinx.fem.petsc.assemble_matrix(A, self.J, self.bcs)
+        A.assemble()
+
+
+def _load(vec, u):
+    """Function u <- PETSc vector vec (owned values), then update ghosts."""
+    vec.copy(compat.petsc_vec(u))
+    u.x.scatter_forward()
+
+
+class SecondOrder(_Formulation):
+    """F(t, U, V, A) = 0 for TSALPHA2; U lives in ``rod.w``."""
+
+    second_order = True
+
+    def __init__(self, rod_: RodDiscretisation, bcs):
+        super().__init__(rod_, bcs)
+        W = rod_.W
+        self.u = rod_.w  # (r, alpha)
+        self.v = dolfinx.fem.Function(W, name="velocity")  # (r_t, alpha_t)
+        self.a = dolfinx.fem.Function(W, name="acceleration")
+        self.shift_v = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
+        self.shift_a = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
+        r, alpha = ufl.split(self.u)
+        r_t, alpha_t = ufl.split(self.v)
+        fields = Fields(r, alpha, r_t, alpha_t)
+        c_dyn = self._coefficients(fields)
+        F = rod.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree, rod_.penalty,
+                         rod_.measures)
+        J = (ufl.derivative(F, self.u, rod_.trial)
+             + self.shift_v * ufl.derivative(F, self.v, rod_.trial)
+             + self.shift_a * ufl.derivative(F, self.a, rod_.trial))
+        self._compile(F, J, fields, c_dyn)
+
+    def _set_top(self, t):
+        self.rod.set_top_position(self.rod.q.top_position(t))
+
+    def attach(self, ts):
+        ts.setI2Function(self._f, self.b)
+        ts.setI2Jacobian(self._j, self.A)
+
+    def _update(self, t, U, V, A=None):
+        self.set_time(t)
+        _load(U, self.u)
+        _load(V, self.v)
+        if A is not None:
+            _load(A, self.a)
+
+    def _f(self, ts, t, U, V, A, F):
+        self._update(t, U, V, A)
+        self.assemble_residual(U, F)
+
+    def _j(self, ts, t, U, V, A, shift_v, shift_a, J, P):
+        self._update(t, U, V, A)
+        self.shift_v.value, self.shift_a.value = shift_v, shift_a
+        self.assemble_jacobian(P)
+        if J != P:
+            J.assemble()
+
+    def initial_vectors(self):
+        U = compat.petsc_vec(self.u).copy()
+        V = compat.petsc_vec(self.v).copy()
+        return U, V
+
+    def load_solution(self, ts):
+        """Functions u, v <- the TS solution (U, V)."""
+        U, V = ts.getSolution2()
+        _load(U, self.u)
+        _load(V, self.v)
+
+
+class FirstOrder(_Formulation):
+    """G(t, X, X_t) = 0 for the first-order TS types; X = (r, alpha, r_t, alpha_t)."""
+
+    second_order = False
+
+    def __init__(self, rod_: RodDiscretisation, bcs_second_order):
+        mesh = rod_.mesh
+        self.W2 = compat.function_space(mesh, compat.rod_pair_element(mesh.ufl_cell(), rod_.degree))
+        self.x = dolfinx.fem.Function(self.W2, name="state")
+        self.x_t = dolfinx.fem.Function(self.W2, name="rate")
+        super().__init__(rod_, self._end_conditions(rod_))
+        self.shift = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
+        r, alpha, v_r, omega = ufl.split(self.x)
+        r_t, alpha_t, v_r_t, omega_t = ufl.split(self.x_t)
+        w_r, chi, v, psi = ufl.split(ufl.TestFunction(self.W2))
+        fields = Fields(r, alpha, v_r, omega)
+        c_dyn = self._coefficients(fields)
+        dx = rod_.measures[0]
+        F = (ufl.inner(r_t - v_r, w_r) + (alpha_t - omega) * chi) * dx \
+            + rod.residual_of_fields(r, alpha, v_r, v_r_t, omega_t, (v, psi), c_dyn,
+                                     rod_.degree, rod_.penalty, rod_.measures)
+        trial = ufl.TrialFunction(self.W2)
+        J = ufl.derivative(F, self.x, trial) + self.shift * ufl.derivative(F, self.x_t, trial)
+        self._compile(F, J, fields, c_dyn)
+
+    def _end_conditions(self, rod_):
+        """r(0) = 0, r(1) = r_N(t) (35)-(36) and their rates r_t(0) = 0, r_t(1) = r_N'(t)."""
+        mesh, W2 = rod_.mesh, self.W2
+        ends = {"bottom": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 0.0)),
+                "top": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 1.0))}
+        self.V_r = rod_.V_r
+        self.r_top = dolfinx.fem.Function(self.V_r)
+        self.r_top_t = dolfinx.fem.Function(self.V_r)
+        zero = dolfinx.fem.Function(self.V_r)
+        self._set_top_functions(0.0, rod_.q)
+        bcs = []
+        for sub, values in ((0, {"bottom": zero, "top": self.r_top}),
+                            (2, {"bottom": zero, "top": self.r_top_t})):
+            for end, g in values.items():
+                dofs = dolfinx.fem.locate_dofs_topological((W2.sub(sub), self.V_r), 0, ends[end])
+                bcs.append(dolfinx.fem.dirichletbc(g, dofs, W2.sub(sub)))
+        return bcs
+
+    def _set_top_functions(self, t, q):
+        for f, value in ((self.r_top, q.top_position(t)), (self.r_top_t, q.top_velocity(t))):
+            f.interpolate(lambda x, v=np.asarray(value): np.outer(v, np.ones(x.shape[1])))
+
+    def _set_top(self, t):
+        self._set_top_functions(t, self.rod.q)
+
+    def attach(self, ts):
+        ts.setIFunction(self._f, self.b)
+        ts.setIJacobian(self._j, self.A)
+
+    def _update(self, t, X, X_t):
+        self.set_time(t)
+        _load(X, self.x)
+        _load(X_t, self.x_t)
+
+    def _f(self, ts, t, X, X_t, F):
+        self._update(t, X, X_t)
+        self.assemble_residual(X, F)
+
+    def _j(self, ts, t, X, X_t, shift, J, P):
+        self._update(t, X, X_t)
+        self.shift.value = shift
+        self.assemble_jacobian(P)
+        if J != P:
+            J.assemble()
+
+    def initial_vectors(self):
+        """X0 = (r, alpha) of ``rod.w``, zero rates."""
+        self.x.sub(0).interpolate(self.rod.w.sub(0))
+        self.x.sub(1).interpolate(self.rod.w.sub(1))
+        self.x.x.scatter_forward()
+        return compat.petsc_vec(self.x).copy(), None
+
+    def load_solution(self, ts):
+        _load(ts.getSolution(), self.x)
