@@ -34,7 +34,7 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.forms.parameters import Parameters
 from rawehelix.solvers.probes import Probes
-from rawehelix.solvers.snes import SolverError, reason_name, set_default_options
+from rawehelix.solvers.snes import FloorConvergence, SolverError, reason_name, set_default_options
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
 
@@ -163,6 +163,7 @@ class DynamicsSolver:
         snes = ts.getSNES()
         snes.setOptionsPrefix(PREFIX + "ts_")
         snes.setFromOptions()
+        snes.setConvergenceTest(FloorConvergence())
         snes.getKSP().setFromOptions()
         snes.getKSP().getPC().setFromOptions()
         return ts

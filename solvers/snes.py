@@ -39,6 +39,38 @@ def set_default_options(prefix: str, defaults: dict):
             opts[prefix + key] = value
 
 
+class FloorConvergence:
+    """SNES convergence test: PETSc's default (rtol, atol, stol) plus the round-off floor.
+
+    The residual of the fourth-order bending term cannot fall below
+    ~eps |J| |x|, which grows like N^3 (and like 1/dt^2 in a time step); there
+    Newton's steps shrink to noise while the residual stagnates.  A step below
+    ``floor_step`` (relative to the state) that no longer lowers the residual,
+    after at least three iterations, is convergence, not failure."""
+
+    def __init__(self, floor_step: float = 1.0e-6):
+        self.floor_step = floor_step
+
+    def __call__(self, snes, it, norms):
+        xnorm, ynorm, fnorm = norms
+        rtol, atol, stol, _ = snes.getTolerances()
+        R = PETSc.SNES.ConvergedReason
+        if it == 0:
+            self.f0 = self.fmin = fnorm
+            return R.CONVERGED_ITERATING
+        if fnorm != fnorm:
+            return R.DIVERGED_FNORM_NAN
+        if fnorm <= atol:
+            return R.CONVERGED_FNORM_ABS
+        if fnorm <= rtol * self.f0:
+            return R.CONVERGED_FNORM_RELATIVE
+        if ynorm <= stol * xnorm:
+            return R.CONVERGED_SNORM_RELATIVE
+        floor = it >= 3 and ynorm <= self.floor_step * (1.0 + xnorm) and fnorm > 0.5 * self.fmin
+        self.fmin = min(self.fmin, fnorm)
+        return R.CONVERGED_SNORM_RELATIVE if floor else R.CONVERGED_ITERATING
+
+
 class NewtonSolver:
     """SNES on F(u; v) = 0 with bcs; the Jacobian is the UFL derivative of F."""
 
@@ -53,39 +85,12 @@ class NewtonSolver:
         self.snes = PETSc.SNES().create(u.function_space.mesh.comm)
         self.snes.setOptionsPrefix(prefix)
         set_default_options(prefix, {**SNES_DEFAULTS, **(options or {})})
-        self.snes.setConvergenceTest(self._converged)
+        self.snes.setConvergenceTest(FloorConvergence())
         self.snes.setFunction(self._residual, self.b)
         self.snes.setJacobian(self._jacobian, self.A)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
         self.prefix = prefix
-
-    #: a Newton step below this (relative to the state) that no longer lowers
-    #: the residual means the round-off floor is reached (see SNES_DEFAULTS)
-    FLOOR_STEP = 1.0e-6
-
-    def _converged(self, snes, it, norms):
-        """PETSc's default test (rtol, atol, stol) plus the round-off floor: the
-        residual of the fourth-order bending term cannot fall below ~eps |J| |x|,
-        which grows like N^3; there Newton's steps shrink to noise while the
-        residual stagnates.  That is convergence, not failure."""
-        xnorm, ynorm, fnorm = norms
-        rtol, atol, stol, _ = snes.getTolerances()
-        R = PETSc.SNES.ConvergedReason
-        if it == 0:
-            self._f0 = self._fmin = fnorm
-            return R.CONVERGED_ITERATING
-        if fnorm != fnorm:
-            return R.DIVERGED_FNORM_NAN
-        if fnorm <= atol:
-            return R.CONVERGED_FNORM_ABS
-        if fnorm <= rtol * self._f0:
-            return R.CONVERGED_FNORM_RELATIVE
-        if ynorm <= stol * xnorm:
-            return R.CONVERGED_SNORM_RELATIVE
-        floor = it >= 3 and ynorm <= self.FLOOR_STEP * (1.0 + xnorm) and fnorm > 0.5 * self._fmin
-        self._fmin = min(self._fmin, fnorm)
-        return R.CONVERGED_SNORM_RELATIVE if floor else R.CONVERGED_ITERATING
 
     def _update(self, x):
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)

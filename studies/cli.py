@@ -22,7 +22,7 @@ from pathlib import Path
 
 from rawehelix.studies import scene as scenes
 
-COMMANDS = ("stationary", "modes", "simulate", "sweep")
+COMMANDS = ("stationary", "modes", "simulate", "sweep", "converge", "extremes")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -54,6 +54,10 @@ def _parser() -> argparse.ArgumentParser:
                            help="frequencies in Hz (default: the scene's [sweep] section)")
             p.add_argument("--series", action="store_true",
                            help="also write each point's tension time series (CSV)")
+    p = sub.add_parser("extremes", help="the scenes at the edges of the physics (studies/extremes)")
+    p.add_argument("-o", "--output", type=Path, default=Path("results/extremes"),
+                   help="output directory (default results/extremes)")
+    p.add_argument("cases", nargs="*", help="case names (default: all)")
     return parser
 
 
@@ -78,12 +82,27 @@ def _frequencies(spec: str | None, params) -> list[float]:
                                f1_step_Hz=step).frequencies()
 
 
+def _extremes(args, petsc_args) -> int:
+    from rawehelix.studies import extremes
+    unknown = [c for c in args.cases if c not in extremes.CASES]
+    if unknown:
+        return _fail(f"extremes: unknown case(s) {', '.join(unknown)}; "
+                     f"known: {', '.join(extremes.CASES)}")
+    import petsc4py
+    petsc4py.init([sys.argv[0], *petsc_args])
+    logging.getLogger().setLevel(logging.WARNING)
+    extremes.run(args.output, cases=args.cases or None)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     args, petsc_args = _parser().parse_known_args(argv)
     stray = [a for a in petsc_args if not a.startswith("-")]
     if stray:
         return _fail(f"unexpected argument(s) {' '.join(stray)}")
+    if args.command == "extremes":
+        return _extremes(args, petsc_args)
     try:
         params = scenes.load(args.scene, elements=args.elements, degree=args.degree,
                              scheme=args.scheme)

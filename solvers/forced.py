@@ -1,0 +1,91 @@
+"""The FE dynamics (PETSc TS) as a backend of :mod:`rawehelix.solvers.periodic`.
+
+One :class:`DynamicsSolver` serves a whole chunk of a sweep.  Each forcing
+frequency restarts the time integrator from the current (U, V) at the start of
+its periods, with the first step ``time.dt_s``; so a point continued in memory
+and a point resumed from its predecessor's state file take the same steps."""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix import compat
+from rawehelix.forms.parameters import Normalised, Parameters
+from rawehelix.solvers.dynamics import DynamicsSolver
+
+
+class FEBackend:
+    scheme = "fe"
+
+    #: fixed steps: with a moving end the initial velocity and acceleration of
+    #: the end dofs jump at every new f1, which the adaptive error estimate of
+    #: alpha2 cannot get below its tolerance however small the step
+    OPTIONS = {"ts_adapt_type": "none"}
+
+    def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None):
+        self.params = params
+        self.solver = DynamicsSolver(params, comm, options={**self.OPTIONS, **(options or {})})
+        self.dt = params.time.dt_s / params.normalised().t_scale
+        rod = self.solver.rod
+        self.v_top = dolfinx.fem.Function(rod.V_r)
+        top = compat.locate_boundary_vertices(rod.mesh, lambda x: np.isclose(x[0], 1.0))
+        dofs = dolfinx.fem.locate_dofs_topological((rod.W.sub(0), rod.V_r), 0, top)
+        self.bc_v = dolfinx.fem.dirichletbc(self.v_top, dofs, rod.W.sub(0))
+        self._stationary = self.pack(None)
+
+    def _vectors(self):
+        form = self.solver.form
+        return (form.u, form.v) if form.second_order else (form.x,)
+
+    def stationary(self):
+        """The state the solver was built with: stationary, top at phase 0, at rest."""
+        return self._stationary
+
+    def advance(self, state, q: Normalised, t0: float, t1: float, t_out):
+        solver = self.solver
+        solver.q = solver.rod.q = q  # the circle of Eq. (70) at this f1 and phase
+        self.unpack_into(state, q.top_velocity(t0))
+        ts = solver.ts
+        ts.setTime(t0)
+        ts.setTimeStep(min(self.dt, (t1 - t0) / max(len(t_out), 1)))
+        ts.restartStep()
+        t_out = np.asarray(t_out)
+        samples = []
+
+        def record(s):
+            if s.t > t0 + 1e-12 * max(1.0, t1):
+                samples.append((s.t, s.probes.values()["tension0"]))
+
+        every = (t1 - t0) / len(t_out) if len(t_out) > 1 else t1 - t0
+        solver.advance(t1, on_output=record, output_every=every)
+        times = np.array([t for t, _ in samples])
+        values = np.array([v for _, v in samples])
+        tension = np.interp(t_out, times, values) if len(times) else np.full(len(t_out), np.nan)
+        return self.pack(None), tension
+
+    def pack(self, _state) -> dict:
+        """The current (U, V) of this rank's solver (COMM_SELF in a sweep)."""
+        return {f"v{k}": compat.petsc_vec(f).array.copy() for k, f in enumerate(self._vectors())}
+
+    def unpack_into(self, state: dict, top_velocity=None):
+        """(U, V) <- state; the upper end's velocity <- that of the circle now."""
+        form = self.solver.form
+        for k, f in enumerate(self._vectors()):
+            compat.petsc_vec(f).array[:] = state[f"v{k}"]
+            f.x.scatter_forward()
+        if top_velocity is not None and form.second_order:
+            self.v_top.interpolate(lambda x: np.outer(np.asarray(top_velocity), np.ones(x.shape[1])))
+            dolfinx.fem.petsc.set_bc(compat.petsc_vec(form.v), [self.bc_v])
+            form.v.x.scatter_forward()
+        if form.second_order:
+            self.solver.ts.setSolution2(compat.petsc_vec(form.u).copy(),
+                                        compat.petsc_vec(form.v).copy())
+        else:
+            self.solver.ts.setSolution(compat.petsc_vec(form.x).copy())
+
+    @staticmethod
+    def unpack(data) -> dict:
+        return {k: np.asarray(data[k]) for k in data.files if k.startswith("v")}

@@ -1,0 +1,37 @@
+"""One test per row of the extremes table (studies/extremes): the outcome is pinned."""
+
+import pytest
+
+from rawehelix.studies import extremes
+
+EXPECTED = {
+    # case: (status, check of the numbers)
+    "axial_x100": ("converged", lambda n: n["tension_rel_diff_N16_N64"] < 1e-4
+                   and n["longitudinal_rel_err"] < 1e-4),
+    "near_zero_tension": ("converged", lambda n: abs(n["tension_s0_N"] - 3.64e-3) < 1e-6
+                          and n["lateral_rel_err"] < 1e-4),
+    "slack_vertical": ("detected", None),
+    "negative_elongation": ("error", None),
+    "string_limit": ("converged", lambda n: n["string_rel_diff"] < 1e-3
+                     and n["beam_string_rel_err"] < 1e-6),
+    "bending_x100": ("converged", lambda n: n["tension_rel_err"] < 1e-6
+                     and n["lateral_rel_err"] < 1e-4),
+    "torsional_buckling": ("detected", lambda n: n["growth_at_0.9"] < 1e-3
+                           and n["growth_at_1.02"] > 1.0 and n["lateral_at_0.99"] < 0.2 * 36.8),
+    "f1_40Hz": ("converged", lambda n: 60 < n["tension_min_N"] <= n["tension_max_N"] < 200),
+    "n_1e4": ("limit", None),
+}
+
+
+def test_every_case_is_pinned():
+    assert set(EXPECTED) == set(extremes.CASES)
+
+
+@pytest.mark.parametrize("case", list(EXPECTED))
+def test_extreme(case):
+    status, check = EXPECTED[case]
+    outcome = extremes.run_case(case)
+    assert outcome.status == status, outcome.detail
+    assert outcome.detail
+    if check is not None:
+        assert check(outcome.numbers), outcome.numbers
