@@ -12,7 +12,7 @@ export OMPI_MCA_rmaps_base_oversubscribe := 1
 MPIRUN  := mpirun -n $(NP) --oversubscribe
 PYTEST_ARGS ?=
 
-.PHONY: install demo test test-serial test-mpi test-debian13 bench clean
+.PHONY: install demo test test-debian13 bench clean
 
 install:
 	@bash scripts/install.sh
@@ -30,3 +30,6 @@ test-debian13:
 
 clean:
 	rm -rf results .pytest_cache
+
+bench: install
+	$(PY) benchmarks/run.py

@@ -41,6 +41,8 @@ class Method:
     degree: int | None = None
     ladder: tuple = ()  # refinement values: elements N (or dt in s for time schemes)
     variable: str = "elements"  # what the ladder refines: "elements" or "dt_s"
+    ts_type: str | None = None  # PETSc TS type for the FE dynamics (default alpha2)
+    elements: int | None = None  # fixed N of a time-step ladder
 
     def resolution(self, value) -> float:
         """A mesh size h (or dt) whose ratio gives the observed order."""
@@ -76,7 +78,10 @@ def _with(params: Parameters, method: Method, value) -> Parameters:
         if method.degree is not None:
             disc["degree"] = method.degree
         return params.replace(discretisation=disc)
-    return params.replace(time={"dt_s": float(value)})
+    disc = {"scheme": method.scheme, "elements": method.elements or params.discretisation.elements}
+    if method.degree is not None:
+        disc["degree"] = method.degree
+    return params.replace(discretisation=disc, time={"dt_s": float(value)})
 
 
 def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
@@ -120,6 +125,82 @@ def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
     return np.array([lowest.get(f, math.nan) for f in FAMILIES])
 
 
+# -- dynamics (Sec. 5.2) -------------------------------------------------------------
+
+SPIN_RUN_S = 15.0  # the spin settles in ~5 s (Fig. 6)
+
+
+def _spin_series(params: Parameters, method: Method, value):
+    """(t [s], spin [rpm] at s = 0, L0/2, L0) of the Sec. 5.2 run, sampled every 5 ms."""
+    p = _with(params, method, value)
+    q = p.normalised()
+    every = 0.005 / q.t_scale
+    if method.scheme == "spline":
+        from rawehelix.solvers.spline_galerkin.dynamics import time_series
+        ts = time_series(p, until_s=SPIN_RUN_S, output_every_s=0.005, rtol=1e-9)
+        return ts.time_s, ts.spin_rpm
+    from rawehelix.solvers.dynamics import DynamicsSolver
+    options = {"ts_type": method.ts_type} if method.ts_type else {}
+    if method.variable == "dt_s":
+        options["ts_adapt_type"] = "none"
+    else:  # adaptive steps, tight enough that space dominates the error
+        options.update({"ts_rtol": 1e-6, "ts_atol": 1e-6})
+    solver = DynamicsSolver(p, MPI.COMM_SELF, options=options)
+    rows = []
+
+    def sample(s):
+        v = s.probes.values()
+        rows.append((s.t, v["spin0"], v["spin_mid"], v["spin1"]))
+
+    solver.advance(SPIN_RUN_S / q.t_scale, on_output=sample, output_every=every)
+    rows = np.array(rows)
+    return q.time_s(rows[:, 0]), q.spin_rpm(rows[:, 1:])
+
+
+def spin_overshoot(params: Parameters, method: Method, value) -> np.ndarray:
+    """Largest spin at s = 0 above the target [rpm] (Sec. 5.2)."""
+    t, spin = _spin_series(params, method, value)
+    return np.array([spin[:, 0].max() - params.controller.target_rpm])
+
+
+def settling_time(params: Parameters, method: Method, value) -> np.ndarray:
+    """When all three spins stay within 2 % of the target [s] (Sec. 5.2); the
+    last exit from the band is located by linear interpolation."""
+    t, spin = _spin_series(params, method, value)
+    target = params.controller.target_rpm
+    dev = np.max(np.abs(spin - target), axis=1) - 0.02 * target
+    outside = np.nonzero(dev > 0)[0]
+    if len(outside) == 0:
+        return np.array([0.0])
+    k = outside[-1]
+    if k + 1 >= len(t):
+        return np.array([math.inf])
+    return np.array([t[k] + (t[k + 1] - t[k]) * dev[k] / (dev[k] - dev[k + 1])])
+
+
+# -- mobile end (Sec. 5.3) -------------------------------------------------------------
+
+TENSION_MAX_F1_HZ = 10.0
+
+
+def tension_max(params: Parameters, method: Method, value) -> np.ndarray:
+    """Maximum tension at s = 0 [N] of the periodic response at f1 = 10 Hz
+    (Fig. 8 inset), from the stationary state with a 3 s lead-in."""
+    from rawehelix.solvers.periodic import periodic_response
+    p = _with(params, method, value).replace(sweep={"lead_in_s": 3.0, "periodic_tolerance": 1e-4})
+    q = p.normalised()
+    if method.scheme == "spline":
+        from rawehelix.solvers.spline_galerkin.forced import SplineBackend
+        backend = SplineBackend(q, p.discretisation.elements, rtol=1e-9, atol=1e-11)
+    else:
+        from rawehelix.solvers.forced import FEBackend
+        backend = FEBackend(p, MPI.COMM_SELF,
+                            options={"ts_type": method.ts_type} if method.ts_type else None)
+    result, _, _ = periodic_response(backend, q, TENSION_MAX_F1_HZ, backend.stationary(), 0.0,
+                                     p.sweep, lead_in=True)
+    return np.array([result.tension_max_N])
+
+
 FE_LADDER = (2, 4, 8, 16, 32, 64)
 SPLINE_LADDER = (2, 4, 8, 16, 32)
 
@@ -134,7 +215,25 @@ def quantities() -> dict:
                                 [Method(f"FE p={p}", "fe", p, (2, 4, 8, 16, 32)) for p in (2, 3, 4)]
                                 + [Method("spline", "spline", None, (2, 4, 8, 16))],
                                 "FE p=4", eigenvalues, list(FAMILIES)),
+        **{name: Quantity(name, unit, _dynamic_methods(ladder_fe, ladder_spline, dts, N), "FE p=4",
+                          fn, [label])
+           for name, unit, fn, label, ladder_fe, ladder_spline, dts, N in (
+               ("spin_overshoot", "rpm", spin_overshoot, "overshoot", (2, 4, 8, 16), (2, 4, 8),
+                (0.02, 0.01, 0.005), 8),
+               ("settling_time", "s", settling_time, "settling", (2, 4, 8, 16), (2, 4, 8),
+                (0.02, 0.01, 0.005), 8),
+               ("tension_max", "N", tension_max, "T max at 10 Hz", (4, 8, 16), (2, 3, 4, 6),
+                (0.002, 0.001, 0.0005), 8))},
     }
+
+
+def _dynamic_methods(ladder_fe, ladder_spline, dts, N):
+    """FE p = 2, 3, 4 in space (adaptive alpha2), the spline reference, and two
+    TS schemes with fixed steps at N elements, p = 3 (the dt ladder)."""
+    return ([Method(f"FE p={p}", "fe", p, ladder_fe) for p in (2, 3, 4)]
+            + [Method("spline", "spline", None, ladder_spline)]
+            + [Method(f"FE N={N} p=3 {ts} (dt)", "fe", 3, dts, "dt_s", ts, N)
+               for ts in ("alpha2", "cn")])
 
 
 # -- the study ---------------------------------------------------------------------
