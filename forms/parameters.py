@@ -148,11 +148,16 @@ class Model:
     # modes grow (Re lambda ~ +1.5e-4 and more), an artefact of the Frenet frame
     # of an almost straight curve (docs/modal_convergence.md).
     gamma: str = "off"
+    # "auto": solve a reduced model where the scene allows it (the planar (x, z)
+    # rod for a planar, torque-free stationary state); "off": always the full one
+    reduction: str = "auto"
     gamma_eps: float = 1.0e-3  # regularisation of |r''|^2 in gamma (normalised curvature)
 
     def __post_init__(self):
         if self.gamma not in GAMMA_TREATMENTS:
             raise ParameterError("model.gamma", self.gamma, f"must be one of {GAMMA_TREATMENTS}")
+        if self.reduction not in ("auto", "off"):
+            raise ParameterError("model.reduction", self.reduction, "must be one of ('auto', 'off')")
         _positive("model", self, "gamma_eps")
 
 

@@ -110,9 +110,11 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
     F_NL = internal_force(r, tau, c.sigma, c.mu, c.beta)  # (32)
-    return (ufl.inner(F_NL, d(v)) * dx
-            + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS)  # (33)
-            + c.delta * tau * d(psi) * dx  # (31)
+    F = (ufl.inner(F_NL, d(v)) * dx
+         + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS))  # (33)
+    if psi is None:  # the planar model: no twist equation
+        return F
+    return (F + c.delta * tau * d(psi) * dx  # (31)
             # (38)-(39): tau(0) = m0, tau(1) = mN; x = 0 or 1 on the two ends
             - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)
 

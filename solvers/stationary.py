@@ -10,6 +10,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import ufl
 import dolfinx.fem
 from mpi4py import MPI
 
@@ -17,7 +18,9 @@ from rawehelix import compat
 from rawehelix.forms import kinematics, rod
 from rawehelix.forms.parameters import Parameters
 from rawehelix.solvers import fields
+from rawehelix.forms.kinematics import tension
 from rawehelix.solvers.discrete import RodDiscretisation
+from rawehelix.solvers.planar import PlanarRod
 from rawehelix.solvers.snes import NewtonSolver, SolverError
 
 
@@ -40,14 +43,17 @@ class StationaryResult:
 class StationarySolver:
     """Newton for the stationary residual of Eqs. (30)-(31) on one discretisation."""
 
-    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene"):
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
+                 planar: bool = False):
         self.params, self.scene = params, scene
-        self.rod = RodDiscretisation(params, comm)
+        # planar: the reduced (x, z) model (solvers.planar), for planar torque-free scenes
+        self.rod = PlanarRod(params, comm) if planar else RodDiscretisation(params, comm)
         self.F = self.rod.stationary_residual()
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
         p = self.rod.degree
         self.V_T = compat.scalar_space(self.rod.mesh, "DG", p - 1)
-        self.tension_expr = rod.tension_of(self.rod.w, self.rod.c)
+        r = self.rod.centre_line() if planar else ufl.split(self.rod.w)[0]
+        self.tension_expr = tension(r, self.rod.c.sigma)  # (29)
 
     def solve(self, first_guess=None) -> StationaryResult:
         """Solve from the chord (or ``first_guess``: s -> (n, 3) centre line)."""
@@ -81,9 +87,13 @@ class StationarySolver:
                 f"tension law (22) does not hold for compression; increase ends.elongation")
 
     def gather(self) -> StationaryResult:
-        r = self.rod.w.sub(0).collapse()
-        r = r[0] if isinstance(r, tuple) else r
-        s, x = fields.gather(r)
+        if getattr(self.rod, "planar", False):
+            s, xz = fields.gather(self.rod.w)
+            x = None if xz is None else np.column_stack([xz[:, 0], 0 * xz[:, 0], xz[:, 1]])
+        else:
+            r = self.rod.w.sub(0).collapse()
+            r = r[0] if isinstance(r, tuple) else r
+            s, x = fields.gather(r)
         T = fields.interpolate_expression(self.tension_expr, self.V_T)
         sT, Tv = fields.gather(T)
         return StationaryResult(s, x, sT, None if Tv is None else Tv[:, 0], 0, 0.0)

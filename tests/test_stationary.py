@@ -159,3 +159,22 @@ def test_slack_is_detected():
                                 model={"drag": False})
     with pytest.raises(SlackError, match="slack"):
         StationarySolver(params, MPI.COMM_SELF).solve()
+
+
+@pytest.mark.parametrize("N", (8, 64))
+def test_planar_reduction_is_exact(N):
+    """The reduced (x, z) model of a planar, torque-free scene gives the full
+    model's stationary state to round-off."""
+    full = StationarySolver(table2(N), MPI.COMM_SELF).solve()
+    planar = StationarySolver(table2(N), MPI.COMM_SELF, planar=True).solve()
+    assert np.max(np.abs(full.centre_line - planar.centre_line)) < 1e-10
+    assert np.max(np.abs(full.tension - planar.tension)) < 1e-7
+
+
+def test_stationary_command_says_which_model(tmp_path):
+    from rawehelix.studies import stationary
+    s = stationary.run(table2(8), tmp_path / "a", log=lambda *a: None, comm=MPI.COMM_SELF)
+    assert s["model"].startswith("planar")
+    s = stationary.run(table2(8).replace(model={"reduction": "off"}), tmp_path / "b",
+                       log=lambda *a: None, comm=MPI.COMM_SELF)
+    assert s["model"] == "full (r, alpha)"

@@ -1,0 +1,85 @@
+"""The planar rod: the reduced model of a planar, torque-free stationary scene.
+
+With fixed ends in the x-z plane (no circle, Eq. 70), gravity along k_E,
+wind along i_E and no end torques, the stationary solution of Eqs. (30)-(31)
+is r = x i_E + z k_E, alpha = 0 (paper Sec. 5.1).  Solving only for (x, z)
+halves the unknowns; the residual is the same UFL with y = 0 and alpha = 0.
+The interface is that of :class:`~rawehelix.solvers.discrete.RodDiscretisation`
+as far as :class:`~rawehelix.solvers.stationary.StationarySolver` uses it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from rawehelix import compat
+from rawehelix.forms import rod
+from rawehelix.forms.parameters import Parameters
+from rawehelix.meshes import interval
+
+
+def planar_allowed(params: Parameters) -> bool:
+    """The stationary scene is planar: its upper end lies in the x-z plane."""
+    return params.ends.circle_radius_m == 0
+
+
+def embed(u):
+    """(x, z) -> r = x i_E + z k_E."""
+    return ufl.as_vector((u[0], 0.0, u[1]))
+
+
+class PlanarRod:
+    planar = True
+
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD):
+        if not planar_allowed(params):
+            raise ValueError("the planar model needs the upper end in the x-z plane")
+        disc = params.discretisation
+        self.params, self.q, self.comm = params, params.normalised(), comm
+        self.degree, self.penalty = disc.degree, disc.penalty
+        self.mesh = interval.mesh_from_parameters(comm, params)
+        self.W = compat.vector_space(self.mesh, "Lagrange", self.degree, 2)
+        self.V_r = self.W
+        self.w = dolfinx.fem.Function(self.W, name="state")
+        self.test = ufl.TestFunction(self.W)
+        self.c = rod.Coefficients.from_normalised(
+            self.q, params.model, make=lambda v: dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(v)))
+        self.measures = (ufl.dx(domain=self.mesh), ufl.dS(domain=self.mesh), ufl.ds(domain=self.mesh))
+        top = self.q.top_position(0.0)
+        self.top_xz = np.array([top[0], top[2]])
+        bottom_v = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 0.0))
+        top_v = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 1.0))
+        self.r_bottom = dolfinx.fem.Function(self.W)
+        self.r_top = dolfinx.fem.Function(self.W)
+        self.r_top.interpolate(lambda x: np.outer(self.top_xz, np.ones(x.shape[1])))
+        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dolfinx.fem.locate_dofs_topological(
+                        self.W, 0, bottom_v)),
+                    dolfinx.fem.dirichletbc(self.r_top, dolfinx.fem.locate_dofs_topological(
+                        self.W, 0, top_v))]
+
+    def centre_line(self):
+        return embed(self.w)
+
+    def stationary_residual(self):
+        alpha = dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(0.0))
+        return rod.residual_of_fields(embed(self.w), alpha, None, None, None,
+                                      (embed(self.test), None), self.c, self.degree,
+                                      self.penalty, self.measures)
+
+    def set_chord(self, w=None):
+        (w or self.w).interpolate(lambda x: np.outer(self.top_xz, x[0]))
+
+    def set_centre_line(self, centre_line, w=None):
+        (w or self.w).interpolate(lambda x: np.asarray(centre_line(x[0]))[:, [0, 2]].T)
+
+    def centre_line_function(self):
+        return self.w
+
+    def dof_count(self) -> int:
+        im = self.W.dofmap.index_map
+        return im.size_global * self.W.dofmap.index_map_bs
