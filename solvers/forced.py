@@ -21,9 +21,10 @@ class FEBackend:
     scheme = "fe"
 
     #: fixed steps: with a moving end the initial velocity and acceleration of
-    #: the end dofs jump at every new f1, which the adaptive error estimate of
-    #: alpha2 cannot get below its tolerance however small the step
-    OPTIONS = {"ts_adapt_type": "none"}
+    #: the end dofs jump at every new f1, and alpha2's adaptive error estimate
+    #: cannot get below its tolerance however small the step; a Newton failure
+    #: still cuts the step (by 4), with no limit on their count over a sweep
+    OPTIONS = {"ts_adapt_type": "none", "ts_max_snes_failures": -1, "ts_snes_max_it": 25}
 
     def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None):
         self.params = params
