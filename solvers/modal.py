@@ -293,8 +293,19 @@ class ModalSolver:
         finite = self.finite_eigenvalue_count()
         nev = min(nev or self.default_nev(per_family), finite - 2)
         tau = self.default_target() if target is None else target
-        pep = create_pep(self.comm, [self.K, self.C, self.M], nev, tau, finite)
-        pep.solve()
+        for attempt in range(3):
+            pep = create_pep(self.comm, [self.K, self.C, self.M], nev, tau, finite)
+            try:
+                pep.solve()
+                break
+            except PETSc.Error as err:
+                # LAPACK's Schur reordering (trexc) can fail on nearly equal
+                # eigenvalues (the in- and out-of-plane lateral pairs); another
+                # target changes the projected problem
+                if attempt == 2:
+                    raise SolverError(f"{self.scene}: SLEPc PEP failed ({err}) for the targets "
+                                      f"tried; try -rawehelix_pep_target or other N") from None
+                tau *= 1.37
         reason = pep.getConvergedReason()
         nconv = pep.getConverged()
         nev_used = pep.getDimensions()[0]
