@@ -51,7 +51,8 @@ class FEBackend:
         self.unpack_into(state, q.top_velocity(t0))
         ts = solver.ts
         ts.setTime(t0)
-        ts.setTimeStep(min(self.dt, (t1 - t0) / max(len(t_out), 1)))
+        step = min(self.dt, (t1 - t0) / max(len(t_out), 1))
+        ts.setTimeStep(step)
         ts.restartStep()
         t_out = np.asarray(t_out)
         samples = []
@@ -59,6 +60,7 @@ class FEBackend:
         def record(s):
             if s.t > t0 + 1e-12 * max(1.0, t1):
                 samples.append((s.t, s.probes.values()["tension0"]))
+            s.ts.setTimeStep(step)  # back to the fixed step after a cut (failed Newton)
 
         every = (t1 - t0) / len(t_out) if len(t_out) > 1 else t1 - t0
         solver.advance(t1, on_output=record, output_every=every)
