@@ -47,13 +47,14 @@ class PointResult:
     period_maxima_N: list = field(default_factory=list)
     series_t_s: np.ndarray | None = None  # tension at s = 0 over the recorded periods
     series_tension_N: np.ndarray | None = None
+    slack: bool = False  # the tension at s = 0 fell to <= 0 in a judged period
 
     def entry(self) -> dict:
         """The summary.json entry."""
         return {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
                 "tension_min_N": self.tension_min_N, "tension_mean_N": self.tension_mean_N,
-                "periods": self.periods, "periodic": self.periodic, "wall_s": self.wall_s,
-                "start": self.start}
+                "periods": self.periods, "periodic": self.periodic, "slack": self.slack,
+                "wall_s": self.wall_s, "start": self.start}
 
 
 def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start: float,
@@ -72,7 +73,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
             state, _ = backend.advance(state, q, t, t + period, np.array([t + period]))
             t += period
     maxima, history = [], []
-    periodic = False
+    periodic = slack = False
     for k in range(1, sweep.max_periods + 1):
         t_out = t + period * np.arange(1, n + 1) / n
         state, tension = backend.advance(state, q, t, t + period, t_out)
@@ -81,6 +82,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
                                      f"t = {q.time_s(t):.3f} s")
         t += period
         maxima.append(float(np.max(tension)))
+        slack = slack or bool(np.min(tension) <= 0)
         history.append((t_out, tension))
         history = history[-sweep.record_periods:]
         # periodic: the per-period maximum changed by less than the tolerance
@@ -98,7 +100,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         f1_Hz=f1_Hz, tension_max_N=float(T_rec.max()), tension_min_N=float(T_rec.min()),
         tension_mean_N=float(T_rec.mean()), periods=len(maxima), periodic=periodic,
         wall_s=time.perf_counter() - start_wall,
-        start="stationary" if lead_in else "continuation",
+        start="stationary" if lead_in else "continuation", slack=slack,
         period_maxima_N=[float(v) for v in q.tension_N(np.array(maxima))],
         series_t_s=q.time_s(t_rec), series_tension_N=T_rec)
     return result, state, t

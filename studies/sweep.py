@@ -38,6 +38,7 @@ from mpi4py import MPI
 
 from rawehelix.forms.parameters import Parameters
 from rawehelix.solvers.periodic import periodic_response
+from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers
 
 RESULTS = "sweep.json"
@@ -118,12 +119,16 @@ def check_directory(outdir: Path, header: dict):
 def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict,
               backend=None, log=print) -> int:
     """Run one rank's contiguous chunk with continuation; return the points computed."""
-    backend = backend or make_backend(params, MPI.COMM_SELF)
+    def backend_factory():
+        return make_backend(params, MPI.COMM_SELF)
+
+    backend = backend or backend_factory()
     q = params.normalised()
     (outdir / "points").mkdir(parents=True, exist_ok=True)
     state, t, computed = None, 0.0, 0
     for i, f1 in enumerate(chunk):
-        if _finished(outdir, f1) is not None:
+        done = _finished(outdir, f1)
+        if done is not None:
             state = None  # the next unfinished point reloads its predecessor's state
             continue
         lead_in = True
@@ -137,8 +142,22 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
                 state, t = backend.stationary(), 0.0
         else:
             lead_in = False
-        result, state, t = periodic_response(backend, q, f1, state, t, params.sweep, lead_in)
         key = _key(f1)
+        try:
+            result, state, t = periodic_response(backend, q, f1, state, t, params.sweep, lead_in)
+        except (SolverError, FloatingPointError, RuntimeError) as err:
+            # the point is recorded as failed; the next one starts afresh
+            entry = {"f1_Hz": f1, "tension_max_N": None, "tension_min_N": None,
+                     "tension_mean_N": None, "periods": 0, "periodic": False, "slack": None,
+                     "failed": str(err), "wall_s": None, "start": "stationary" if lead_in
+                     else "continuation"}
+            writers.write_json(outdir / "points" / f"{key}.json", {"entry": entry})
+            with open(outdir / "computed.log", "a") as f:
+                f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()} failed\n")
+            merge_results(outdir, header)
+            log(f"  f1 = {f1:6.2f} Hz: FAILED: {err}")
+            backend, state, computed = backend_factory(), None, computed + 1
+            continue
         _write_npz(outdir / "points" / f"{key}.npz", {**backend.pack(state), "t": t})
         writers.write_json(outdir / "points" / f"{key}.json", {
             "entry": result.entry(), "period_maxima_N": result.period_maxima_N,
@@ -147,7 +166,8 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
             f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}\n")
         merge_results(outdir, header)
         computed += 1
-        flag = "" if result.periodic else "  NOT PERIODIC (hit max_periods)"
+        flag = ("" if result.periodic else "  NOT PERIODIC (hit max_periods)") + \
+            ("  SLACK (T <= 0)" if result.slack else "")
         log(f"  f1 = {f1:6.2f} Hz: T max {result.tension_max_N:8.2f} N, min "
             f"{result.tension_min_N:8.2f} N, {result.periods:3d} periods, "
             f"{result.wall_s:6.1f} s ({result.start}){flag}")
@@ -192,19 +212,23 @@ def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = 
         data = merge_results(outdir, header)
         wanted = {round(f, 5) for f in frequencies}
         points = [p for p in data["points"] if round(p["f1_Hz"], 5) in wanted]
-        peak = max(points, key=lambda p: p["tension_max_N"]) if points else None
+        good = [p for p in points if p.get("tension_max_N") is not None]
+        peak = max(good, key=lambda p: p["tension_max_N"]) if good else None
         summary = {**header, "points": points,
                    "resonance_Hz": peak["f1_Hz"] if peak else None,
                    "peak_tension_N": peak["tension_max_N"] if peak else None,
                    "not_periodic_Hz": [p["f1_Hz"] for p in points if not p["periodic"]],
+                   "slack_Hz": [p["f1_Hz"] for p in points if p.get("slack")],
+                   "failed_Hz": [p["f1_Hz"] for p in points if p.get("failed")],
                    "ranks": comm.size, "computed_now": computed,
                    "wall_s": time.perf_counter() - start}
         writers.write_json(outdir / "summary.json", summary)
         sweep_png(outdir, points, name)
         if series:
             write_series(outdir, points)
-        log(f"  resonance (largest T max) at f1 = {summary['resonance_Hz']} Hz, "
-            f"T max = {summary['peak_tension_N']:.1f} N; wrote {outdir}/summary.json, sweep.png")
+        if peak:
+            log(f"  resonance (largest T max) at f1 = {summary['resonance_Hz']} Hz, "
+                f"T max = {summary['peak_tension_N']:.1f} N; wrote {outdir}/summary.json, sweep.png")
     return comm.bcast(summary, root=0)
 
 
@@ -212,6 +236,8 @@ def write_series(outdir: Path, points: list[dict]):
     """Per-point time series of the tension at s = 0 (CSV) over the recorded periods."""
     for p in points:
         data = _finished(outdir, p["f1_Hz"])
+        if not data.get("series_t_s"):
+            continue
         path = outdir / "points" / f"{_key(p['f1_Hz'])}_tension.csv"
         np.savetxt(path, np.column_stack([data["series_t_s"], data["series_tension_N"]]),
                    delimiter=",", header="t_s,tension_s0_N", comments="")
@@ -219,6 +245,8 @@ def write_series(outdir: Path, points: list[dict]):
 
 def sweep_png(outdir: Path, points: list[dict], title: str, inset_Hz: float = 10.0):
     """Fig. 8: maximum tension at s = 0 against f1; the inset shows T(t) near 10 Hz."""
+    failed = [p["f1_Hz"] for p in points if p.get("tension_max_N") is None]
+    points = [p for p in points if p.get("tension_max_N") is not None]
     if not points:
         return
     plt = writers._pyplot()
@@ -232,6 +260,8 @@ def sweep_png(outdir: Path, points: list[dict], title: str, inset_Hz: float = 10
     ax.plot(f[ok], tmax[ok], "o", color="C0", label="T max (periodic)")
     if np.any(~ok):
         ax.plot(f[~ok], tmax[~ok], "x", color="C3", ms=9, label="T max (not periodic: cap hit)")
+    for k, f1 in enumerate(failed):
+        ax.axvline(f1, color="C3", ls="--", lw=1, label="failed (see summary)" if k == 0 else None)
     ax.set_xlabel("forcing frequency f1 [Hz]")
     ax.set_ylabel("tension at s = 0 [N]")
     ax.set_title(f"{title}: maximum tension against f1 (Fig. 8)")
