@@ -50,10 +50,10 @@ class SweepError(ValueError):
 
 def fingerprint(params: Parameters) -> str:
     """A hash of everything that changes the points: not f1 itself, the f1
-    list, nor the time section."""
+    list, the end time nor the output sampling (the time step does count)."""
     data = dataclasses.asdict(params)
     data["ends"].pop("circle_frequency_Hz")
-    data.pop("time")
+    data["time"] = {"dt_s": data["time"]["dt_s"]}
     for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
         data["sweep"].pop(key)
     return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
