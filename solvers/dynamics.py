@@ -124,6 +124,10 @@ class DynamicsSolver:
             initial(self)
         bcs = self.rod.bcs[:2]  # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free
         set_default_options(PREFIX, TS_DEFAULTS)
+        if self.q.r1 > 0 and self.q.omega1 > 0 and "ts_adapt_type" not in (options or {}):
+            # a moving end (Eq. 70) starts with the end's velocity and acceleration
+            # jumping, which alpha2's error estimate never accepts: fixed steps
+            options = {**(options or {}), "ts_adapt_type": "none"}
         set_default_options(PREFIX + "ts_", {**SNES_DEFAULTS, "snes_atol": self.residual_floor()})
         with _TemporaryOptions(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
