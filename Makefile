@@ -19,6 +19,7 @@ install:
 
 demo: install
 	$(RAWE) stationary studies/scenes/stationary_table2.toml -o results/stationary_table2/stationary
+	$(RAWE) modes studies/scenes/stationary_table2.toml -o results/stationary_table2/modes
 	$(RAWE) modes studies/scenes/stationary_table2.toml --scheme spline --elements 2 -o results/stationary_table2/modes_spline_N2
 
 test: install
