@@ -293,8 +293,9 @@ class ModalSolver:
         finite = self.finite_eigenvalue_count()
         nev = min(nev or self.default_nev(per_family), finite - 2)
         tau = self.default_target() if target is None else target
-        for attempt in range(3):
-            pep = create_pep(self.comm, [self.K, self.C, self.M], nev, tau, finite)
+        for attempt, factor in enumerate((1.0, 1.37, 0.61, 2.3, 0.37)):
+            pep = create_pep(self.comm, [self.K, self.C, self.M], nev, tau * factor, finite,
+                             ncv_extra=7 * attempt)
             try:
                 pep.solve()
                 break
@@ -302,10 +303,9 @@ class ModalSolver:
                 # LAPACK's Schur reordering (trexc) can fail on nearly equal
                 # eigenvalues (the in- and out-of-plane lateral pairs); another
                 # target changes the projected problem
-                if attempt == 2:
+                if attempt == 4:
                     raise SolverError(f"{self.scene}: SLEPc PEP failed ({err}) for the targets "
                                       f"tried; try -rawehelix_pep_target or other N") from None
-                tau *= 1.37
         reason = pep.getConvergedReason()
         nconv = pep.getConverged()
         nev_used = pep.getDimensions()[0]
@@ -477,7 +477,8 @@ class ModalSolver:
         return s, u / scale, a / scale
 
 
-def create_pep(comm, operators, nev: int, target: float, finite: int, prefix: str = "rawehelix_"):
+def create_pep(comm, operators, nev: int, target: float, finite: int, prefix: str = "rawehelix_",
+               ncv_extra: int = 0):
     """A TOAR PEP with shift-and-invert about a real target; options from ``prefix``."""
     from slepc4py import SLEPc
     set_default_options(prefix, PEP_DEFAULTS)
@@ -485,7 +486,7 @@ def create_pep(comm, operators, nev: int, target: float, finite: int, prefix: st
     pep.setOptionsPrefix(prefix)
     pep.setOperators(operators)
     pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
-    ncv = min(max(2 * nev, nev + 30), finite)
+    ncv = min(max(2 * nev, nev + 30) + ncv_extra, finite)
     pep.setDimensions(nev=nev, ncv=ncv)
     pep.setTarget(target)
     pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
