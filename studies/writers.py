@@ -38,6 +38,16 @@ def write_json(path: Path, data: dict) -> Path:
     return path
 
 
+def _finish(fig, path: Path, title: str, dpi: int = 110) -> Path:
+    """Title, layout, write the PNG and free the figure."""
+    import matplotlib.pyplot as plt
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
 def _pyplot():
     import matplotlib
     matplotlib.use("Agg")
@@ -86,11 +96,7 @@ def centre_line_png(path: Path, s_m, x_m, tension_s_m, tension_N, title: str,
     ax2.set_ylabel("tension T [N]")
     ax2.set_title("tension, Eq. (22)")
     ax2.grid(True, alpha=0.3)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _finish(fig, path, title, dpi=110)
 
 
 def centre_line_xdmf(path: Path, x_m, point_data: dict) -> Path:
@@ -125,11 +131,7 @@ def mode_shapes_png(path: Path, s_m, shapes: dict, title: str) -> Path:
     for ax in axes.ravel()[len(shapes):]:
         ax.axis("off")
     axes.ravel()[0].legend(loc="best", fontsize=8)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _finish(fig, path, title, dpi=120)
 
 
 def dynamics_png(path: Path, rows: np.ndarray, target_rpm: float, title: str) -> Path:
@@ -152,8 +154,4 @@ def dynamics_png(path: Path, rows: np.ndarray, target_rpm: float, title: str) ->
     ax[2].legend(loc="best")
     for a in ax:
         a.grid(True, alpha=0.3)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _finish(fig, path, title, dpi=110)
