@@ -216,6 +216,9 @@ class DynamicsSolver:
             if self._pending and t + dt > self._pending[0] - 1e-3 * dt:
                 self._dt_wanted = dt
                 dt = self._pending[0] - t
+            if t + dt > t_end:  # a step past the max time: PETSc 3.22 fails ("bad hmax")
+                self._dt_wanted = self._dt_wanted or dt
+                dt = t_end - t
             ts_.setTimeStep(dt)
 
         def monitor(ts_, step, t, X):
