@@ -44,15 +44,20 @@ def create_mesh_1d(comm, cells: np.ndarray, x: np.ndarray):
                                     ghost_mode=dolfinx.mesh.GhostMode.shared_facet)
 
 
-def rod_element(cell, degree: int):
-    """The mixed (r, alpha) element: vector P_p with 3 components and scalar P_p."""
+def _mixed(cell, degree: int, copies: int):
+    """``copies`` x (vector P_p with 3 components, scalar P_p) as one mixed element."""
     if NEW:
         vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
         sca = basix.ufl.element("Lagrange", "interval", degree)
-        return basix.ufl.mixed_element([vec, sca])
+        return basix.ufl.mixed_element([vec, sca] * copies)
     vec = ufl.VectorElement("Lagrange", cell, degree, dim=3)
     sca = ufl.FiniteElement("Lagrange", cell, degree)
-    return ufl.MixedElement([vec, sca])
+    return ufl.MixedElement([vec, sca] * copies)
+
+
+def rod_element(cell, degree: int):
+    """The mixed (r, alpha) element: vector P_p with 3 components and scalar P_p."""
+    return _mixed(cell, degree, 1)
 
 
 def function_space(mesh, element):
@@ -110,9 +115,6 @@ def cell_count(mesh) -> int:
     return mesh.topology.index_map(mesh.topology.dim).size_local
 
 
-def xdmf_file(comm, path, mode: str = "w"):
-    return dolfinx.io.XDMFFile(comm, str(path), mode)
-
 
 def apply_lifting_and_bc(b, J_form, bcs, x, scale: float = -1.0):
     """b <- b - scale*A(x - g) lifting, ghost accumulation, then the bc rows of a
@@ -130,25 +132,11 @@ def collapse(V_sub):
     return out if isinstance(out, tuple) else (out, None)
 
 
-def meshtags(mesh, dim, indices, values):
-    return dolfinx.mesh.meshtags(mesh, dim, indices, values)
-
 
 def rod_pair_element(cell, degree: int):
     """The first-order (r, alpha, r_t, alpha_t) element: two copies of :func:`rod_element`'s
     fields, flattened into one mixed element of four sub-elements."""
-    if NEW:
-        vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
-        sca = basix.ufl.element("Lagrange", "interval", degree)
-        return basix.ufl.mixed_element([vec, sca, vec, sca])
-    vec = ufl.VectorElement("Lagrange", cell, degree, dim=3)
-    sca = ufl.FiniteElement("Lagrange", cell, degree)
-    return ufl.MixedElement([vec, sca, vec, sca])
-
-
-def set_bc_rows(b, bcs, x, scale: float = -1.0):
-    """Only the Dirichlet rows of a Newton residual: b_bc = scale*(g - x)."""
-    dolfinx.fem.petsc.set_bc(b, bcs, x, scale)
+    return _mixed(cell, degree, 2)
 
 
 def vertex_tags(mesh, vertices, value: int = 1):

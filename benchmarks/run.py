@@ -71,11 +71,9 @@ def bench_sweep(f1):
 def newton_iteration_cost(N: int, repeats: int) -> float:
     """One Newton iteration of a time step (residual, Jacobian, MUMPS LU solve) at
     the chord state; this is the cost of a step (~1.06 iterations per step)."""
-    import dolfinx.fem.petsc
     from petsc4py import PETSc
     from mpi4py import MPI
     from rawehelix import compat
-    from rawehelix.solvers.dynamics import DynamicsSolver  # noqa: F401 (same forms)
     from rawehelix.solvers.discrete import RodDiscretisation
     from rawehelix.solvers.ts_forms import SecondOrder
     from rawehelix.studies import scene
@@ -129,7 +127,6 @@ def bench_mpi_speedup(f1):
 
 
 def bench_modal(repeats: int):
-    from petsc4py import PETSc
     from mpi4py import MPI
     from rawehelix.solvers.modal import ModalSolver
     from rawehelix.studies import scene

@@ -52,6 +52,7 @@ class RodDiscretisation:
         self.set_top_position(self.q.top_position(0.0))
         dofs_b = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, bottom)
         dofs_t = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, top)
+        self.end_dofs = {"bottom": dofs_b, "top": dofs_t}  # centre-line dofs (W, V_r)
         self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_b, self.W.sub(0)),
                     dolfinx.fem.dirichletbc(self.r_top, dofs_t, self.W.sub(0))]
         if pin_twist:

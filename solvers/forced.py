@@ -32,9 +32,7 @@ class FEBackend:
         self.dt = params.time.dt_s / params.normalised().t_scale
         rod = self.solver.rod
         self.v_top = dolfinx.fem.Function(rod.V_r)
-        top = compat.locate_boundary_vertices(rod.mesh, lambda x: np.isclose(x[0], 1.0))
-        dofs = dolfinx.fem.locate_dofs_topological((rod.W.sub(0), rod.V_r), 0, top)
-        self.bc_v = dolfinx.fem.dirichletbc(self.v_top, dofs, rod.W.sub(0))
+        self.bc_v = dolfinx.fem.dirichletbc(self.v_top, rod.end_dofs["top"], rod.W.sub(0))
         self._stationary = self.pack(None)
 
     def _vectors(self):

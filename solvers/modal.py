@@ -187,10 +187,8 @@ class ModalSolver:
         (35)-(36); none on the twist (the rigid rotation stays free)."""
         rod = self.rod
         zero = dolfinx.fem.Function(rod.V_r)
-        ends = compat.locate_boundary_vertices(
-            rod.mesh, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0))
-        dofs = dolfinx.fem.locate_dofs_topological((rod.W.sub(0), rod.V_r), 0, ends)
-        return [dolfinx.fem.dirichletbc(zero, dofs, rod.W.sub(0))]
+        return [dolfinx.fem.dirichletbc(zero, dofs, rod.W.sub(0))
+                for dofs in rod.end_dofs.values()]
 
     def _energy_forms(self):
         """Kinetic-energy matrices of the families and of the components.

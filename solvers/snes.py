@@ -14,7 +14,7 @@ SNES_DEFAULTS = {
     # Full Newton steps: near convergence the residual of the fourth-order
     # bending term reaches a round-off floor that grows like N^3 (its Jacobian
     # entries grow like mu p^4 / h^3), where a backtracking line search gives
-    # up.  Convergence is then declared on the step: |dx| < stol |x|.
+    # up.  FloorConvergence then declares convergence on the step.
     "snes_linesearch_type": "basic",
     "snes_rtol": 1.0e-10,
     "snes_atol": 1.0e-12,

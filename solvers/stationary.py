@@ -11,11 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import ufl
-import dolfinx.fem
 from mpi4py import MPI
 
 from rawehelix import compat
-from rawehelix.forms import kinematics, rod
 from rawehelix.forms.parameters import Parameters
 from rawehelix.solvers import fields
 from rawehelix.forms.kinematics import tension

@@ -9,7 +9,6 @@ import ufl
 import dolfinx.fem
 import dolfinx.fem.petsc
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from rawehelix import compat
 from rawehelix.solvers import shooting
