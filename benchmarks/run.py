@@ -69,12 +69,13 @@ def bench_sweep(f1):
 
 
 def newton_iteration_cost(N: int, repeats: int) -> float:
-    """One Newton iteration of a time step (residual, Jacobian, MUMPS LU solve) at
-    the chord state; this is the cost of a step (~1.06 iterations per step)."""
+    """One Newton iteration of a time step (residual, Jacobian, LU solve with the
+    solvers' own choice, ``lu_options``) at the chord state; a step costs ~1-2 of these."""
     from petsc4py import PETSc
     from mpi4py import MPI
     from rawehelix import compat
     from rawehelix.solvers.discrete import RodDiscretisation
+    from rawehelix.solvers.snes import lu_options
     from rawehelix.solvers.ts_forms import SecondOrder
     from rawehelix.studies import scene
     params = scene.load("nominal_operation", elements=N, degree=3)
@@ -86,7 +87,10 @@ def newton_iteration_cost(N: int, repeats: int) -> float:
     ksp = PETSc.KSP().create(MPI.COMM_SELF)
     ksp.setType("preonly")
     ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
+    lu = lu_options(MPI.COMM_SELF)
+    ksp.getPC().setFactorSolverType(lu["pc_factor_mat_solver_type"])
+    if "pc_factor_mat_ordering_type" in lu:
+        ksp.getPC().setFactorOrdering(lu["pc_factor_mat_ordering_type"])
     y = x.duplicate()
     times = []
     for _ in range(repeats):

@@ -140,7 +140,9 @@ class Model:
     gravity: bool = True
     drag: bool = True
     bending: bool = True
-    twist: bool = True  # twist dynamics, Eq. (31)
+    # the twist field alpha and its equation (31); false (a torque-free scene,
+    # FE scheme) holds alpha = 0: no torsional modes, no twist coupling
+    twist: bool = True
     # Frenet torsion gamma, Eq. (34): "off" (the paper's own code) or
     # "regularised" (see forms.kinematics.frenet_torsion).  "off" is the default:
     # at the planar stationary states the regularised coupling shifts the
@@ -152,6 +154,20 @@ class Model:
     # rod for a planar, torque-free stationary state); "off": always the full one
     reduction: str = "auto"
     gamma_eps: float = 1.0e-3  # regularisation of |r''|^2 in gamma (normalised curvature)
+
+    def describe(self, planar: bool = False) -> str:
+        """The model that runs, for summary.json: reduction and the terms switched on."""
+        if planar:
+            head = ("planar (x, z): the ends lie in the x-z plane and carry no torque, so the "
+                    "stationary state is planar with alpha = 0 (Sec. 5.1)")
+        elif not self.twist:
+            head = "centre line only (model.twist = false: alpha = 0, no torsional modes)"
+        else:
+            head = "full (r, alpha)"
+        terms = [name for name in ("gravity", "drag", "bending") if getattr(self, name)]
+        if self.gamma != "off" and self.twist and not planar:
+            terms.append(f"gamma ({self.gamma})")
+        return f"{head}; terms: {', '.join(terms) or 'tension only'}"
 
     def __post_init__(self):
         if self.gamma not in GAMMA_TREATMENTS:
@@ -252,6 +268,16 @@ class Parameters:
     discretisation: Discretisation = field(default_factory=Discretisation)
     time: Time = field(default_factory=Time)
     sweep: Sweep = field(default_factory=Sweep)
+
+    def __post_init__(self):
+        if not self.model.twist:
+            # model.twist = false removes the twist field: alpha = 0 everywhere
+            if self.torque.top_Nm != 0 or self.controller.active:
+                raise ParameterError("model.twist", False,
+                                     "needs a torque-free scene (torque.top_Nm = 0, controller off): "
+                                     "torque is carried by the twist, Eq. (31)")
+            if self.discretisation.scheme != "fe":
+                raise ParameterError("model.twist", False, "is implemented by the FE scheme only")
 
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:

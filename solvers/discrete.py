@@ -14,6 +14,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
 from rawehelix.forms.parameters import Parameters
 from rawehelix.meshes import interval
@@ -55,16 +56,28 @@ class RodDiscretisation:
         self.end_dofs = {"bottom": dofs_b, "top": dofs_t}  # centre-line dofs (W, V_r)
         self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_b, self.W.sub(0)),
                     dolfinx.fem.dirichletbc(self.r_top, dofs_t, self.W.sub(0))]
+        self.V_a, _ = compat.collapse(self.W.sub(1))
+        self.alpha_zero = dolfinx.fem.Function(self.V_a)
+        # model.twist = false: no twist field, alpha = 0 on every dof (the scene
+        # is torque-free, which Parameters checks); the solvers add these bcs
+        self.twist_bcs = [] if self.params.model.twist else [dolfinx.fem.dirichletbc(
+            self.alpha_zero, self.all_dofs(self.W.sub(1), self.V_a), self.W.sub(1))]
         if pin_twist:
             # alpha(0) = 0 removes the free rigid rotation (torque-free ends)
-            self.V_a, _ = compat.collapse(self.W.sub(1))
-            self.alpha_bottom = dolfinx.fem.Function(self.V_a)
             dofs_a = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, bottom)
-            self.bcs.append(dolfinx.fem.dirichletbc(self.alpha_bottom, dofs_a, self.W.sub(1)))
+            self.bcs.append(dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, self.W.sub(1)))
+        self.bcs += self.twist_bcs
+
+    def all_dofs(self, W_sub, V_collapsed):
+        """Every dof of a sub-space (for a field held at zero)."""
+        tdim = self.mesh.topology.dim
+        cells = self.mesh.topology.index_map(tdim)
+        every = np.arange(cells.size_local + cells.num_ghosts, dtype=np.int32)
+        return dolfinx.fem.locate_dofs_topological((W_sub, V_collapsed), tdim, every)
 
     def set_top_position(self, position):
         position = np.asarray(position, dtype=float)
-        self.r_top.interpolate(lambda x: np.outer(position, np.ones(x.shape[1])))
+        set_constant(self.r_top, position)
 
     # -- states ------------------------------------------------------------------
     def set_chord(self, w=None):

@@ -34,7 +34,8 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.forms.parameters import Parameters
 from rawehelix.solvers.probes import Probes
-from rawehelix.solvers.snes import FloorConvergence, SolverError, reason_name, set_default_options
+from rawehelix.solvers.snes import (FloorConvergence, SolverError, default_options, lu_options,
+                                   reason_name, temporary_options)
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
 
@@ -58,8 +59,7 @@ SNES_DEFAULTS = {  # under the prefix rawehelix_ts_
     # snes_atol: see residual_floor()
     "snes_max_it": 12,
     "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
+    "pc_type": "lu",  # with lu_options(comm)
 }
 
 
@@ -70,29 +70,6 @@ class NonFiniteState(ArithmeticError):
 def ts_reason_name(reason: int) -> str:
     names = {v: k for k, v in vars(PETSc.TS.ConvergedReason).items() if isinstance(v, int)}
     return f"{names.get(reason, '?')} ({reason})"
-
-
-class _TemporaryOptions:
-    """Set PETSc options for one set-up, remove them afterwards (tests, sweeps)."""
-
-    def __init__(self, prefix: str, options: dict | None):
-        self.prefix, self.options = prefix, options or {}
-
-    def __enter__(self):
-        opts = PETSc.Options()
-        self.added = []
-        for key, value in self.options.items():
-            name = self.prefix + key
-            self.added.append((name, opts.getString(name) if opts.hasName(name) else None))
-            opts[name] = value
-        return self
-
-    def __exit__(self, *exc):
-        opts = PETSc.Options()
-        for name, old in self.added:
-            opts.delValue(name)
-            if old is not None:
-                opts[name] = old
 
 
 class DynamicsSolver:
@@ -122,14 +99,16 @@ class DynamicsSolver:
         self.rod.c.m0.value = 0.0
         if initial is not None:
             initial(self)
-        bcs = self.rod.bcs[:2]  # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free
-        set_default_options(PREFIX, TS_DEFAULTS)
-        if self.q.r1 > 0 and self.q.omega1 > 0 and "ts_adapt_type" not in (options or {}):
+        # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free (unless model.twist = false)
+        bcs = self.rod.bcs[:2] + self.rod.twist_bcs
+        ts_defaults = dict(TS_DEFAULTS)
+        if self.q.r1 > 0 and self.q.omega1 > 0:
             # a moving end (Eq. 70) starts with the end's velocity and acceleration
             # jumping, which alpha2's error estimate never accepts: fixed steps
-            options = {**(options or {}), "ts_adapt_type": "none"}
-        set_default_options(PREFIX + "ts_", {**SNES_DEFAULTS, "snes_atol": self.residual_floor()})
-        with _TemporaryOptions(PREFIX, options):
+            ts_defaults["ts_adapt_type"] = "none"
+        snes_defaults = {**SNES_DEFAULTS, **lu_options(comm), "snes_atol": self.residual_floor()}
+        with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
+                temporary_options(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
             self.form = SecondOrder(self.rod, bcs) if ts_type == "alpha2" else FirstOrder(self.rod, bcs)
             self.ts = self._create_ts(ts_type)
@@ -216,7 +195,9 @@ class DynamicsSolver:
             if self._pending and t + dt > self._pending[0] - 1e-3 * dt:
                 self._dt_wanted = dt
                 dt = self._pending[0] - t
-            if t + dt > t_end:  # a step past the max time: PETSc 3.22 fails ("bad hmax")
+            # no step past the max time (PETSc 3.22 fails: "bad hmax"), and no
+            # sliver of a step left before it (round-off after many equal steps)
+            if t + dt > t_end - 1e-3 * dt:
                 self._dt_wanted = self._dt_wanted or dt
                 dt = t_end - t
             ts_.setTimeStep(dt)

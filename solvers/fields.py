@@ -1,4 +1,4 @@
-"""Gather finite element fields to rank 0 as arrays over the arc length."""
+"""Finite element fields as arrays: gathered to rank 0 over the arc length, or set to a constant."""
 
 from __future__ import annotations
 
@@ -35,3 +35,13 @@ def interpolate_expression(ufl_expr, V) -> "dolfinx.fem.Function":
     u = dolfinx.fem.Function(V)
     u.interpolate(compat.expression(ufl_expr, V))
     return u
+
+
+def set_constant(u, value):
+    """u <- the constant vector ``value`` on a collapsed Lagrange vector space.
+
+    Lagrange dofs are nodal values, so this is exact; it costs microseconds,
+    where ``u.interpolate(lambda x: ...)`` costs ~0.2 ms on DOLFINx 0.5 (the
+    time-dependent end condition is set at every residual evaluation)."""
+    bs = u.function_space.dofmap.index_map_bs
+    u.x.array.reshape(-1, bs)[:] = np.asarray(value, dtype=u.x.array.dtype)

@@ -33,8 +33,8 @@ transformation:
 * TOAR works on the general (non-symmetric: drag, and the gamma coupling of
   Eq. 34 which has no potential) quadratic problem without forming the
   2n x 2n pencil; memory is n x (ncv + 2) instead of 2n x ncv;
-* shift-and-invert factorises P(tau) = tau^2 M + tau C + K once (MUMPS, in
-  parallel) and makes the eigenvalues nearest the target converge first;
+* shift-and-invert factorises P(tau) = tau^2 M + tau C + K once (PETSc's LU
+  in serial, MUMPS in parallel) and makes the eigenvalues nearest the target converge first;
 * PETSc here is real, so the target tau is real.  The eigenvalues sit near
   the imaginary axis, |lambda - tau|^2 ~ tau^2 + omega^2, so a real target
   orders them by |lambda|: the slowest modes come first.  tau is put on the
@@ -91,7 +91,7 @@ from rawehelix.forms import rod as rod_forms
 from rawehelix.forms.kinematics import d
 from rawehelix.forms.parameters import Parameters
 from rawehelix.solvers import fields
-from rawehelix.solvers.snes import SolverError, set_default_options
+from rawehelix.solvers.snes import SolverError, default_options, lu_options
 from rawehelix.solvers.stationary import StationarySolver
 
 FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional", "rigid")
@@ -103,8 +103,7 @@ PEP_DEFAULTS = {
     "pep_max_it": 500,
     "st_type": "sinvert",
     "st_ksp_type": "preonly",
-    "st_pc_type": "lu",
-    "st_pc_factor_mat_solver_type": "mumps",
+    "st_pc_type": "lu",  # with lu_options(comm)
 }
 
 
@@ -120,7 +119,7 @@ class Mode:
     vectors: tuple = field(repr=False, default=None)  # (Re x, Im x) PETSc vectors
 
 
-def analytic_frequencies(q, tension: float, count: int) -> dict:
+def analytic_frequencies(q, tension: float, count: int, twist: bool = True) -> dict:
     """omega_n, n = 1..count, of the classical models (normalised, Eq. 25).
 
     Used only to place the target and size the Krylov space; the tests check
@@ -136,14 +135,14 @@ def analytic_frequencies(q, tension: float, count: int) -> dict:
         "longitudinal": n * math.sqrt(q.sigma),
         "lateral_in_plane": lateral,
         "lateral_out_of_plane": lateral,
-        "torsional": n * math.sqrt(q.delta),
+        **({"torsional": n * math.sqrt(q.delta)} if twist else {}),  # model.twist = false: none
     }
 
 
-def _count_below(q, tension: float, omega: float) -> int:
+def _count_below(q, tension: float, omega: float, twist: bool = True) -> int:
     """How many analytic modes (all families) have omega_n <= omega."""
     total = 0
-    for rate in (math.sqrt(q.sigma), math.sqrt(q.delta)):  # bar, shaft
+    for rate in (math.sqrt(q.sigma), math.sqrt(q.delta))[:2 if twist else 1]:  # bar, shaft
         total += int(omega / (math.pi * rate))
     # lateral, twice (in and out of plane): solve mu k^4 + T k^2 = omega^2 for k = n pi
     mu = max(q.bending * q.mu, 1e-300)
@@ -188,7 +187,7 @@ class ModalSolver:
         rod = self.rod
         zero = dolfinx.fem.Function(rod.V_r)
         return [dolfinx.fem.dirichletbc(zero, dofs, rod.W.sub(0))
-                for dofs in rod.end_dofs.values()]
+                for dofs in rod.end_dofs.values()] + rod.twist_bcs
 
     def _energy_forms(self):
         """Kinetic-energy matrices of the families and of the components.
@@ -259,13 +258,22 @@ class ModalSolver:
         """Eigenvalues (both of each pair) to hold the lowest ``per_family``
         modes of every family, from :func:`analytic_frequencies`."""
         T = max(self.mean_tension_value, 0.0)
-        est = analytic_frequencies(self.q, T, per_family)
+        est = analytic_frequencies(self.q, T, per_family, self.twist)
         omega = margin * max(v[-1] for v in est.values())
-        return 2 * _count_below(self.q, T, omega) + 2 + 4
+        return 2 * _count_below(self.q, T, omega, self.twist) + 2 + 4
+
+    @property
+    def twist(self) -> bool:
+        return self.params.model.twist
+
+    @property
+    def families(self) -> tuple:
+        """The families this model has: no torsional ones without the twist field."""
+        return tuple(f for f in FAMILIES[:-1] if self.twist or f != "torsional")
 
     def default_target(self) -> float:
         T = max(self.mean_tension_value, 0.0)
-        est = analytic_frequencies(self.q, T, 1)
+        est = analytic_frequencies(self.q, T, 1, self.twist)
         return 0.25 * min(v[0] for v in est.values())
 
     def finite_eigenvalue_count(self) -> int:
@@ -316,7 +324,7 @@ class ModalSolver:
         tau = pep.getTarget()
         modes = self._collect(pep, nconv, keep_vectors, zero_tol * abs(tau) * 4)
         pep.destroy()
-        found = {f: sum(m.family == f for m in modes) for f in FAMILIES[:-1]}
+        found = {f: sum(m.family == f for m in modes) for f in self.families}
         self.missing = {f: k for f, k in found.items() if k < per_family} if check_families else {}
         if self.missing and require_families:
             raise SolverError(
@@ -479,7 +487,6 @@ def create_pep(comm, operators, nev: int, target: float, finite: int, prefix: st
                ncv_extra: int = 0):
     """A TOAR PEP with shift-and-invert about a real target; options from ``prefix``."""
     from slepc4py import SLEPc
-    set_default_options(prefix, PEP_DEFAULTS)
     pep = SLEPc.PEP().create(comm)
     pep.setOptionsPrefix(prefix)
     pep.setOperators(operators)
@@ -488,6 +495,9 @@ def create_pep(comm, operators, nev: int, target: float, finite: int, prefix: st
     pep.setDimensions(nev=nev, ncv=ncv)
     pep.setTarget(target)
     pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-    pep.setFromOptions()  # -rawehelix_pep_*, -rawehelix_st_*
-    pep.getST().getKSP().setFromOptions()
+    lu = {"st_" + k: v for k, v in lu_options(comm).items()}
+    with default_options(prefix, {**PEP_DEFAULTS, **lu}):
+        pep.setFromOptions()  # -rawehelix_pep_*, -rawehelix_st_*
+        pep.getST().getKSP().setFromOptions()
+        pep.getST().getKSP().getPC().setFromOptions()
     return pep

@@ -18,6 +18,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
 from rawehelix.forms.parameters import Parameters
 from rawehelix.meshes import interval
@@ -56,7 +57,7 @@ class PlanarRod:
         top_v = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 1.0))
         self.r_bottom = dolfinx.fem.Function(self.W)
         self.r_top = dolfinx.fem.Function(self.W)
-        self.r_top.interpolate(lambda x: np.outer(self.top_xz, np.ones(x.shape[1])))
+        set_constant(self.r_top, self.top_xz)
         self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dolfinx.fem.locate_dofs_topological(
                         self.W, 0, bottom_v)),
                     dolfinx.fem.dirichletbc(self.r_top, dolfinx.fem.locate_dofs_topological(

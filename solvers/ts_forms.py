@@ -32,6 +32,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import energy, rod
 from rawehelix.solvers.discrete import RodDiscretisation
 
@@ -212,11 +213,14 @@ class FirstOrder(_Formulation):
             for end, g in values.items():
                 dofs = dolfinx.fem.locate_dofs_topological((W2.sub(sub), self.V_r), 0, ends[end])
                 bcs.append(dolfinx.fem.dirichletbc(g, dofs, W2.sub(sub)))
+        if not rod_.params.model.twist:  # alpha = alpha_t = 0 everywhere
+            bcs += [dolfinx.fem.dirichletbc(rod_.alpha_zero, rod_.all_dofs(W2.sub(sub), rod_.V_a),
+                                            W2.sub(sub)) for sub in (1, 3)]
         return bcs
 
     def _set_top_functions(self, t, q):
         for f, value in ((self.r_top, q.top_position(t)), (self.r_top_t, q.top_velocity(t))):
-            f.interpolate(lambda x, v=np.asarray(value): np.outer(v, np.ones(x.shape[1])))
+            set_constant(f, value)
 
     def _set_top(self, t):
         self._set_top_functions(t, self.rod.q)

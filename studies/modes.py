@@ -125,6 +125,7 @@ def fe_modes(params: Parameters, outdir: pathlib.Path | None, count: int | None 
             "dofs": solver.rod.dof_count(),
             "ranks": comm.size,
             "gamma": params.model.gamma,
+            "model": params.model.describe(),
             "mean_tension_N": float(q.tension_N(solver.mean_tension_value)),
             "missing_families": missing,
             "wall_s": wall,

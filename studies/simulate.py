@@ -129,7 +129,8 @@ def run(params: Parameters, outdir: Path | None, name: str = "scene", title: str
 
     summary = {"scene": name, "elements": disc.elements, "degree": disc.degree,
                "dofs": solver.rod.dof_count(), "ranks": comm.size,
-               "ts_type": solver.ts.getType(), "target_rpm": params.controller.target_rpm}
+               "ts_type": solver.ts.getType(), "target_rpm": params.controller.target_rpm,
+               "model": params.model.describe()}
 
     def write_summary(complete: bool, error: str | None = None):
         if comm.rank != 0:

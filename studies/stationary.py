@@ -39,9 +39,7 @@ def run(params: Parameters, outdir: Path | None, name: str = "scene", title: str
             "degree": disc.degree,
             "mesh": disc.mesh,
             "dofs": solver.rod.dof_count(),
-            "model": ("planar (x, z): the ends lie in the x-z plane and carry no torque, so "
-                      "the stationary state is planar with alpha = 0 (Sec. 5.1)") if planar
-                     else "full (r, alpha)",
+            "model": params.model.describe(planar),
             "ranks": comm.size,
             "newton_iterations": result.newton_iterations,
             "tension_N": {"s0": float(T[0]), "s1": float(T[-1]),

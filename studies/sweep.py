@@ -6,7 +6,7 @@ s = 0 over the last periods are recorded.  Each f1 continues from the final
 state of the previous one, as in the paper.
 
 Under ``mpirun -n k`` the sorted frequency list is cut into k contiguous
-chunks; each rank runs its chunk on its own communicator (COMM_SELF), with
+chunks of about equal estimated cost (:func:`chunks`); each rank runs its chunk on its own communicator (COMM_SELF), with
 continuation inside the chunk; the first point of a chunk starts from the
 stationary state with a lead-in (``sweep.lead_in_s``).  Rank 0 gathers.
 
@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix.forms.parameters import Parameters
+from rawehelix.forms.parameters import Parameters, Sweep
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers
@@ -174,9 +174,46 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
     return computed
 
 
-def chunks(frequencies: list[float], k: int) -> list[list[float]]:
-    """k contiguous chunks of the sorted list, sizes differing by at most one."""
-    return [list(c) for c in np.array_split(np.array(sorted(frequencies)), k)]
+#: estimated simulated time for one point to become periodic after
+#: continuation, beyond its minimum periods [s]; measured on Sec. 5.3 (N = 8):
+#: 1-6 s, longest past the resonance where the response jumps branch
+SETTLE_S = 3.0
+
+
+def point_cost(f1: float, sweep: Sweep) -> float:
+    """Estimated simulated time of one point [s]: the cost model of :func:`chunks`."""
+    return sweep.min_periods / f1 + SETTLE_S
+
+
+def chunks(frequencies: list[float], k: int, sweep: Sweep | None = None) -> list[list[float]]:
+    """k contiguous chunks of the sorted list.
+
+    Without ``sweep``: sizes differing by at most one.  With it: the largest
+    estimated simulated time of a chunk is as small as it can be, counting
+    ``point_cost`` per point and ``sweep.lead_in_s`` once per chunk (a low f1
+    has long periods, so the low chunk gets fewer points).  Time steps have a
+    fixed length, so the wall time of a chunk follows its simulated time."""
+    f = sorted(frequencies)
+    if sweep is None or k <= 1 or len(f) <= k:
+        return [list(c) for c in np.array_split(np.array(f), k)]
+    w = np.array([point_cost(x, sweep) for x in f])
+    prefix = np.concatenate([[0.0], np.cumsum(w)])
+    n = len(f)
+    # best[j][i]: the smallest largest cost of the first i points in j chunks
+    best = np.full((k + 1, n + 1), np.inf)
+    cut = np.zeros((k + 1, n + 1), dtype=int)
+    best[0][0] = 0.0
+    for j in range(1, k + 1):
+        for i in range(j, n + 1):
+            for m in range(j - 1, i):
+                cost = max(best[j - 1][m], sweep.lead_in_s + prefix[i] - prefix[m])
+                if cost < best[j][i]:
+                    best[j][i], cut[j][i] = cost, m
+    bounds, i = [], n
+    for j in range(k, 0, -1):
+        bounds.append((cut[j][i], i))
+        i = cut[j][i]
+    return [f[a:b] for a, b in reversed(bounds)]
 
 
 def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = "scene",
@@ -200,7 +237,7 @@ def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = 
         outdir.mkdir(parents=True, exist_ok=True)
         merge_results(outdir, header)
     comm.Barrier()
-    mine = chunks(frequencies, comm.size)[comm.rank]
+    mine = chunks(frequencies, comm.size, params.sweep)[comm.rank]
     rank_log = log if comm.size == 1 else (lambda m: print(f"[rank {comm.rank}]{m}", flush=True))
     if mine:
         rank_log(f"  chunk {mine[0]:.2f}-{mine[-1]:.2f} Hz ({len(mine)} points)")
@@ -221,6 +258,7 @@ def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = 
                    "slack_Hz": [p["f1_Hz"] for p in points if p.get("slack")],
                    "failed_Hz": [p["f1_Hz"] for p in points if p.get("failed")],
                    "ranks": comm.size, "computed_now": computed,
+                   "model": params.model.describe(),
                    "wall_s": time.perf_counter() - start}
         writers.write_json(outdir / "summary.json", summary)
         sweep_png(outdir, points, name)

@@ -51,7 +51,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from rawehelix.forms.parameters import (Discretisation, Ends, Environment, Helix, Model,
+from rawehelix.forms.parameters import (Discretisation, Ends, Environment, Helix, Model, ParameterError,
                                         Parameters)
 from rawehelix.solvers import shooting
 from rawehelix.solvers.modal import ModalSolver, create_pep
@@ -218,6 +218,31 @@ def test_gamma_coupling():
     assert max(abs(x) for x in shift) < 5e-3
     assert max(abs(x) for x in shift) > 1e-4  # the coupling is visible...
     assert max(abs(l.real) for l in tors_off) < 1e-6  # ... and absent without gamma
+
+
+def test_without_twist_field():
+    """model.twist = false (a torque-free scene) holds alpha = 0: no torsional
+    modes and no rigid rotation.  With gamma off the twist drives the centre
+    line (the moment beta alpha' (r' x r'') of Eq. 32) but not the reverse at a
+    twist-free stationary state, so the block-triangular spectrum keeps the
+    centre-line eigenvalues of the full model: equal to 1e-8 here (N = 8)."""
+    _, full = spectrum("table2")
+    solver = ModalSolver(table2().replace(model={"twist": False}), MPI.COMM_SELF)
+    solver.linearise()
+    modes = solver.solve()
+    assert solver.families == FAMILIES[:3]
+    assert not [m for m in modes if m.family in ("torsional", "rigid")]
+    for family in FAMILIES[:3]:
+        a, b = np.array(first(modes, family)), np.array(first(full, family))
+        assert len(a) == 3 and np.max(np.abs(a - b) / np.abs(b)) < 1e-8, (family, a, b)
+    assert max(solver.bc_amplitude(m) for m in modes[:10]) < 1e-9  # alpha = 0 holds
+
+
+def test_twist_switch_needs_a_torque_free_fe_scene():
+    with pytest.raises(ParameterError, match="model.twist.*torque-free"):
+        scene.load("nominal_operation").replace(model={"twist": False})
+    with pytest.raises(ParameterError, match="FE scheme only"):
+        table2().replace(model={"twist": False}, discretisation={"scheme": "spline"})
 
 
 @pytest.mark.mpi

@@ -176,4 +176,27 @@ def test_stationary_command_says_which_model(tmp_path):
     assert s["model"].startswith("planar")
     s = stationary.run(table2(8).replace(model={"reduction": "off"}), tmp_path / "b",
                        log=lambda *a: None, comm=MPI.COMM_SELF)
-    assert s["model"] == "full (r, alpha)"
+    assert s["model"] == "full (r, alpha); terms: gravity, drag, bending"
+    s = stationary.run(table2(8).replace(model={"reduction": "off", "twist": False, "drag": False}),
+                       tmp_path / "c", log=lambda *a: None, comm=MPI.COMM_SELF)
+    assert s["model"].startswith("centre line only (model.twist = false")
+    assert s["model"].endswith("terms: gravity, bending")
+
+
+def test_solver_defaults_do_not_leak_into_the_options_database():
+    """Each solver sets its PETSc defaults for its own set-up only: the global
+    options database is the same before and after (the first solver of a
+    process used to fix the Newton tolerance and LU of every later one)."""
+    from petsc4py import PETSc
+
+    from rawehelix.solvers.dynamics import DynamicsSolver
+    from rawehelix.solvers.modal import ModalSolver
+
+    before = PETSc.Options().getAll()
+    StationarySolver(table2(4), MPI.COMM_SELF).solve()
+    DynamicsSolver(scene.load("nominal_operation", elements=4), MPI.COMM_SELF,
+                   options={"ts_type": "cn"})
+    modal = ModalSolver(table2(4), MPI.COMM_SELF)
+    modal.linearise()
+    modal.solve(nev=6)
+    assert PETSc.Options().getAll() == before

@@ -99,6 +99,30 @@ def test_cap_is_flagged(tmp_path):
     assert summary["not_periodic_Hz"] == [10.0]
 
 
+@pytest.mark.parametrize("k", [1, 2, 3, 40])
+def test_chunks_are_contiguous_and_balanced(k):
+    """The f1 list of Fig. 8 cut for k ranks: every point once, in order; with
+    the cost model (min_periods / f1 + SETTLE_S per point, lead_in_s per chunk)
+    the low-frequency chunk gets fewer points, and no chunk costs more than the
+    equal-count split's dearest one."""
+    params = scene.load("mobile_end")
+    f = [0.5 * i for i in range(1, 31)]
+    parts = sweep.chunks(f, k, params.sweep)
+    assert len(parts) == k
+    assert [x for c in parts for x in c] == f
+    if k >= len(f):
+        assert all(len(c) <= 1 for c in parts)
+        return
+
+    def cost(c):
+        return params.sweep.lead_in_s + sum(sweep.point_cost(x, params.sweep) for x in c)
+    even = sweep.chunks(f, k)
+    assert max(map(cost, parts)) <= max(map(cost, even)) + 1e-12
+    if k == 2:
+        assert len(parts[0]) < len(parts[1])  # the periods are long at low f1
+        assert max(map(cost, parts)) < 0.9 * max(map(cost, even))
+
+
 def test_resonance_of_the_paper_at_n2(tmp_path):
     """Fig. 8 at N = 2: flat up to ~8 Hz, a rise above about 9 Hz, peak (> 900 N)
     near 13 Hz, collapse above."""
