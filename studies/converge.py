@@ -20,6 +20,9 @@ its own communicator; rank 0 gathers and writes ``converge.csv``,
 from __future__ import annotations
 
 import csv
+import dataclasses
+import hashlib
+import json
 import math
 import time
 from dataclasses import dataclass, field
@@ -29,6 +32,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.forms.parameters import Parameters
+from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers
 
 
@@ -57,6 +61,7 @@ class Run:
     wall_s: float
     error: float = math.nan
     order: float = math.nan
+    failed: str | None = None  # why the run failed (its value is nan)
 
 
 @dataclass
@@ -131,7 +136,9 @@ SPIN_RUN_S = 15.0  # the spin settles in ~5 s (Fig. 6)
 
 
 def _spin_series(params: Parameters, method: Method, value):
-    """(t [s], spin [rpm] at s = 0, L0/2, L0) of the Sec. 5.2 run, sampled every 5 ms."""
+    """(t [s], spin [rpm] at s = 0, L0/2, L0) of the Sec. 5.2 run, sampled every
+    5 ms, or at every step of a fixed-step (dt ladder) run: cutting its steps to
+    land on the sample times would make every dt above 5 ms a 5 ms run."""
     p = _with(params, method, value)
     q = p.normalised()
     every = 0.005 / q.t_scale
@@ -152,7 +159,11 @@ def _spin_series(params: Parameters, method: Method, value):
         v = s.probes.values()
         rows.append((s.t, v["spin0"], v["spin_mid"], v["spin1"]))
 
-    solver.advance(SPIN_RUN_S / q.t_scale, on_output=sample, output_every=every)
+    if method.variable == "dt_s":
+        sample(solver)
+        solver.advance(SPIN_RUN_S / q.t_scale, on_step=sample)
+    else:
+        solver.advance(SPIN_RUN_S / q.t_scale, on_output=sample, output_every=every)
     rows = np.array(rows)
     return q.time_s(rows[:, 0]), q.spin_rpm(rows[:, 1:])
 
@@ -230,8 +241,10 @@ def quantities() -> dict:
                 (0.02, 0.01, 0.005), 8),
                ("settling_time", "s", settling_time, "settling", (2, 4, 8, 16), (2, 4, 8),
                 (0.02, 0.01, 0.005), 8),
+               # cn works on the first-order form, whose Jacobian costs ~9x alpha2's
+               # to assemble (twice the fields): it gets the longer steps
                ("tension_max", "N", tension_max, "T max at 10 Hz", (4, 8, 16), (2, 3, 4, 6),
-                (5e-4, 2.5e-4, 1.25e-4), 8))},
+                {"alpha2": (5e-4, 2.5e-4, 1.25e-4), "cn": (1e-3, 5e-4, 2.5e-4)}, 8))},
     }
 
 
@@ -240,7 +253,8 @@ def _dynamic_methods(ladder_fe, ladder_spline, dts, N):
     TS schemes with fixed steps at N elements, p = 3 (the dt ladder)."""
     return ([Method(f"FE p={p}", "fe", p, ladder_fe) for p in (2, 3, 4)]
             + [Method("spline", "spline", None, ladder_spline)]
-            + [Method(f"FE N={N} p=3 {ts} (dt)", "fe", 3, dts, "dt_s", ts, N)
+            + [Method(f"FE N={N} p=3 {ts} (dt)", "fe", 3,
+                      dts[ts] if isinstance(dts, dict) else dts, "dt_s", ts, N)
                for ts in ("alpha2", "cn")])
 
 
@@ -275,6 +289,43 @@ def _timed(evaluate, params, method, value, budget_s: float = 1.0, repeats: int 
             return result, min(walls)
 
 
+def _step(method: Method, value) -> str:
+    if method.variable == "dt_s":
+        return f"N = {method.elements}, dt = {value:g} s"
+    return f"N = {int(value)}"
+
+
+class _RunCache:
+    """Finished runs as files in ``outdir/runs/``: a study stopped (or crashed)
+    part-way is resumed by the same command, and a run is never done twice.
+    A file counts only for the same scene, discretisation and quantity."""
+
+    def __init__(self, folder: Path | None, params: Parameters, quantity: str):
+        self.folder = folder
+        data = json.dumps([dataclasses.asdict(params), quantity], sort_keys=True, default=str)
+        self.fingerprint = hashlib.sha256(data.encode()).hexdigest()[:16]
+
+    def _path(self, method: Method, value) -> Path:
+        slug = "".join(c if c.isalnum() else "_" for c in method.label)
+        return self.folder / f"{slug}_{value:g}.json"
+
+    def get(self, method: Method, value):
+        if self.folder is None or not self._path(method, value).exists():
+            return None
+        data = json.loads(self._path(method, value).read_text())
+        if data.get("fingerprint") != self.fingerprint:
+            return None
+        return (np.asarray(data["result"], dtype=float),
+                math.nan if data["wall_s"] is None else data["wall_s"], data["failed"])
+
+    def put(self, method: Method, value, result, wall, failed):
+        if self.folder is not None:
+            writers.write_json(self._path(method, value), {
+                "fingerprint": self.fingerprint, "method": method.label, "value": value,
+                "result": [None if not np.isfinite(v) else float(v) for v in result],
+                "wall_s": None if not np.isfinite(wall) else wall, "failed": failed})
+
+
 def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "scene",
         comm=MPI.COMM_WORLD, log=print, methods: list | None = None) -> dict:
     """Run the refinement study of ``quantity``; returns the summary on every rank."""
@@ -282,22 +333,36 @@ def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "sce
     qty = quantities()[quantity]
     methods = methods or qty.methods
     jobs = [(m, v) for m in methods for v in m.ladder]
+    cache = _RunCache(Path(outdir) / "runs" if outdir is not None else None, params, quantity)
     mine, warm = [], set()
     for k, (method, value) in enumerate(jobs):
         if k % comm.size != comm.rank:
             continue
-        if method.label not in warm:  # just-in-time compilation is not part of the cost:
-            qty.evaluate(params, method, method.ladder[0])  # warm up on the cheapest run
-            warm.add(method.label)
-        result, wall = _timed(qty.evaluate, params, method, value)
-        mine.append((k, result, wall))
-        log(f"  {method.label:>10} {method.variable} = {value:<8g} "
-            f"{np.array2string(result, precision=8)} ({mine[-1][2]:.2f} s)")
+        cached = cache.get(method, value)
+        if cached is not None:
+            mine.append((k, *cached))
+            log(f"  {method.label:>10} {_step(method, value)}: {cached[0]} (done before, {cached[1]:.2f} s)")
+            continue
+        try:
+            if method.label not in warm:  # just-in-time compilation is not part of the cost:
+                qty.evaluate(params, method, method.ladder[0])  # warm up on the cheapest run
+                warm.add(method.label)
+            result, wall = _timed(qty.evaluate, params, method, value)
+            failed = None
+        except (SolverError, ArithmeticError, RuntimeError) as err:
+            # a run that fails is a result too (a step too long, a mesh too coarse)
+            result, wall, failed = np.full(len(qty.components), math.nan), math.nan, str(err)
+        cache.put(method, value, result, wall, failed)
+        mine.append((k, result, wall, failed))
+        log(f"  {method.label:>10} {_step(method, value)}: "
+            + (f"FAILED: {failed}" if failed else
+               f"{np.array2string(result, precision=8)} ({wall:.2f} s)"))
     gathered = comm.gather(mine, root=0)
     summary = None
     if comm.rank == 0:
         results = sorted((item for part in gathered for item in part), key=lambda i: i[0])
-        runs = [Run(jobs[k][0], jobs[k][1], result, wall) for k, result, wall in results]
+        runs = [Run(jobs[k][0], jobs[k][1], result, wall, failed=failed)
+                for k, result, wall, failed in results]
         ref_runs = [r for r in runs if r.method.label == qty.reference]
         ref_run = max(ref_runs, key=lambda r: 1.0 / r.method.resolution(r.value_of_ladder))
         reference = ref_run.result
@@ -311,8 +376,12 @@ def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "sce
                           "independent": independent,
                           "independent_rel_diff": None if independent is None else
                           float(np.max(np.abs(reference - independent) / np.abs(independent)))},
-            "runs": [{"method": r.method.label, r.method.variable: r.value_of_ladder,
-                      "value": r.result, "error": r.error, "order": r.order, "wall_s": r.wall_s}
+            "runs": [{"method": r.method.label, "refined": r.method.variable,
+                      "elements": r.method.elements if r.method.variable == "dt_s" else r.value_of_ladder,
+                      "dt_s": r.value_of_ladder if r.method.variable == "dt_s" else None,
+                      "step": _step(r.method, r.value_of_ladder),
+                      "value": r.result, "error": r.error, "order": r.order, "wall_s": r.wall_s,
+                      "failed": r.failed}
                      for r in runs],
             "ranks": comm.size, "wall_s": time.perf_counter() - start,
         }
@@ -332,12 +401,13 @@ def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: Quantity, n
     var = qty.methods[0].variable
     with open(outdir / "converge.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["method", var, *[f"{c} [{qty.unit}]" for c in qty.components],
-                    "rel_error", "observed_order", "wall_s"])
+        w.writerow(["method", "elements", "dt_s", *[f"{c} [{qty.unit}]" for c in qty.components],
+                    "rel_error", "observed_order", "wall_s", "failed"])
         for r in summary["runs"]:
-            w.writerow([r["method"], r[var], *[f"{v:.12g}" for v in r["value"]],
+            w.writerow([r["method"], r["elements"], "" if r["dt_s"] is None else r["dt_s"],
+                        *[f"{v:.12g}" for v in r["value"]],
                         f"{r['error']:.3e}", "" if not np.isfinite(r["order"]) else f"{r['order']:.2f}",
-                        f"{r['wall_s']:.3f}"])
+                        f"{r['wall_s']:.3f}", r["failed"] or ""])
     ref = summary["reference"]
     lines = [f"# Convergence of `{qty.name}` ({name})", "",
              f"Error: relative to the finest run of {ref['method']} ({var} = {ref[var]}), "
@@ -345,13 +415,13 @@ def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: Quantity, n
     if ref["independent"] is not None:
         lines.append(f"That reference differs from the independent one by "
                      f"{ref['independent_rel_diff']:.1e} (relative).")
-    lines += ["", f"| method | {var} | value [{qty.unit}] | rel. error | observed order | wall [s] |",
+    lines += ["", f"| method | run | value [{qty.unit}] | rel. error | observed order | wall [s] |",
               "| --- | --- | --- | --- | --- | --- |"]
     for r in summary["runs"]:
         value = ", ".join(f"{v:.8g}" for v in r["value"])
         order = "" if not np.isfinite(r["order"]) else f"{r['order']:.2f}"
-        lines.append(f"| {r['method']} | {r[var]} | {value} | {r['error']:.2e} | {order} | "
-                     f"{r['wall_s']:.3f} |")
+        wall = f"{r['wall_s']:.3f}" if not r["failed"] else f"failed: {r['failed'][:80]}"
+        lines.append(f"| {r['method']} | {r['step']} | {value} | {r['error']:.2e} | {order} | {wall} |")
     (outdir / "converge.md").write_text("\n".join(lines) + "\n")
     work_precision_png(outdir / "work_precision.png", by_method, qty, name)
 
