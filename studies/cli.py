@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+import traceback
 from pathlib import Path
 
 from rawehelix.studies import scene as scenes
@@ -159,10 +160,26 @@ def main(argv: list[str] | None = None) -> int:
                 return _fail(str(err))
     except SolverError as err:
         print(f"rawehelix: {err}", file=sys.stderr)
+        _abort_other_ranks(MPI.COMM_WORLD, 1)
         return 1
     except NotImplementedError as err:
         return _fail(str(err))
+    except Exception:
+        if MPI.COMM_WORLD.size == 1:
+            raise
+        traceback.print_exc()
+        _abort_other_ranks(MPI.COMM_WORLD, 1)
+        raise
     return 0
+
+
+def _abort_other_ranks(comm, code: int):
+    """Under mpirun an error on one rank would leave the others waiting in a
+    collective call for ever (Open MPI waits busily: both cores stay at 100 %):
+    end the whole job instead."""
+    if comm.size > 1:
+        sys.stderr.flush()
+        comm.Abort(code)
 
 
 if __name__ == "__main__":

@@ -48,15 +48,21 @@ def test_time_step_ladder(tmp_path):
     spin overshoot of Sec. 5.2 converges at least at second order in dt
     (measured 4.4 then 2.8 on 20/10/5 ms, approaching 2; asserted > 1.5), and
     the outputs name each run's N and dt."""
+    time_ref = "FE N=8 p=3 alpha2 (dt)"  # the quantity's time reference: its finest run
+    assert converge.quantities()["spin_overshoot"].time_reference == time_ref
     methods = [Method("FE p=4", "fe", 4, (2,)),
-               Method("FE N=2 p=3 alpha2 (dt)", "fe", 3, (0.02, 0.01, 0.005), "dt_s", "alpha2", 2),
-               Method("FE N=2 p=3 alpha2 (fine)", "fe", 3, (0.00125,), "dt_s", "alpha2", 2)]
+               Method("FE N=2 p=3 alpha2", "fe", 3, (0.02, 0.01, 0.005), "dt_s", "alpha2", 2),
+               Method(time_ref, "fe", 3, (0.02, 0.00125), "dt_s", "alpha2", 2)]
     summary, _ = study(tmp_path, "spin_overshoot", "nominal_operation", methods)
     ladder = [r for r in summary["runs"] if r["method"] == methods[1].label]
-    fine = next(r for r in summary["runs"] if r["method"] == methods[2].label)
+    fine = next(r for r in summary["runs"] if r["method"] == time_ref and r["dt_s"] == 0.00125)
+    assert summary["time_reference"]["dt_s"] == 0.00125
     assert [r["dt_s"] for r in ladder] == [0.02, 0.01, 0.005]
     assert all(r["elements"] == 2 and not r["failed"] for r in ladder)
-    errors = [abs(r["value"][0] - fine["value"][0]) for r in ladder]
+    target = scene.load("nominal_operation").controller.target_rpm  # the overshoot is ~0:
+    assert summary["error_scale"] == target  # its error is measured against the target spin
+    errors = [abs(r["value"][0] - fine["value"][0]) / target for r in ladder]
+    assert [r["error"] for r in ladder] == pytest.approx(errors, rel=1e-12)  # time error only
     orders = [math.log2(a / b) for a, b in zip(errors, errors[1:])]
     assert min(orders) > 1.5, (errors, orders)
     md = (tmp_path / "converge.md").read_text()
