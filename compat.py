@@ -110,6 +110,16 @@ def locate_boundary_vertices(mesh, marker):
     return dolfinx.mesh.locate_entities_boundary(mesh, 0, marker)
 
 
+def locate_all_dofs(mesh, spaces):
+    """Every dof of ``spaces`` ((W.sub(i), V_collapsed)) on this rank's cells and
+    ghosts.  DOLFINx 0.9 needs the cell-to-cell connectivity for this."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim, tdim)
+    cells = mesh.topology.index_map(tdim)
+    every = np.arange(cells.size_local + cells.num_ghosts, dtype=np.int32)
+    return dolfinx.fem.locate_dofs_topological(spaces, tdim, every)
+
+
 def cell_count(mesh) -> int:
     """Number of cells owned by this rank."""
     return mesh.topology.index_map(mesh.topology.dim).size_local

@@ -70,10 +70,7 @@ class RodDiscretisation:
 
     def all_dofs(self, W_sub, V_collapsed):
         """Every dof of a sub-space (for a field held at zero)."""
-        tdim = self.mesh.topology.dim
-        cells = self.mesh.topology.index_map(tdim)
-        every = np.arange(cells.size_local + cells.num_ghosts, dtype=np.int32)
-        return dolfinx.fem.locate_dofs_topological((W_sub, V_collapsed), tdim, every)
+        return compat.locate_all_dofs(self.mesh, (W_sub, V_collapsed))
 
     def set_top_position(self, position):
         position = np.asarray(position, dtype=float)
