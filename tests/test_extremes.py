@@ -18,7 +18,8 @@ EXPECTED = {
                      and n["lateral_rel_err"] < 1e-4),
     "torsional_buckling": ("detected", lambda n: n["growth_at_0.9"] < 1e-3
                            and n["growth_at_1.02"] > 1.0 and n["lateral_at_0.99"] < 0.2 * 36.8),
-    "f1_40Hz": ("converged", lambda n: 60 < n["tension_min_N"] <= n["tension_max_N"] < 200),
+    "f1_40Hz": ("converged", lambda n: 700 < n["tension_min_N"] <= n["tension_max_N"] < 750
+                and n["rel_diff_N8_N16"] < 0.01 and n["spline_N2_tension_max_N"] < 200),
     "dt_x10": ("converged", lambda n: n["spin_diff_rpm"] < 0.05),
     "n_1e4": ("limit", None),
 }
