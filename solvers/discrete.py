@@ -14,6 +14,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
 from rawehelix.forms.parameters import Parameters
@@ -91,6 +92,14 @@ class RodDiscretisation:
         w.sub(0).interpolate(lambda x: np.asarray(centre_line(x[0])).T)
         w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
         w.x.scatter_forward()
+
+    def centre_line(self):
+        """r as UFL (the first field of the state)."""
+        return ufl.split(self.w)[0]
+
+    def gather_centre_line(self):
+        """(s, r (n, 3)) at the Lagrange nodes on rank 0 ((None, None) elsewhere)."""
+        return fields.gather(self.w.sub(0).collapse())
 
     def stationary_residual(self, w=None):
         w = w or self.w

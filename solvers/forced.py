@@ -59,10 +59,10 @@ class FEBackend:
         step = (t1 - t0) / math.ceil((t1 - t0) / self.dt - 1e-9)
         ts.setTimeStep(step)
         ts.restartStep()
-        samples = [(t0, solver.probes.values()["tension0"])]  # (above 31 Hz a step > T/64)
+        samples = [(t0, solver.probes.value("tension0"))]  # (above 31 Hz a step > T/64)
 
         def record(s):
-            samples.append((s.t, s.probes.values()["tension0"]))
+            samples.append((s.t, s.probes.value("tension0")))
             s.ts.setTimeStep(step)  # back to the fixed step after a cut (failed Newton)
 
         solver.advance(t1, on_step=record)

@@ -18,6 +18,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
 from rawehelix.forms.parameters import Parameters
@@ -35,8 +36,6 @@ def embed(u):
 
 
 class PlanarRod:
-    planar = True
-
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD):
         if not planar_allowed(params):
             raise ValueError("the planar model needs the upper end in the x-z plane")
@@ -78,8 +77,11 @@ class PlanarRod:
     def set_centre_line(self, centre_line, w=None):
         (w or self.w).interpolate(lambda x: np.asarray(centre_line(x[0]))[:, [0, 2]].T)
 
-    def centre_line_function(self):
-        return self.w
+    def gather_centre_line(self):
+        """(s, r (n, 3) with y = 0) at the Lagrange nodes on rank 0 ((None, None) elsewhere)."""
+        s, xz = fields.gather(self.w)
+        x = None if xz is None else np.column_stack([xz[:, 0], 0 * xz[:, 0], xz[:, 1]])
+        return s, x
 
     def dof_count(self) -> int:
         im = self.W.dofmap.index_map

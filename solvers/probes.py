@@ -53,8 +53,7 @@ class Probes:
         }
         self.forms = {k: dolfinx.fem.form(v) for k, v in forms.items()}
         # fields along s, interpolated at the Lagrange nodes
-        V_r = rod.V_r
-        V_s, _ = compat.collapse(rod.W.sub(1))
+        V_r, V_s = rod.V_r, rod.V_a
         self.field_exprs = {
             "r": (compat.expression(f.r, V_r), dolfinx.fem.Function(V_r)),
             "alpha": (compat.expression(f.alpha, V_s), dolfinx.fem.Function(V_s)),
@@ -71,6 +70,10 @@ class Probes:
         local = np.array([dolfinx.fem.assemble_scalar(f) for f in self.forms.values()])
         total = self.comm.allreduce(local, op=MPI.SUM)
         return dict(zip(self.forms, total))
+
+    def value(self, name: str) -> float:
+        """One normalised point value (collective): the sweep reads T(0) every step."""
+        return self.comm.allreduce(dolfinx.fem.assemble_scalar(self.forms[name]), op=MPI.SUM)
 
     def fields(self) -> dict | None:
         """Normalised fields at the Lagrange nodes, sorted by s, on rank 0 (None elsewhere)."""

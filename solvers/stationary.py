@@ -10,7 +10,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import ufl
 from mpi4py import MPI
 
 from rawehelix import compat
@@ -50,8 +49,7 @@ class StationarySolver:
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
         p = self.rod.degree
         self.V_T = compat.scalar_space(self.rod.mesh, "DG", p - 1)
-        r = self.rod.centre_line() if planar else ufl.split(self.rod.w)[0]
-        self.tension_expr = tension(r, self.rod.c.sigma)  # (29)
+        self.tension_expr = tension(self.rod.centre_line(), self.rod.c.sigma)  # (29)
 
     def solve(self, first_guess=None) -> StationaryResult:
         """Solve from the chord (or ``first_guess``: s -> (n, 3) centre line)."""
@@ -85,13 +83,7 @@ class StationarySolver:
                 f"tension law (22) does not hold for compression; increase ends.elongation")
 
     def gather(self) -> StationaryResult:
-        if getattr(self.rod, "planar", False):
-            s, xz = fields.gather(self.rod.w)
-            x = None if xz is None else np.column_stack([xz[:, 0], 0 * xz[:, 0], xz[:, 1]])
-        else:
-            r = self.rod.w.sub(0).collapse()
-            r = r[0] if isinstance(r, tuple) else r
-            s, x = fields.gather(r)
+        s, x = self.rod.gather_centre_line()
         T = fields.interpolate_expression(self.tension_expr, self.V_T)
         sT, Tv = fields.gather(T)
         return StationaryResult(s, x, sT, None if Tv is None else Tv[:, 0], 0, 0.0)

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import hashlib
 import json
 import math
 import time
@@ -317,8 +316,7 @@ class _RunCache:
 
     def __init__(self, folder: Path | None, params: Parameters, quantity: str):
         self.folder = folder
-        data = json.dumps([dataclasses.asdict(params), quantity], sort_keys=True, default=str)
-        self.fingerprint = hashlib.sha256(data.encode()).hexdigest()[:16]
+        self.fingerprint = writers.digest([dataclasses.asdict(params), quantity])
 
     def _path(self, method: Method, value) -> Path:
         slug = "".join(c if c.isalnum() else "_" for c in method.label)

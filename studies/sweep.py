@@ -27,7 +27,6 @@ or discretisation into the same directory is refused.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import os
 import time
@@ -56,7 +55,7 @@ def fingerprint(params: Parameters) -> str:
     data["time"] = {"dt_s": data["time"]["dt_s"]}
     for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
         data["sweep"].pop(key)
-    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
+    return writers.digest(data)
 
 
 def make_backend(params: Parameters, comm):
@@ -127,8 +126,7 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
     (outdir / "points").mkdir(parents=True, exist_ok=True)
     state, t, computed = None, 0.0, 0
     for i, f1 in enumerate(chunk):
-        done = _finished(outdir, f1)
-        if done is not None:
+        if _finished(outdir, f1) is not None:
             state = None  # the next unfinished point reloads its predecessor's state
             continue
         lead_in = True
@@ -152,9 +150,7 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
                      "failed": str(err), "wall_s": None, "start": "stationary" if lead_in
                      else "continuation"}
             writers.write_json(outdir / "points" / f"{key}.json", {"entry": entry})
-            with open(outdir / "computed.log", "a") as f:
-                f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()} failed\n")
-            merge_results(outdir, header)
+            _computed(outdir, header, f1, " failed")
             log(f"  f1 = {f1:6.2f} Hz: FAILED: {err}")
             backend, state, computed = backend_factory(), None, computed + 1
             continue
@@ -162,9 +158,7 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
         writers.write_json(outdir / "points" / f"{key}.json", {
             "entry": result.entry(), "period_maxima_N": result.period_maxima_N,
             "series_t_s": result.series_t_s, "series_tension_N": result.series_tension_N})
-        with open(outdir / "computed.log", "a") as f:
-            f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}\n")
-        merge_results(outdir, header)
+        _computed(outdir, header, f1)
         computed += 1
         flag = ("" if result.periodic else "  NOT PERIODIC (hit max_periods)") + \
             ("  SLACK (T <= 0)" if result.slack else "")
@@ -183,6 +177,13 @@ SETTLE_S = 3.0
 def point_cost(f1: float, sweep: Sweep) -> float:
     """Estimated simulated time of one point [s]: the cost model of :func:`chunks`."""
     return sweep.min_periods / f1 + SETTLE_S
+
+
+def _computed(outdir: Path, header: dict, f1: float, note: str = ""):
+    """A point is finished: one line in computed.log, then sweep.json merged."""
+    with open(outdir / "computed.log", "a") as f:
+        f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}{note}\n")
+    merge_results(outdir, header)
 
 
 def chunks(frequencies: list[float], k: int, sweep: Sweep | None = None) -> list[list[float]]:

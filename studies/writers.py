@@ -4,6 +4,7 @@ Every function here runs on one rank (the caller picks rank 0)."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import tempfile
@@ -24,6 +25,13 @@ def _jsonable(obj):
     if isinstance(obj, float) and not np.isfinite(obj):
         return None
     return obj
+
+
+def digest(data) -> str:
+    """A short hash of JSON-able data: the fingerprint that keeps results of
+    another scene or discretisation apart."""
+    text = json.dumps(data, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def write_json(path: Path, data: dict) -> Path:
