@@ -53,7 +53,7 @@ class Coefficients:
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
-        """From :class:`rawehelix.forms.parameters.Normalised` and a scene's
+        """From :class:`rawehelix.parameters.Normalised` and a scene's
         ``model``; ``make`` wraps each number (e.g. into a dolfinx Constant)."""
         return cls(
             sigma=make(q.sigma), mu=make(q.mu), beta=make(q.beta), nu=make(q.nu),

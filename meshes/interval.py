@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.forms.parameters import Normalised, Parameters
+from rawehelix.parameters import Normalised, Parameters
 
 __all__ = ["uniform_nodes", "graded_nodes", "bending_length", "suggest_grading",
            "write_meshio", "read_meshio", "create", "mesh_nodes", "mesh_from_parameters"]

@@ -1,7 +1,7 @@
 """The discrete rod: mesh, mixed (r, alpha) space, constants, measures and end conditions.
 
 Shared by the stationary, dynamic and modal solvers.  Built from validated
-:class:`~rawehelix.forms.parameters.Parameters`; reads no files.
+:class:`~rawehelix.parameters.Parameters`; reads no files.
 """
 
 from __future__ import annotations
@@ -16,8 +16,9 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
+from rawehelix.solvers.state import RodState
 from rawehelix.forms import rod
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.meshes import interval
 
 
@@ -78,6 +79,20 @@ class RodDiscretisation:
         set_constant(self.r_top, position)
 
     # -- states ------------------------------------------------------------------
+    def get_state(self, w=None, w_t=None, t: float = 0.0) -> RodState:
+        """The state held in ``w`` (default ``self.w``) and ``w_t`` (a copy)."""
+        w = w or self.w
+        return RodState(w.x.array.copy(), None if w_t is None else w_t.x.array.copy(), t,
+                        self.dof_count())
+
+    def set_state(self, state: RodState, w=None, w_t=None):
+        """``w`` (default ``self.w``) and ``w_t`` (if given) <- the state."""
+        w = w or self.w
+        state.check(self.dof_count(), w.x.array.size)
+        w.x.array[:] = state.w
+        if w_t is not None:
+            w_t.x.array[:] = 0.0 if state.w_t is None else state.w_t
+
     def set_chord(self, w=None):
         """w <- the straight chord r = s r_N, alpha = 0: the default first guess."""
         w = w or self.w

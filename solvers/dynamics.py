@@ -32,7 +32,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.solvers.probes import Probes
 from rawehelix.solvers.snes import (FloorConvergence, SolverError, default_options, lu_options,
                                    reason_name, temporary_options)

@@ -16,7 +16,7 @@ from mpi4py import MPI
 
 from rawehelix import compat
 from rawehelix.solvers.fields import set_constant
-from rawehelix.forms.parameters import Normalised, Parameters
+from rawehelix.parameters import Normalised, Parameters
 from rawehelix.solvers.dynamics import DynamicsSolver
 
 

@@ -89,7 +89,7 @@ import dolfinx.fem.petsc
 from rawehelix import compat
 from rawehelix.forms import rod as rod_forms
 from rawehelix.forms.kinematics import d
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.solvers import fields
 from rawehelix.solvers.snes import SolverError, default_options, lu_options
 from rawehelix.solvers.stationary import StationarySolver

@@ -17,7 +17,7 @@ A *backend* integrates the rod; it works in normalised units and provides
     backend.advance(state, q, t0, t1, t_out) -> (state at t1, tension at s = 0 at t_out)
     backend.pack(state) -> dict of arrays;  backend.unpack(dict) -> state
 
-with ``q`` the :class:`~rawehelix.forms.parameters.Normalised` of the current
+with ``q`` the :class:`~rawehelix.parameters.Normalised` of the current
 frequency (``Normalised.at_frequency``).
 """
 
@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rawehelix.forms.parameters import Normalised, Sweep
+from rawehelix.parameters import Normalised, Sweep
 
 
 @dataclass

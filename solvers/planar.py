@@ -21,7 +21,7 @@ from rawehelix import compat
 from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.meshes import interval
 
 

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
-from rawehelix.forms.parameters import Normalised
+from rawehelix.parameters import Normalised
 
 __all__ = ["ShootingSolution", "solve", "rhs", "load_vector", "default_segments"]
 

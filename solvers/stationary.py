@@ -13,7 +13,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix import compat
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.solvers import fields
 from rawehelix.forms.kinematics import tension
 from rawehelix.solvers.discrete import RodDiscretisation
@@ -35,6 +35,7 @@ class StationaryResult:
     tension: np.ndarray  # normalised tension, Eq. (29)
     newton_iterations: int
     wall_s: float
+    state: object = None  # RodState on every rank (full rod; None for the planar one)
 
 
 class StationarySolver:
@@ -66,7 +67,15 @@ class StationarySolver:
         self._check_taut(result)
         result.newton_iterations = its
         result.wall_s = time.perf_counter() - start
+        if hasattr(self.rod, "get_state"):
+            result.state = self.rod.get_state()
         return result
+
+    def set_end_torques(self, ground: float = 0.0, top: float = 0.0):
+        """Torques at s = 0 and s = L0 (normalised by GJ / L0), Eqs. (38)-(39);
+        the stationary state of Sec. 5.1 has none."""
+        self.rod.c.m0.value = ground
+        self.rod.c.mN.value = top
 
     def _check_taut(self, result):
         """Eq. (22) is Hooke's law for a taut helix; a compressed one is slack

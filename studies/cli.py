@@ -77,7 +77,7 @@ def _frequencies(spec: str | None, params) -> list[float]:
         raise ValueError(f"{spec!r} is not START:STOP:STEP (numbers in Hz)") from None
     if not (start > 0 and stop >= start and step > 0):
         raise ValueError(f"{spec!r}: needs 0 < START <= STOP and STEP > 0")
-    from rawehelix.forms.parameters import Sweep
+    from rawehelix.parameters import Sweep
     import dataclasses
     return dataclasses.replace(Sweep(), f1_start_Hz=start, f1_stop_Hz=stop,
                                f1_step_Hz=step).frequencies()

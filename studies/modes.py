@@ -12,7 +12,7 @@ import math
 import pathlib
 import time
 
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 
 FAMILY_LABELS = {
     "longitudinal": "Longitudinal",

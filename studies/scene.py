@@ -1,6 +1,6 @@
 """Scene files: TOML in SI units -> validated :class:`Parameters`.
 
-A scene has the sections of :class:`rawehelix.forms.parameters.Parameters`
+A scene has the sections of :class:`rawehelix.parameters.Parameters`
 (``[helix]``, ``[ends]``, ``[environment]``, ``[torque]``, ``[controller]``,
 ``[model]``, ``[discretisation]``, ``[time]``) and an optional top-level
 ``title``.  ``studies/scenes/example.toml`` documents every key.
@@ -16,7 +16,7 @@ import dataclasses
 import tomllib
 from pathlib import Path
 
-from rawehelix.forms.parameters import (Controller, Discretisation, Ends, Environment,
+from rawehelix.parameters import (Controller, Discretisation, Ends, Environment,
                                         Helix, Model, ParameterError, Parameters, Sweep,
                                         Time, Torque)
 

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import render, writers

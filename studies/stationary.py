@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 from rawehelix.solvers import shooting
 from rawehelix.solvers.planar import planar_allowed
 from rawehelix.solvers.stationary import StationarySolver, sag

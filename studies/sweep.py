@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix.forms.parameters import Parameters, Sweep
+from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers

@@ -51,7 +51,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from rawehelix.forms.parameters import (Discretisation, Ends, Environment, Helix, Model, ParameterError,
+from rawehelix.parameters import (Discretisation, Ends, Environment, Helix, Model, ParameterError,
                                         Parameters)
 from rawehelix.solvers import shooting
 from rawehelix.solvers.modal import ModalSolver, create_pep

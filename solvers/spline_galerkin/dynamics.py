@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from rawehelix.forms.parameters import Parameters
+from rawehelix.parameters import Parameters
 
 from . import stationary
 from .system import SplineGalerkin

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from rawehelix.forms.parameters import Normalised
+from rawehelix.parameters import Normalised
 
 from . import stationary
 from .dynamics import initial_state

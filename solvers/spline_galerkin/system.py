@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rawehelix.forms.parameters import Normalised
+from rawehelix.parameters import Normalised
 
 from .basis import SplineBasis, natural_second_derivatives, shape_functions
 from .matrices import GalerkinMatrices
