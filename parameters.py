@@ -216,9 +216,10 @@ class Time:
     until_s: float = 30.0  # end of the simulation [s]
     dt_s: float = 1.0e-3  # (initial) time step [s]
     output_every_s: float = 0.05  # sampling of the time series [s]
+    fields_every_s: float = 0.5  # sampling of the fields along s (XDMF, pictures) [s]
 
     def __post_init__(self):
-        _positive("time", self, "until_s", "dt_s", "output_every_s")
+        _positive("time", self, "until_s", "dt_s", "output_every_s", "fields_every_s")
 
 
 @dataclass(frozen=True)
@@ -268,6 +269,8 @@ class Parameters:
     discretisation: Discretisation = field(default_factory=Discretisation)
     time: Time = field(default_factory=Time)
     sweep: Sweep = field(default_factory=Sweep)
+    name: str = "scene"  # the scene file's stem: labels outputs, changes no number
+    title: str = ""  # the scene's title, for figures
 
     def __post_init__(self):
         if not self.model.twist:
@@ -282,9 +285,18 @@ class Parameters:
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:
         ``p.replace(discretisation={"elements": 32})``."""
-        changed = {name: dataclasses.replace(getattr(self, name), **values)
+        changed = {name: values if isinstance(values, str)
+                   else dataclasses.replace(getattr(self, name), **values)
                    for name, values in sections.items()}
         return dataclasses.replace(self, **changed)
+
+    def as_dict(self) -> dict:
+        """Every section as plain data, without the labels (name, title): what
+        fingerprints of results hash."""
+        data = dataclasses.asdict(self)
+        data.pop("name")
+        data.pop("title")
+        return data
 
     def normalised(self) -> "Normalised":
         return Normalised.from_parameters(self)

@@ -47,7 +47,7 @@ def main():
           f"{'resid%':>7s} {'jac%':>6s} {'linear%':>8s} {'final spin rpm':>15s}")
     for name, opts in variants.items():
         p = params.replace(time={"dt_s": 0.01}) if "fixed" in name else params
-        solver = DynamicsSolver(p, options=opts)
+        solver = DynamicsSolver.from_stationary(p, options=opts)
         timers = {"residual": 0.0, "jacobian": 0.0}
 
         def timed(fn, key):

@@ -23,19 +23,21 @@ the IP bending term is far too stiff).
 from __future__ import annotations
 
 import math
-from pathlib import Path
-
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
 import dolfinx.fem
+import dolfinx.fem.petsc
 
 from rawehelix import compat
 from rawehelix.parameters import Parameters
+from rawehelix.solvers.discrete import RodDiscretisation
+from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.probes import Probes
 from rawehelix.solvers.snes import (FloorConvergence, SolverError, default_options, lu_options,
                                    reason_name, temporary_options)
+from rawehelix.solvers.state import RodState
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
 
@@ -73,7 +75,8 @@ def ts_reason_name(reason: int) -> str:
 
 
 class DynamicsSolver:
-    """PETSc TS on the FE rod, started from the stationary state (Sec. 5.1).
+    """PETSc TS on the FE rod.  It takes a state and integrates it; it solves
+    nothing when it is built and writes no files.
 
     Parameters
     ----------
@@ -84,21 +87,23 @@ class DynamicsSolver:
     options
         Extra PETSc options for this solver only, without the ``rawehelix_``
         prefix: ``{"ts_type": "cn", "ts_adapt_type": "none"}``.
-    initial
-        Optional callable ``(solver) -> None`` that changes the initial state
-        (``solver.rod.w``; velocities start at zero) after the stationary solve.
+    rod
+        The discretisation to integrate on (default: a new one of ``params``);
+        :meth:`from_stationary` passes the stationary solver's.
+
+    Give it a state with :meth:`set_state` (or build it with
+    :meth:`from_stationary`), then :meth:`advance`; :meth:`state` returns the
+    last accepted state, :meth:`set_end_motion` moves the upper end on its
+    circle (Eq. 70) at another frequency.
     """
 
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, options: dict | None = None,
-                 initial=None):
+                 rod: RodDiscretisation | None = None):
         self.params, self.comm = params, comm
-        self.q = params.normalised()
-        stationary = StationarySolver(params, comm)
-        stationary.solve()
-        self.rod = stationary.rod  # its alpha(0) = 0 condition is the last bc
-        self.rod.c.m0.value = 0.0
-        if initial is not None:
-            initial(self)
+        self._q_scene = params.normalised()
+        self.rod = rod if rod is not None else RodDiscretisation(params, comm)
+        self.rod.q = self.q = self._q_scene
+        self.rod.c.m0.value = 0.0  # the ground torque is the controller's, in the form
         # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free (unless model.twist = false)
         bcs = self.rod.bcs[:2] + self.rod.twist_bcs
         ts_defaults = dict(TS_DEFAULTS)
@@ -113,9 +118,25 @@ class DynamicsSolver:
             self.form = SecondOrder(self.rod, bcs) if ts_type == "alpha2" else FirstOrder(self.rod, bcs)
             self.ts = self._create_ts(ts_type)
         self.probes = Probes(self.form)
-        self._fix_controller_offset()
+        rod_ = self.rod
+        self._v_top = dolfinx.fem.Function(rod_.V_r)  # the upper end's velocity, Eq. (70)
+        self._bc_v = dolfinx.fem.dirichletbc(self._v_top, rod_.end_dofs["top"], rod_.W.sub(0))
+        self._velocity = dolfinx.fem.Function(rod_.W)  # scratch for the first-order form
         self.newton_iterations = 0
         self.steps = 0
+        self._good = None
+        self._fresh = False
+        self._has_state = False
+
+    @classmethod
+    def from_stationary(cls, params: Parameters, comm=MPI.COMM_WORLD, options: dict | None = None,
+                        scene: str = "scene") -> "DynamicsSolver":
+        """A solver started from the stationary state of Sec. 5.1 (at rest, t = 0)."""
+        stationary = StationarySolver(params, comm, scene=scene)
+        result = stationary.solve()
+        solver = cls(params, comm, options, rod=stationary.rod)
+        solver.set_state(result.state)
+        return solver
 
     def residual_floor(self) -> float:
         """An absolute Newton tolerance ten times the round-off floor of |F|.
@@ -151,13 +172,77 @@ class DynamicsSolver:
         snes.getKSP().getPC().setFromOptions()
         return ts
 
-    def _fix_controller_offset(self):
-        """C in m0 = mN + k1 (alpha(0) - alpha_dot* t) + k2 alpha_t(0) + C: m0(0) = m0 of
-        the initial state (zero: the stationary state has no torques)."""
-        self.form.set_time(0.0)
-        self.form.load_solution(self.ts)
-        v = self.probes.values()
-        self.form.offset.value = 0.0 - (v["m0"] - float(self.form.offset.value))
+    # -- states --------------------------------------------------------------------
+    def set_state(self, state: RodState):
+        """Start from ``state``: its time, configuration and velocity (at rest if
+        it has none) and its controller constant C of Eq. (40) (if it has none,
+        C makes the ground torque of the state zero: the stationary state
+        carries no torque)."""
+        form, rod = self.form, self.rod
+        if form.second_order:
+            rod.set_state(state, w=form.u, w_t=form.v)
+        else:
+            rod.set_state(state, w=rod.w, w_t=self._velocity)
+            form.x.sub(0).interpolate(rod.w.sub(0))
+            form.x.sub(1).interpolate(rod.w.sub(1))
+            form.x.sub(2).interpolate(self._velocity.sub(0))
+            form.x.sub(3).interpolate(self._velocity.sub(1))
+        for f in self._state_functions():
+            f.x.scatter_forward()
+        self.ts.setTime(state.t)
+        form.set_time(state.t)
+        self._push()
+        if state.offset is None:
+            form.offset.value = 0.0
+            form.offset.value = -self.probes.value("m0")  # m0 = 0 in this state
+        else:
+            form.offset.value = state.offset
+        self._good = (state.t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
+        self._fresh = self._has_state = True
+
+    def state(self) -> RodState:
+        """The last accepted state (a copy), with the controller constant C."""
+        if not self._has_state:
+            raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
+        form, rod = self.form, self.rod
+        t = self.t if self._good is None else self._good[0]
+        if form.second_order:
+            w, w_t = form.u, form.v
+        else:
+            w, w_t = dolfinx.fem.Function(rod.W), self._velocity
+            w.sub(0).interpolate(form.x.sub(0))
+            w.sub(1).interpolate(form.x.sub(1))
+            w_t.sub(0).interpolate(form.x.sub(2))
+            w_t.sub(1).interpolate(form.x.sub(3))
+            w.x.scatter_forward()
+            w_t.x.scatter_forward()
+        state = rod.get_state(w, w_t, t)
+        state.offset = float(form.offset.value)
+        return state
+
+    def _push(self):
+        """The TS solution <- the formulation's functions."""
+        form = self.form
+        if form.second_order:
+            self.ts.setSolution2(compat.petsc_vec(form.u).copy(), compat.petsc_vec(form.v).copy())
+        else:
+            self.ts.setSolution(compat.petsc_vec(form.x).copy())
+
+    def set_end_motion(self, f1_Hz: float, t_start: float = 0.0):
+        """The upper end on the circle of radius ``ends.circle_radius_m`` at f1 [Hz],
+        Eq. (70), at phase 0 at the normalised time ``t_start``; the velocity of
+        the end in the current state jumps to that of the circle (a sweep keeps
+        its position: the circle restarts where the last one ended)."""
+        q = self._q_scene.at_frequency(f1_Hz, t_start)
+        self.q = self.rod.q = q
+        self.form.moving_top = q.r1 > 0 and q.omega1 > 0
+        if self._has_state and self.form.second_order:
+            t = self.t
+            set_constant(self._v_top, q.top_velocity(t))
+            dolfinx.fem.petsc.set_bc(compat.petsc_vec(self.form.v), [self._bc_v])
+            self.form.v.x.scatter_forward()
+            self._push()
+            self._good = (t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
 
     # -- stepping ---------------------------------------------------------------
     @property
@@ -171,7 +256,9 @@ class DynamicsSolver:
         land on those times), and ``on_step(solver)`` after every step.
 
         Raises SolverError if a step cannot be completed within the retries;
-        the state is then the last good one (see :meth:`save_state`)."""
+        the state is then the last good one (see :meth:`state`)."""
+        if not self._has_state:
+            raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
         ts = self.ts
         t0 = ts.getTime()
         eps = 1e-9 * max(1.0, t_end)
@@ -183,7 +270,6 @@ class DynamicsSolver:
                 outputs.append(t_end)
         self._pending = outputs
         self._dt_wanted = None
-        self._good = None
         self._on_step, self._on_output = on_step, on_output
 
         def prestep(ts_):
@@ -202,12 +288,17 @@ class DynamicsSolver:
                 dt = t_end - t
             ts_.setTimeStep(dt)
 
+        first_call = [True]
+
         def monitor(ts_, step, t, X):
-            if step == 0 and self.steps == 0:
-                self._accepted(t, first=True)
+            # TSSolve monitors its start state, then every accepted step
+            if first_call[0]:
+                first_call[0] = False
+                if self._fresh:  # a state just set: it is the first output
+                    self._fresh = False
+                    self._accepted(t, first=True)
                 return
-            if step > 0:
-                self._accepted(t)
+            self._accepted(t)
 
         ts.setPreStep(prestep)
         ts.setMonitor(monitor)
@@ -273,7 +364,7 @@ class DynamicsSolver:
             f"(-{PREFIX}ts_max_snes_failures 20), adaptive steps (-{PREFIX}ts_adapt_type basic), "
             f"more Newton iterations (-{PREFIX}ts_snes_max_it 30) or more elements.")
 
-    # -- state file ---------------------------------------------------------------
+    # -- fields ---------------------------------------------------------------------
     def state_arrays(self) -> dict | None:
         """The current state along s (normalised), on rank 0 (None elsewhere)."""
         f = self.probes.fields()
@@ -282,20 +373,6 @@ class DynamicsSolver:
         return {"t": self.t if self._good is None else self._good[0],
                 "s": f["s"], "r": f["r"], "alpha": f["alpha"], "r_t": f["r_t"],
                 "alpha_t": f["alpha_t"]}
-
-    def save_state(self, path: Path) -> Path | None:
-        """Write the last good state to ``path`` (.npz, normalised, with SI scales); collective."""
-        a = self.state_arrays()
-        if self.comm.rank != 0:
-            return None
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.stem + ".tmp.npz")
-        q = self.q
-        np.savez(tmp, **a, t_s=q.time_s(a["t"]), L0_m=q.L0, t_scale_s=q.t_scale,
-                 elements=self.params.discretisation.elements, degree=self.rod.degree)
-        tmp.replace(path)
-        return path
 
     # -- energy (normalised) ----------------------------------------------------------
     def energy(self) -> dict:

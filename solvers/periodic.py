@@ -14,11 +14,13 @@ never jumps: continuation as in the paper.
 A *backend* integrates the rod; it works in normalised units and provides
 
     backend.stationary()                     -> state at t = 0 (stationary, top at phase 0)
-    backend.advance(state, q, t0, t1, t_out) -> (state at t1, tension at s = 0 at t_out)
+    backend.set_frequency(f1_Hz, t_start)    the circle at f1, phase 0 at t_start
+                                             (``Normalised.at_frequency``)
+    backend.advance(state, t0, t1, t_out)    -> (state at t1, tension at s = 0 at t_out)
     backend.pack(state) -> dict of arrays;  backend.unpack(dict) -> state
 
-with ``q`` the :class:`~rawehelix.parameters.Normalised` of the current
-frequency (``Normalised.at_frequency``).
+Backends read and write no files: ``pack`` and ``unpack`` convert a state to
+and from plain arrays, which the caller may keep where it likes.
 """
 
 from __future__ import annotations
@@ -64,19 +66,20 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
     Returns (PointResult, final state, final normalised time)."""
     start_wall = time.perf_counter()
     q = q_base.at_frequency(f1_Hz, t_start)
+    backend.set_frequency(f1_Hz, t_start)
     period = 2 * math.pi / q.omega1
     n = sweep.samples_per_period
     t = t_start
     if lead_in and sweep.lead_in_s > 0:
         n_lead = math.ceil(sweep.lead_in_s / q.t_scale / period)
         for _ in range(n_lead):
-            state, _ = backend.advance(state, q, t, t + period, np.array([t + period]))
+            state, _ = backend.advance(state, t, t + period, np.array([t + period]))
             t += period
     maxima, history = [], []
     periodic = slack = False
     for k in range(1, sweep.max_periods + 1):
         t_out = t + period * np.arange(1, n + 1) / n
-        state, tension = backend.advance(state, q, t, t + period, t_out)
+        state, tension = backend.advance(state, t, t + period, t_out)
         if not np.all(np.isfinite(tension)):
             raise FloatingPointError(f"f1 = {f1_Hz} Hz: the tension is not finite at "
                                      f"t = {q.time_s(t):.3f} s")

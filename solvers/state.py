@@ -23,14 +23,33 @@ class RodState:
     w_t: np.ndarray | None = None  # velocity dofs (None: at rest)
     t: float = 0.0  # normalised time, Eq. (25)
     dofs: int = 0  # global number of dofs of the discretisation it belongs to
+    offset: float | None = None  # C of the controller, Eq. (40) integrated (None: not started)
 
     def copy(self) -> "RodState":
         return RodState(self.w.copy(), None if self.w_t is None else self.w_t.copy(),
-                        self.t, self.dofs)
+                        self.t, self.dofs, self.offset)
 
     def at_rest(self) -> "RodState":
         """The same configuration with zero velocity."""
         return RodState(self.w.copy(), None, self.t, self.dofs)
+
+    def arrays(self) -> dict:
+        """Plain arrays (for a file of the caller's): see :meth:`from_arrays`."""
+        out = {"w": self.w, "t": np.float64(self.t), "dofs": np.int64(self.dofs)}
+        if self.w_t is not None:
+            out["w_t"] = self.w_t
+        if self.offset is not None:
+            out["offset"] = np.float64(self.offset)
+        return out
+
+    @classmethod
+    def from_arrays(cls, data) -> "RodState":
+        """The state of :meth:`arrays` (a dict or an open .npz)."""
+        keys = set(data.keys())
+        return cls(np.asarray(data["w"]).copy(),
+                   np.asarray(data["w_t"]).copy() if "w_t" in keys else None,
+                   float(data["t"]), int(data["dofs"]),
+                   float(data["offset"]) if "offset" in keys else None)
 
     def check(self, dofs: int, size: int, what: str = "solver"):
         """Refuse a state of another discretisation."""

@@ -75,7 +75,7 @@ def _section(path, name: str, table) -> object:
         raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
 
 
-def parameters_from_dict(data: dict, path="<scene>") -> Parameters:
+def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) -> Parameters:
     """Validate a parsed scene (as from TOML) and build its parameters."""
     for key, value in data.items():
         if key in TOP_LEVEL:
@@ -83,11 +83,37 @@ def parameters_from_dict(data: dict, path="<scene>") -> Parameters:
         elif key not in SECTIONS:
             raise SceneError(path, key, "unknown section; allowed are "
                              + ", ".join(["title", *SECTIONS]))
-    for name in REQUIRED:
-        if name not in data:
-            raise SceneError(path, name, f"the section [{name}] is required")
-    sections = {name: _section(path, name, data[name]) for name in SECTIONS if name in data}
-    return Parameters(**sections)
+    for name_ in REQUIRED:
+        if name_ not in data:
+            raise SceneError(path, name_, f"the section [{name_}] is required")
+    sections = {s: _section(path, s, data[s]) for s in SECTIONS if s in data}
+    label = name if name is not None else Path(str(path)).stem
+    try:
+        return Parameters(**sections, name=label, title=data.get("title", label))
+    except ParameterError as err:
+        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+
+
+def apply_overrides(data: dict, overrides: dict, path="<scene>") -> dict:
+    """A copy of the parsed scene with dotted keys set: ``{"helix.EI_Nm2": 9000.0}``.
+
+    The values are validated later, with the file's own (same messages)."""
+    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in data.items()}
+    for key, value in (overrides or {}).items():
+        section, _, name = str(key).partition(".")
+        if not name:
+            if section in TOP_LEVEL:
+                data[section] = value
+                continue
+            raise SceneError(path, key, "an override is a dotted key SECTION.KEY, e.g. "
+                             "helix.EI_Nm2; sections are " + ", ".join(SECTIONS))
+        if section not in SECTIONS:
+            raise SceneError(path, key, "unknown section; allowed are " + ", ".join(SECTIONS))
+        table = data.setdefault(section, {})
+        if not isinstance(table, dict):
+            raise SceneError(path, section, f"must be a table [{section}]")
+        table[name] = value
+    return data
 
 
 def resolve(path) -> Path:
@@ -99,24 +125,25 @@ def resolve(path) -> Path:
 
 
 def load(path, elements: int | None = None, degree: int | None = None,
-         scheme: str | None = None) -> Parameters:
-    """Read and validate a scene; command-line overrides of the discretisation
-    are validated like the file's own values."""
+         scheme: str | None = None, overrides: dict | None = None) -> Parameters:
+    """Read and validate a scene.
+
+    ``elements``, ``degree`` and ``scheme`` set the discretisation;
+    ``overrides`` sets any dotted scene key (``{"helix.EI_Nm2": 9000.0}``).
+    Both are validated like the file's own values: a bad one raises
+    :class:`SceneError` naming the file, the key and what is allowed."""
     p = resolve(path)
     if not p.is_file():
-        raise SceneError(p, "file", "no such scene file")
+        raise SceneError(p, "file", "no such scene file (nor a shipped scene: "
+                         + ", ".join(sorted(f.stem for f in SCENE_DIR.glob("*.toml"))) + ")")
     try:
         data = tomllib.loads(p.read_text())
     except tomllib.TOMLDecodeError as err:
         raise SceneError(p, "file", f"is not valid TOML ({err})") from None
-    over = {k: v for k, v in (("elements", elements), ("degree", degree), ("scheme", scheme))
-            if v is not None}
-    if over:
-        data.setdefault("discretisation", {})
-        if not isinstance(data["discretisation"], dict):
-            raise SceneError(p, "discretisation", "must be a table [discretisation]")
-        data["discretisation"] = {**data["discretisation"], **over}
-    return parameters_from_dict(data, p)
+    disc = {f"discretisation.{k}": v for k, v in
+            (("elements", elements), ("degree", degree), ("scheme", scheme)) if v is not None}
+    data = apply_overrides(data, {**(overrides or {}), **disc}, p)
+    return parameters_from_dict(data, p, name=p.stem)
 
 
 def title(path) -> str:

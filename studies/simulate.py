@@ -1,73 +1,158 @@
-"""`rawehelix simulate`: the dynamics of a scene (Secs. 5.2, 5.3) from its stationary state.
+"""Dynamics of a scene (Secs. 5.2, 5.3) from its stationary state: :func:`compute`
+returns a :class:`TimeSeries`; :meth:`TimeSeries.write` writes it.
 
-Writes into the output directory, incrementally (an interrupted run keeps
-everything up to the last output time):
+Computing writes nothing.  ``TimeSeries.write(outdir)`` writes:
 
     time_series.csv   t [s], spin [rpm] at s = 0, ~L0/2, L0, ground torque [Nm],
                       tension [N] at s = 0 and L0, lateral displacement of the middle [m]
-    summary.json      key figures (rewritten at every output; "complete" at the end)
-    state.npz         the last good state (normalised, see DynamicsSolver.save_state)
-    centre_line.xdmf  (+ .h5) the moving centre line with tension, twist and spin
+    summary.json      key figures; ``solve_s`` is the time loop, ``wall_s`` the whole job
+    state.npz         the final (or last good) state (normalised, with SI scales)
+    centre_line.xdmf  (+ .h5) the moving centre line with tension, twist and spin,
+                      every ``time.fields_every_s``
     dynamics.png      Fig. 6: spins against the target, ground torque, tensions
-    helix_<t>s.png, helix.gif   pyvista renderings (if pyvista is installed)
+    helix_<t>s.png, helix.gif   pyvista pictures (if pyvista is installed)
+
+A run that fails raises :class:`SimulationError`, which carries the time
+series up to the last good state (``err.partial``), so a caller can write it.
+Long runs can checkpoint: ``compute(..., checkpoint=f, checkpoint_every_s=60)``
+calls ``f(partial)`` every 60 s of wall time (the command line writes the
+partial outputs there).
 """
 
 from __future__ import annotations
 
 import csv
+import logging
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import render, writers
-from rawehelix.studies.xdmf_series import PolylineSeries
+from rawehelix.studies import metrics, writers
+from rawehelix.studies.scene import SceneError
+
+log = logging.getLogger("rawehelix")
 
 COLUMNS = ("time_s", "spin_s0_rpm", "spin_mid_rpm", "spin_L0_rpm", "ground_torque_Nm",
            "tension_s0_N", "tension_L0_N", "lateral_mid_m")
-SETTLING_BAND = 0.02  # all three spins within 2% of the target
 
 
-def settling_time(t_s, spins_rpm, target_rpm) -> float | None:
-    """First time after which all three spins stay within 2% of the target (None if never)."""
-    if target_rpm == 0 or len(t_s) == 0:
-        return None
-    outside = np.any(np.abs(np.asarray(spins_rpm) - target_rpm) > SETTLING_BAND * abs(target_rpm),
-                     axis=1)
-    if outside[-1]:
-        return None
-    last_out = np.nonzero(outside)[0]
-    return float(t_s[last_out[-1] + 1]) if len(last_out) else float(t_s[0])
+class SimulationError(SolverError):
+    """The dynamics stopped; ``partial`` is the :class:`TimeSeries` up to the last good state."""
+
+    def __init__(self, message: str, partial: "TimeSeries"):
+        super().__init__(message)
+        self.partial = partial
 
 
-class Recorder:
-    """Turns solver states into rows, fields and files (rank 0 writes)."""
+@dataclass
+class Frame:
+    """The fields along s at one time (SI)."""
 
-    def __init__(self, solver: DynamicsSolver, outdir: Path | None, frames_every: int, title: str):
-        self.solver, self.q = solver, solver.q
-        self.outdir = Path(outdir) if outdir is not None else None
+    t_s: float
+    s_m: np.ndarray
+    x_m: np.ndarray  # (n, 3) centre line
+    alpha_rad: np.ndarray
+    tension_N: np.ndarray
+    twist_rad_per_m: np.ndarray
+    spin_rpm: np.ndarray
+
+
+@dataclass
+class TimeSeries:
+    """A dynamic run in SI units (arrays on rank 0; empty elsewhere)."""
+
+    params: Parameters
+    rows: np.ndarray  # (n, len(COLUMNS))
+    frames: list = field(default_factory=list)  # Frame every time.fields_every_s
+    final_state: dict | None = None  # normalised arrays of the last good state (+ SI scales)
+    summary: dict = field(default_factory=dict)
+    rank: int = 0
+    _start: float = 0.0
+
+    @property
+    def t_s(self) -> np.ndarray:
+        return self.rows[:, 0]
+
+    @property
+    def spin_rpm(self) -> np.ndarray:
+        """(n, 3): the spin at s = 0, ~L0/2 and L0 [rpm]."""
+        return self.rows[:, 1:4]
+
+    @property
+    def ground_torque_Nm(self) -> np.ndarray:
+        return self.rows[:, 4]
+
+    @property
+    def tension_s0_N(self) -> np.ndarray:
+        return self.rows[:, 5]
+
+    @property
+    def tension_s1_N(self) -> np.ndarray:
+        return self.rows[:, 6]
+
+    @property
+    def lateral_mid_m(self) -> np.ndarray:
+        """Displacement of the middle normal to the chord, from the start [m]."""
+        return self.rows[:, 7]
+
+    def write(self, outdir, pictures: bool = True, gif: bool = True) -> Path:
+        """Write the files listed in the module docstring into ``outdir`` (rank 0)."""
+        outdir = Path(outdir)
+        if self.rank != 0:
+            return outdir
+        outdir.mkdir(parents=True, exist_ok=True)
+        with open(outdir / "time_series.csv", "w", newline="") as f:
+            out = csv.writer(f)
+            out.writerow(COLUMNS)
+            out.writerows([[f"{x:.9g}" for x in row] for row in self.rows])
+        if self.final_state is not None:
+            writers.write_npz(outdir / "state.npz", self.final_state)
+        if self.frames:
+            writers.frames_xdmf(outdir / "centre_line.xdmf", self.frames)
+        if pictures and len(self.rows):
+            self._figures(outdir, gif)
+        self.summary["wall_s"] = time.perf_counter() - self._start
+        writers.write_json(outdir / "summary.json", self.summary)
+        return outdir
+
+    def _figures(self, outdir: Path, gif: bool):
+        title = self.params.title or self.params.name
+        writers.dynamics_png(outdir / "dynamics.png", self.rows, self.params.controller.target_rpm,
+                             title)
+        from rawehelix.studies import render
+        if not self.frames or not render.available():
+            return
+        R = self.params.helix.radius_m
+        reference = self.frames[0].x_m
+        for frame in (self.frames[0], self.frames[-1]):
+            render.helix_png(outdir / f"helix_{frame.t_s:.2f}s.png", frame.x_m, frame.alpha_rad,
+                             frame.tension_N, R, title, time_s=frame.t_s, reference_m=reference)
+        if gif:
+            render.helix_gif(outdir / "helix.gif",
+                             [(f.t_s, f.x_m, f.alpha_rad, f.tension_N) for f in self.frames], R,
+                             title=title, reference_m=reference)
+
+
+class _Recorder:
+    """Rows at every output time, fields at every ``fields_every`` (collective)."""
+
+    def __init__(self, solver, fields_every: int):
+        self.q = solver.q
         self.rank0 = solver.comm.rank == 0
         self.rows: list[tuple] = []
-        self.frames: list = []
-        self.frames_every = max(1, frames_every)
-        self.title = title
+        self.frames: list[Frame] = []
+        self.fields_every = max(1, fields_every)
         self.r_mid0 = None
         top = self.q.top_position(0.0)
         self.chord = top / np.linalg.norm(top)
-        self.csv = self.xdmf = None
-        if self.outdir is not None and self.rank0:
-            self.outdir.mkdir(parents=True, exist_ok=True)
-            self._csv_file = open(self.outdir / "time_series.csv", "w", newline="")
-            self.csv = csv.writer(self._csv_file)
-            self.csv.writerow(COLUMNS)
-            self.xdmf = PolylineSeries(self.outdir / "centre_line.xdmf")
 
-    def __call__(self, solver: DynamicsSolver):
+    def __call__(self, solver):
         q = self.q
         v = solver.probes.values()
         r_mid = np.array([v["x_mid"], v["y_mid"], v["z_mid"]])
@@ -75,131 +160,115 @@ class Recorder:
             self.r_mid0 = r_mid
         d = r_mid - self.r_mid0
         lateral = np.linalg.norm(d - d.dot(self.chord) * self.chord)  # normal to the chord
-        row = (float(q.time_s(solver.t)), *(float(q.spin_rpm(v[k])) for k in ("spin0", "spin_mid", "spin1")),
+        row = (float(q.time_s(solver.t)),
+               *(float(q.spin_rpm(v[k])) for k in ("spin0", "spin_mid", "spin1")),
                float(q.torque_Nm(v["m0"])), float(q.tension_N(v["tension0"])),
                float(q.tension_N(v["tension1"])), float(q.length_m(lateral)))
         self.rows.append(row)
-        fields = solver.probes.fields()  # collective
-        k = len(self.rows) - 1
-        if self.outdir is not None:
-            solver.save_state(self.outdir / "state.npz")  # collective
-        if not self.rank0 or self.outdir is None:
-            if self.rank0 and k % self.frames_every == 0:
-                self.frames.append(self._frame(row[0], fields))
+        if (len(self.rows) - 1) % self.fields_every == 0:
+            self.frame(solver, row[0])
+
+    def frame(self, solver, t_s: float):
+        f = solver.probes.fields()  # collective
+        if f is None or (self.frames and self.frames[-1].t_s == t_s):
             return
-        self.csv.writerow([f"{x:.9g}" for x in row])
-        self._csv_file.flush()
-        x_m = q.length_m(fields["r"])
-        self.xdmf.write(row[0], x_m, {
-            "s_m": q.length_m(fields["s"]),
-            "tension_N": q.tension_N(fields["tension"]),
-            "twist_rad_per_m": fields["twist"] / q.L0,
-            "alpha_rad": fields["alpha"],
-            "spin_rpm": q.spin_rpm(fields["alpha_t"]),
-        })
-        if k % self.frames_every == 0:
-            self.frames.append(self._frame(row[0], fields))
-
-    def _frame(self, t_s, fields):
-        return (t_s, self.q.length_m(fields["r"]), np.array(fields["alpha"]))
-
-    def close(self):
-        if self.csv is not None:
-            self._csv_file.close()
-            self.xdmf.close()
+        q = self.q
+        self.frames.append(Frame(t_s, q.length_m(f["s"]), q.length_m(f["r"]), np.array(f["alpha"]),
+                                 q.tension_N(f["tension"]), f["twist"] / q.L0,
+                                 q.spin_rpm(f["alpha_t"])))
 
 
-def run(params: Parameters, outdir: Path | None, name: str = "scene", title: str = "",
-        until_s: float | None = None, comm=MPI.COMM_WORLD, log=print, options: dict | None = None,
-        picture_times_s=None, progress: bool | None = None) -> dict:
-    """Simulate the scene; returns the summary (every rank).  Raises SolverError on failure
-    (after writing summary.json with the error and the last good state)."""
+def _state_file(solver) -> dict | None:
+    """The solver's last good state as arrays (rank 0), with its SI scales."""
+    a = solver.state_arrays()  # collective
+    if a is None:
+        return None
+    q, disc = solver.q, solver.params.discretisation
+    return {**a, "t_s": q.time_s(a["t"]), "L0_m": q.L0, "t_scale_s": q.t_scale,
+            "elements": disc.elements, "degree": disc.degree}
+
+
+def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORLD,
+            options: dict | None = None, progress: bool | None = None,
+            checkpoint=None, checkpoint_every_s: float = 60.0) -> TimeSeries:
+    """Integrate the scene from its stationary state to ``until_s`` [s] (default
+    ``time.until_s``); returns the :class:`TimeSeries` (complete on rank 0).
+
+    ``options``: PETSc options of the time integrator (without the prefix).
+    ``progress``: a progress bar on rank 0 (default: when stdout is a terminal).
+    ``checkpoint(partial)``: called every ``checkpoint_every_s`` of wall time.
+    Raises :class:`SceneError` for a scene this solver cannot run and
+    :class:`SimulationError` (with the partial series) when the dynamics stop."""
+    from rawehelix.solvers.dynamics import DynamicsSolver
+
     start = time.perf_counter()
+    if params.discretisation.scheme != "fe":
+        raise SceneError(params.name, "discretisation.scheme", "'simulate' runs the FE scheme "
+                         "(the spline reference is solvers.spline_galerkin.dynamics)")
+    if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
+        raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
     q = params.normalised()
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s
-    n_out = max(1, int(round(until_s / tm.output_every_s)))
-    solver = DynamicsSolver(params, comm, options=options)
-    rec = Recorder(solver, outdir, frames_every=max(1, n_out // 60), title=title or name)
+    solver = DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name)
+    rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)))
     show = (progress if progress is not None else sys.stdout.isatty()) and comm.rank == 0
     bar = None
     if show:
         from tqdm import tqdm
-        bar = tqdm(total=round(until_s, 6), unit="s", desc=name, bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]")
-
-    summary = {"scene": name, "elements": disc.elements, "degree": disc.degree,
+        bar = tqdm(total=round(until_s, 6), unit="s", desc=params.name,
+                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]")
+    summary = {"scene": params.name, "elements": disc.elements, "degree": disc.degree,
                "dofs": solver.rod.dof_count(), "ranks": comm.size,
                "ts_type": solver.ts.getType(), "target_rpm": params.controller.target_rpm,
                "model": params.model.describe()}
+    loop_start = time.perf_counter()
 
-    def write_summary(complete: bool, error: str | None = None):
-        if comm.rank != 0:
-            return
+    def result(complete: bool, error: str | None = None) -> TimeSeries:
         rows = np.array(rec.rows) if rec.rows else np.zeros((0, len(COLUMNS)))
-        summary.update({
-            "complete": complete, "error": error,
-            "simulated_s": float(rows[-1, 0]) if len(rows) else 0.0,
-            "wall_s": time.perf_counter() - start,
-            "steps": solver.steps, "newton_iterations": solver.newton_iterations,
-            "settling_time_s": settling_time(rows[:, 0], rows[:, 1:4], params.controller.target_rpm),
-        })
+        series = TimeSeries(params, rows, list(rec.frames), _state_file(solver), dict(summary),
+                            comm.rank, start)
+        s = series.summary
+        s.update({"complete": complete, "error": error,
+                  "simulated_s": float(rows[-1, 0]) if len(rows) else 0.0,
+                  "solve_s": time.perf_counter() - loop_start,
+                  "wall_s": time.perf_counter() - start,
+                  "steps": solver.steps, "newton_iterations": solver.newton_iterations,
+                  "settling_time_s": metrics.settling_time(rows[:, 0], rows[:, 1:4],
+                                                           params.controller.target_rpm)})
         if len(rows):
-            summary["final"] = {"spin_rpm": {"s0": rows[-1, 1], "mid": rows[-1, 2], "L0": rows[-1, 3]},
-                                "ground_torque_Nm": rows[-1, 4], "tension_s0_N": rows[-1, 5],
-                                "tension_L0_N": rows[-1, 6], "lateral_mid_m": rows[-1, 7]}
-            summary["tension_range_N"] = [float(rows[:, 5:7].min()), float(rows[:, 5:7].max())]
-            summary["real_time_factor"] = summary["simulated_s"] / max(summary["wall_s"], 1e-12)
-        if outdir is not None:
-            writers.write_json(Path(outdir) / "summary.json", summary)
+            s["final"] = {"spin_rpm": {"s0": rows[-1, 1], "mid": rows[-1, 2], "L0": rows[-1, 3]},
+                          "ground_torque_Nm": rows[-1, 4], "tension_s0_N": rows[-1, 5],
+                          "tension_L0_N": rows[-1, 6], "lateral_mid_m": rows[-1, 7]}
+            s["tension_range_N"] = [float(rows[:, 5:7].min()), float(rows[:, 5:7].max())]
+            s["real_time_factor"] = s["simulated_s"] / max(s["solve_s"], 1e-12)
+        return series
 
-    last_summary = [0.0]
+    last_checkpoint = [time.perf_counter()]
 
     def on_output(sv):
         rec(sv)
         if bar is not None:
             bar.update(round(rec.rows[-1][0] - bar.n, 6))
-        if time.perf_counter() - last_summary[0] > 2.0:  # incremental, cheap
-            write_summary(False)
-            last_summary[0] = time.perf_counter()
+        if checkpoint is not None and time.perf_counter() - last_checkpoint[0] > checkpoint_every_s:
+            checkpoint(result(False))  # collective
+            last_checkpoint[0] = time.perf_counter()
 
-    error = None
     try:
         solver.advance(until_s / q.t_scale, on_output=on_output,
                        output_every=tm.output_every_s / q.t_scale)
     except SolverError as err:
-        error = str(err)
+        rec.frame(solver, float(q.time_s(solver.state().t)))
+        raise SimulationError(str(err), result(False, str(err))) from None
     finally:
         if bar is not None:
             bar.close()
-        rec.close()
-    if outdir is not None:
-        solver.save_state(Path(outdir) / "state.npz")
-    write_summary(error is None, error)
-    if error is not None:
-        raise SolverError(error + (f" The last good state is in {Path(outdir) / 'state.npz'}."
-                                   if outdir is not None else ""))
-    if comm.rank == 0 and outdir is not None:
-        _figures(params, rec, Path(outdir), title or name, picture_times_s, log)
-        writers.write_json(Path(outdir) / "summary.json", summary)
-        log(f"{name}: {summary['steps']} steps, {summary['newton_iterations']} Newton iterations, "
-            f"{summary['wall_s']:.1f} s wall, real-time factor {summary.get('real_time_factor', 0):.1f}")
-        f = summary.get("final", {})
-        if f:
-            log(f"  final spin {f['spin_rpm']['s0']:.3f} / {f['spin_rpm']['mid']:.3f} / "
-                f"{f['spin_rpm']['L0']:.3f} rpm, ground torque {f['ground_torque_Nm']:.3f} Nm, "
-                f"T(0) = {f['tension_s0_N']:.2f} N; wrote {outdir}")
-    return comm.bcast(summary, root=0)
-
-
-def _figures(params, rec: Recorder, outdir: Path, title: str, picture_times_s, log):
-    rows = np.array(rec.rows)
-    writers.dynamics_png(outdir / "dynamics.png", rows, params.controller.target_rpm, title)
-    R = params.helix.radius_m
-    frames = rec.frames
-    if not frames:
-        return
-    times = picture_times_s if picture_times_s is not None else [frames[0][0], frames[-1][0]]
-    for t in times:
-        t_f, x_m, alpha = min(frames, key=lambda f: abs(f[0] - t))
-        render.png(outdir / f"helix_{t_f:.2f}s.png", x_m, alpha, R, f"{title}  t = {t_f:.2f} s")
-    render.gif(outdir / "helix.gif", [(f"t = {t:.2f} s", x, a) for t, x, a in frames], R)
+    rec.frame(solver, rec.rows[-1][0] if rec.rows else 0.0)  # the last fields too
+    series = result(True)
+    s = series.summary
+    if comm.rank == 0:
+        log.info("%s: %d steps, %d Newton iterations, %.1f s, real-time factor %.1f",
+                 params.name, s["steps"], s["newton_iterations"], s["solve_s"],
+                 s.get("real_time_factor", 0.0))
+    series.summary = comm.bcast(s, root=0)
+    return series

@@ -1,40 +1,85 @@
-"""`rawehelix stationary`: the stationary state of Sec. 5.1, checked against shooting."""
+"""The stationary state of Sec. 5.1, checked against shooting: :func:`compute`
+returns a :class:`Stationary`; :meth:`Stationary.write` writes summary.json,
+stationary.png and centre_line.xdmf.  Computing writes nothing."""
 
 from __future__ import annotations
 
+import logging
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.solvers import shooting
-from rawehelix.solvers.planar import planar_allowed
-from rawehelix.solvers.stationary import StationarySolver, sag
 from rawehelix.studies import writers
+from rawehelix.studies.scene import SceneError
+
+log = logging.getLogger("rawehelix")
 
 
-def run(params: Parameters, outdir: Path | None, name: str = "scene", title: str = "",
-        comm=MPI.COMM_WORLD, log=print) -> dict:
-    """Solve, compare with shooting, write summary.json, PNG and XDMF into ``outdir``.
+@dataclass
+class Stationary:
+    """A stationary state in SI units (arrays on rank 0, None elsewhere)."""
 
-    Returns the summary (on every rank).  Nothing is written if ``outdir`` is None."""
+    params: Parameters
+    s_m: np.ndarray | None  # arc length of the centre-line nodes [m]
+    centre_line_m: np.ndarray | None  # (n, 3) [m]; z points down (Sec. 2)
+    s_tension_m: np.ndarray | None  # arc length of the tension nodes [m]
+    tension_N: np.ndarray | None  # T(s) [N], Eq. (29)
+    shooting_centre_line_m: np.ndarray | None  # the shooting reference at s_m [m]
+    summary: dict = field(default_factory=dict)
+    state: object = None  # the RodState (normalised) for solvers that take it
+    rank: int = 0
+
+    def write(self, outdir) -> Path:
+        """summary.json, stationary.png (centre line and tension) and
+        centre_line.xdmf (for ParaView) into ``outdir`` (rank 0 writes)."""
+        outdir = Path(outdir)
+        if self.rank != 0:
+            return outdir
+        outdir.mkdir(parents=True, exist_ok=True)
+        title = self.params.title or self.params.name
+        writers.centre_line_png(outdir / "stationary.png", self.s_m, self.centre_line_m,
+                                self.s_tension_m, self.tension_N, title,
+                                reference_x_m=self.shooting_centre_line_m)
+        writers.centre_line_xdmf(outdir / "centre_line.xdmf", self.centre_line_m, {
+            "s_m": self.s_m, "tension_N": np.interp(self.s_m, self.s_tension_m, self.tension_N)})
+        writers.write_json(outdir / "summary.json", self.summary)
+        return outdir
+
+
+def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
+    """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
+    allows it), compared with the shooting solution of Sys. (67)."""
+    from rawehelix.solvers import shooting
+    from rawehelix.solvers.planar import planar_allowed
+    from rawehelix.solvers.stationary import StationarySolver, sag
+
+    if params.discretisation.scheme != "fe":
+        raise SceneError(params.name, "discretisation.scheme",
+                         "'stationary' runs the FE scheme; the spline reference's stationary "
+                         "state is part of 'modes'")
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
     planar = params.model.reduction == "auto" and planar_allowed(params)
-    solver = StationarySolver(params, comm, scene=name, planar=planar)
+    solver = StationarySolver(params, comm, scene=params.name, planar=planar)
     result = solver.solve()
     reference = shooting.solve(q)  # the independent reference, Sys. (67)
     residual_at_shooting = solver.residual_at(reference.centre_line)  # collective
+    out = Stationary(params, None, None, None, None, None, state=result.state, rank=comm.rank)
     summary = None
     if comm.rank == 0:
         x = q.length_m(result.centre_line)
         x_ref = q.length_m(reference.centre_line(result.s))
         T = q.tension_N(result.tension)
+        out.s_m, out.centre_line_m = q.length_m(result.s), x
+        out.s_tension_m, out.tension_N = q.length_m(result.s_tension), T
+        out.shooting_centre_line_m = x_ref
         summary = {
-            "scene": name,
+            "scene": params.name,
             "elements": disc.elements,
             "degree": disc.degree,
             "mesh": disc.mesh,
@@ -50,21 +95,20 @@ def run(params: Parameters, outdir: Path | None, name: str = "scene", title: str
             "residual_at_shooting": float(residual_at_shooting),
             "wall_s": time.perf_counter() - start,
         }
-        log(f"{name}: {'planar' if planar else 'full'} model, N = {disc.elements}, p = {disc.degree}: "
-            f"{summary['newton_iterations']} Newton iterations, {summary['wall_s']:.2f} s")
-        log(f"  tension T(0) = {T[0]:.3f} N, T(L0) = {T[-1]:.3f} N "
-            f"(shooting T(0) = {summary['shooting_tension_s0_N']:.3f} N)")
-        log(f"  sag {summary['sag_m']:.5f} m; FE vs shooting max |dr| = "
-            f"{summary['shooting_max_diff_m']:.3e} m; FE residual at shooting = "
-            f"{residual_at_shooting:.3e}")
-        if outdir is not None:
-            outdir = Path(outdir)
-            outdir.mkdir(parents=True, exist_ok=True)
-            s_m = q.length_m(result.s)
-            writers.centre_line_png(outdir / "stationary.png", s_m, x, q.length_m(result.s_tension),
-                                    T, title or name, reference_x_m=x_ref)
-            writers.centre_line_xdmf(outdir / "centre_line.xdmf", x, {
-                "s_m": s_m, "tension_N": np.interp(result.s, result.s_tension, T)})
-            writers.write_json(outdir / "summary.json", summary)
-            log(f"  wrote {outdir}/summary.json, stationary.png, centre_line.xdmf")
-    return comm.bcast(summary, root=0)
+        log.info("%s: %s model, N = %d, p = %d: %d Newton iterations, %.2f s", params.name,
+                 "planar" if planar else "full", disc.elements, disc.degree,
+                 result.newton_iterations, summary["wall_s"])
+    out.summary = comm.bcast(summary, root=0)
+    return out
+
+
+def report(result: Stationary) -> str:
+    """The lines a user reads after a stationary solve."""
+    s = result.summary
+    T = s["tension_N"]
+    return (f"{s['scene']}: N = {s['elements']}, p = {s['degree']} ({s['model'].split(';')[0]}): "
+            f"{s['newton_iterations']} Newton iterations, {s['wall_s']:.2f} s\n"
+            f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N "
+            f"(shooting T(0) = {s['shooting_tension_s0_N']:.3f} N)\n"
+            f"  sag {s['sag_m']:.5f} m; FE vs shooting max |dr| = {s['shooting_max_diff_m']:.3e} m; "
+            f"FE residual at shooting = {s['residual_at_shooting']:.3e}")

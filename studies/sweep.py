@@ -1,4 +1,4 @@
-"""`rawehelix sweep`: the frequency sweep of Sec. 5.3 (Fig. 8), resumable and MPI-parallel.
+"""The frequency sweep of Sec. 5.3 (Fig. 8): resumable and MPI-parallel.
 
 For each f1 the response is integrated until periodic (see
 :mod:`rawehelix.solvers.periodic`) and the maximum, minimum and mean tension at
@@ -6,30 +6,33 @@ s = 0 over the last periods are recorded.  Each f1 continues from the final
 state of the previous one, as in the paper.
 
 Under ``mpirun -n k`` the sorted frequency list is cut into k contiguous
-chunks of about equal estimated cost (:func:`chunks`); each rank runs its chunk on its own communicator (COMM_SELF), with
-continuation inside the chunk; the first point of a chunk starts from the
-stationary state with a lead-in (``sweep.lead_in_s``).  Rank 0 gathers.
+chunks of about equal estimated cost (:func:`chunks`); each rank runs its chunk
+on its own communicator (COMM_SELF), with continuation inside the chunk; the
+first point of a chunk starts from the stationary state with a lead-in
+(``sweep.lead_in_s``).  Rank 0 gathers.
 
-Output directory:
+:func:`compute` returns a :class:`SweepResult` and writes nothing, unless the
+caller names a ``checkpoint`` directory, which makes the sweep resumable:
 
     sweep.json          the results file: fingerprint and finished points,
                         rewritten atomically after every point
     points/f1_*.json    one finished point (entry and its tension series)
     points/f1_*.npz     its final state, for continuation and resuming
     computed.log        one line per point computed (to check resuming)
-    summary.json        points, resonance_Hz, elements, degree, ranks, wall_s
-    sweep.png           Fig. 8: maximum tension against f1, inset T(t) near 10 Hz
 
-Re-running the same command skips finished points; a run with another scene
-or discretisation into the same directory is refused.
+The same call again skips finished points; a checkpoint of another scene or
+discretisation is refused.  :meth:`SweepResult.write` writes summary.json
+(points, resonance_Hz, elements, degree, ranks, wall_s) and sweep.png (Fig. 8,
+inset T(t) near 10 Hz).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
+import logging
 import os
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +42,7 @@ from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers
+from rawehelix.studies.scene import SceneError
 
 RESULTS = "sweep.json"
 
@@ -50,7 +54,7 @@ class SweepError(ValueError):
 def fingerprint(params: Parameters) -> str:
     """A hash of everything that changes the points: not f1 itself, the f1
     list, the end time nor the output sampling (the time step does count)."""
-    data = dataclasses.asdict(params)
+    data = params.as_dict()
     data["ends"].pop("circle_frequency_Hz")
     data["time"] = {"dt_s": data["time"]["dt_s"]}
     for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
@@ -73,17 +77,96 @@ def _key(f1: float) -> str:
     return f"f1_{f1:010.5f}"
 
 
-def _write_npz(path: Path, arrays: dict):
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp.npz")
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
+def validate_frequencies(f1_Hz) -> list[float]:
+    """The f1 list, checked once: finite numbers > 0 [Hz], sorted, without repeats."""
+    try:
+        values = [float(f) for f in f1_Hz]
+    except (TypeError, ValueError):
+        raise SceneError("sweep", "f1_Hz", f"{f1_Hz!r}: must be a list of numbers [Hz]") from None
+    if not values:
+        raise SceneError("sweep", "f1_Hz", "must hold at least one frequency")
+    bad = [f for f in values if not (f > 0 and np.isfinite(f))]
+    if bad:
+        raise SceneError("sweep", "f1_Hz", f"{bad[0]!r}: every f1 must be a finite number > 0 [Hz]")
+    return sorted({round(f, 10) for f in values})
 
 
-def _finished(outdir: Path, f1: float) -> dict | None:
-    path = outdir / "points" / f"{_key(f1)}.json"
-    if not path.exists():
-        return None
-    return json.loads(path.read_text())
+class MemoryStore:
+    """Finished points kept in memory (a sweep without a checkpoint directory)."""
+
+    def __init__(self):
+        self.records, self.states = {}, {}
+
+    def finished(self, f1: float) -> dict | None:
+        return self.records.get(_key(f1))
+
+    def state(self, f1: float):
+        return self.states.get(_key(f1))
+
+    def save(self, f1: float, record: dict, state_arrays: dict | None, note: str = ""):
+        self.records[_key(f1)] = record
+        if state_arrays is not None:
+            self.states[_key(f1)] = state_arrays
+
+    def all_records(self, comm) -> list[dict]:
+        gathered = comm.gather(list(self.records.values()), root=0)
+        return None if gathered is None else [r for part in gathered for r in part]
+
+
+class DirectoryStore:
+    """Finished points in a checkpoint directory: resumable (see the module docstring)."""
+
+    def __init__(self, outdir: Path, header: dict):
+        self.outdir, self.header = Path(outdir), header
+
+    def open(self, comm):
+        """Refuse a directory of another sweep, then create it (collective)."""
+        error = None
+        if comm.rank == 0:
+            try:
+                check_directory(self.outdir, self.header)
+            except SweepError as err:
+                error = str(err)
+        error = comm.bcast(error, root=0)
+        if error:
+            raise SweepError(error)
+        if comm.rank == 0:
+            (self.outdir / "points").mkdir(parents=True, exist_ok=True)
+            merge_results(self.outdir, self.header)
+        comm.Barrier()
+
+    def finished(self, f1: float) -> dict | None:
+        path = self.outdir / "points" / f"{_key(f1)}.json"
+        return json.loads(path.read_text()) if path.exists() else None
+
+    def state(self, f1: float):
+        path = self.outdir / "points" / f"{_key(f1)}.npz"
+        if not path.exists():
+            return None
+        with np.load(path) as data:
+            return {k: data[k] for k in data.files}
+
+    def save(self, f1: float, record: dict, state_arrays: dict | None, note: str = ""):
+        points = self.outdir / "points"
+        if state_arrays is not None:
+            writers.write_npz(points / f"{_key(f1)}.npz", state_arrays)
+        writers.write_json(points / f"{_key(f1)}.json", record)
+        with open(self.outdir / "computed.log", "a") as f:
+            f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}{note}\n")
+        merge_results(self.outdir, self.header)
+
+    def all_records(self, comm) -> list[dict] | None:
+        comm.Barrier()
+        if comm.rank != 0:
+            return None
+        records = []
+        for path in sorted((self.outdir / "points").glob("f1_*.json")):
+            try:
+                records.append(json.loads(path.read_text()))
+            except json.JSONDecodeError:
+                continue
+        merge_results(self.outdir, self.header)
+        return records
 
 
 def merge_results(outdir: Path, header: dict) -> dict:
@@ -115,32 +198,30 @@ def check_directory(outdir: Path, header: dict):
             f"p = {old.get('degree')}); use another -o directory or delete it")
 
 
-def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict,
-              backend=None, log=print) -> int:
+def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=None) -> int:
     """Run one rank's contiguous chunk with continuation; return the points computed."""
+    log = log or logging.getLogger("rawehelix").info
+
     def backend_factory():
         return make_backend(params, MPI.COMM_SELF)
 
     backend = backend or backend_factory()
     q = params.normalised()
-    (outdir / "points").mkdir(parents=True, exist_ok=True)
     state, t, computed = None, 0.0, 0
     for i, f1 in enumerate(chunk):
-        if _finished(outdir, f1) is not None:
+        if store.finished(f1) is not None:
             state = None  # the next unfinished point reloads its predecessor's state
             continue
         lead_in = True
         if state is None:
-            prev = outdir / "points" / f"{_key(chunk[i - 1])}.npz" if i > 0 else None
-            if prev is not None and prev.exists():
-                with np.load(prev) as data:
-                    state, t = backend.unpack(data), float(data["t"])
+            prev = store.state(chunk[i - 1]) if i > 0 else None
+            if prev is not None:
+                state, t = backend.unpack(prev), float(prev["t"])
                 lead_in = False
             else:
                 state, t = backend.stationary(), 0.0
         else:
             lead_in = False
-        key = _key(f1)
         try:
             result, state, t = periodic_response(backend, q, f1, state, t, params.sweep, lead_in)
         except (SolverError, FloatingPointError, RuntimeError) as err:
@@ -149,16 +230,13 @@ def run_chunk(params: Parameters, outdir: Path, chunk: list[float], header: dict
                      "tension_mean_N": None, "periods": 0, "periodic": False, "slack": None,
                      "failed": str(err), "wall_s": None, "start": "stationary" if lead_in
                      else "continuation"}
-            writers.write_json(outdir / "points" / f"{key}.json", {"entry": entry})
-            _computed(outdir, header, f1, " failed")
+            store.save(f1, {"entry": entry}, None, " failed")
             log(f"  f1 = {f1:6.2f} Hz: FAILED: {err}")
             backend, state, computed = backend_factory(), None, computed + 1
             continue
-        _write_npz(outdir / "points" / f"{key}.npz", {**backend.pack(state), "t": t})
-        writers.write_json(outdir / "points" / f"{key}.json", {
-            "entry": result.entry(), "period_maxima_N": result.period_maxima_N,
-            "series_t_s": result.series_t_s, "series_tension_N": result.series_tension_N})
-        _computed(outdir, header, f1)
+        store.save(f1, {"entry": result.entry(), "period_maxima_N": result.period_maxima_N,
+                        "series_t_s": result.series_t_s, "series_tension_N": result.series_tension_N},
+                   {**backend.pack(state), "t": t})
         computed += 1
         flag = ("" if result.periodic else "  NOT PERIODIC (hit max_periods)") + \
             ("  SLACK (T <= 0)" if result.slack else "")
@@ -177,13 +255,6 @@ SETTLE_S = 3.0
 def point_cost(f1: float, sweep: Sweep) -> float:
     """Estimated simulated time of one point [s]: the cost model of :func:`chunks`."""
     return sweep.min_periods / f1 + SETTLE_S
-
-
-def _computed(outdir: Path, header: dict, f1: float, note: str = ""):
-    """A point is finished: one line in computed.log, then sweep.json merged."""
-    with open(outdir / "computed.log", "a") as f:
-        f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}{note}\n")
-    merge_results(outdir, header)
 
 
 def chunks(frequencies: list[float], k: int, sweep: Sweep | None = None) -> list[list[float]]:
@@ -217,39 +288,67 @@ def chunks(frequencies: list[float], k: int, sweep: Sweep | None = None) -> list
     return [f[a:b] for a, b in reversed(bounds)]
 
 
-def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = "scene",
-        comm=MPI.COMM_WORLD, log=print, series: bool = False) -> dict:
-    """The whole sweep; returns the summary on every rank."""
-    start = time.perf_counter()
-    outdir = Path(outdir)
-    disc = params.discretisation
-    header = {"scene": name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
-              "elements": disc.elements, "degree": disc.degree if disc.scheme == "fe" else None}
-    error = None
-    if comm.rank == 0:
-        try:
-            check_directory(outdir, header)
-        except SweepError as err:
-            error = str(err)
-    error = comm.bcast(error, root=0)
-    if error:
-        raise SweepError(error)
-    if comm.rank == 0:
+@dataclass
+class SweepResult:
+    """The points of a sweep (rank 0; empty elsewhere) and its summary."""
+
+    params: Parameters
+    points: list  # summary entries, sorted by f1: f1_Hz, tension_max_N, ..., periodic
+    series: dict = field(default_factory=dict)  # f1 -> (t_s, tension_N) over the recorded periods
+    summary: dict = field(default_factory=dict)
+    rank: int = 0
+
+    def write(self, outdir, series: bool = False) -> Path:
+        """summary.json and sweep.png (and, with ``series``, each point's T(t) as CSV)."""
+        outdir = Path(outdir)
+        if self.rank != 0:
+            return outdir
         outdir.mkdir(parents=True, exist_ok=True)
-        merge_results(outdir, header)
-    comm.Barrier()
+        writers.write_json(outdir / "summary.json", self.summary)
+        sweep_png(outdir / "sweep.png", self.points, self.series, self.params.name)
+        if series:
+            write_series(outdir, self.series)
+        return outdir
+
+
+def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None,
+            log=None) -> SweepResult:
+    """The periodic response at each f1 [Hz] (default: the scene's [sweep] list).
+
+    ``checkpoint``: a directory that keeps finished points, so that the same
+    call resumes a stopped sweep (see the module docstring); without it the
+    sweep writes nothing.  Returns the :class:`SweepResult` (summary on every rank)."""
+    start = time.perf_counter()
+    frequencies = validate_frequencies(params.sweep.frequencies() if f1_Hz is None else f1_Hz)
+    disc = params.discretisation
+    header = {"scene": params.name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
+              "elements": disc.elements, "degree": disc.degree if disc.scheme == "fe" else None}
+    if checkpoint is not None:
+        store = DirectoryStore(Path(checkpoint), header)
+        store.open(comm)
+    else:
+        store = MemoryStore()
     mine = chunks(frequencies, comm.size, params.sweep)[comm.rank]
-    rank_log = log if comm.size == 1 else (lambda m: print(f"[rank {comm.rank}]{m}", flush=True))
+    rank_log = log or logging.getLogger("rawehelix").info
+    if comm.size > 1:
+        rank_log = (lambda m, _log=rank_log: _log(f"[rank {comm.rank}]{m}"))
     if mine:
         rank_log(f"  chunk {mine[0]:.2f}-{mine[-1]:.2f} Hz ({len(mine)} points)")
-    computed = run_chunk(params, outdir, mine, header, log=rank_log)
+    computed = run_chunk(params, store, mine, log=rank_log)
     computed = comm.allreduce(computed, op=MPI.SUM)
-    comm.Barrier()
+    records = store.all_records(comm)
+    result = SweepResult(params, [], rank=comm.rank)
     summary = None
     if comm.rank == 0:
-        data = merge_results(outdir, header)
         wanted = {round(f, 5) for f in frequencies}
-        points = [p for p in data["points"] if round(p["f1_Hz"], 5) in wanted]
+        records = sorted((r for r in records if round(r["entry"]["f1_Hz"], 5) in wanted),
+                         key=lambda r: r["entry"]["f1_Hz"])
+        points = [r["entry"] for r in records]
+        result.points = points
+        result.series = {r["entry"]["f1_Hz"]: (np.asarray(r["series_t_s"]),
+                                                np.asarray(r["series_tension_N"]))
+                         for r in records if r.get("series_t_s") is not None
+                         and len(r["series_t_s"])}
         good = [p for p in points if p.get("tension_max_N") is not None]
         peak = max(good, key=lambda p: p["tension_max_N"]) if good else None
         summary = {**header, "points": points,
@@ -261,33 +360,25 @@ def run(params: Parameters, outdir: Path, frequencies: list[float], name: str = 
                    "ranks": comm.size, "computed_now": computed,
                    "model": params.model.describe(),
                    "wall_s": time.perf_counter() - start}
-        writers.write_json(outdir / "summary.json", summary)
-        sweep_png(outdir, points, name)
-        if series:
-            write_series(outdir, points)
-        if peak:
-            log(f"  resonance (largest T max) at f1 = {summary['resonance_Hz']} Hz, "
-                f"T max = {summary['peak_tension_N']:.1f} N; wrote {outdir}/summary.json, sweep.png")
-    return comm.bcast(summary, root=0)
+    result.summary = comm.bcast(summary, root=0)
+    return result
 
 
-def write_series(outdir: Path, points: list[dict]):
+def write_series(outdir: Path, series: dict):
     """Per-point time series of the tension at s = 0 (CSV) over the recorded periods."""
-    for p in points:
-        data = _finished(outdir, p["f1_Hz"])
-        if not data.get("series_t_s"):
-            continue
-        path = outdir / "points" / f"{_key(p['f1_Hz'])}_tension.csv"
-        np.savetxt(path, np.column_stack([data["series_t_s"], data["series_tension_N"]]),
-                   delimiter=",", header="t_s,tension_s0_N", comments="")
+    (Path(outdir) / "points").mkdir(parents=True, exist_ok=True)
+    for f1, (t, T) in series.items():
+        path = Path(outdir) / "points" / f"{_key(f1)}_tension.csv"
+        np.savetxt(path, np.column_stack([t, T]), delimiter=",", header="t_s,tension_s0_N",
+                   comments="")
 
 
-def sweep_png(outdir: Path, points: list[dict], title: str, inset_Hz: float = 10.0):
+def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz: float = 10.0):
     """Fig. 8: maximum tension at s = 0 against f1; the inset shows T(t) near 10 Hz."""
     failed = [p["f1_Hz"] for p in points if p.get("tension_max_N") is None]
     points = [p for p in points if p.get("tension_max_N") is not None]
     if not points:
-        return
+        return None
     plt = writers._pyplot()
     f = np.array([p["f1_Hz"] for p in points])
     tmax = np.array([p["tension_max_N"] for p in points])
@@ -306,16 +397,16 @@ def sweep_png(outdir: Path, points: list[dict], title: str, inset_Hz: float = 10
     ax.set_title(f"{title}: maximum tension against f1 (Fig. 8)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")
-    near = points[int(np.argmin(np.abs(f - inset_Hz)))]
-    data = _finished(outdir, near["f1_Hz"])
-    if data and data.get("series_t_s"):
+    if series:
+        near = min(series, key=lambda f1: abs(f1 - inset_Hz))
+        t, T = series[near]
         ins = ax.inset_axes([0.1, 0.36, 0.38, 0.3])  # above the flat low-f1 part
-        t = np.array(data["series_t_s"])
-        ins.plot(t - t[0], data["series_tension_N"], "-", lw=1)
-        ins.set_title(f"T(t) at f1 = {near['f1_Hz']:g} Hz", fontsize=8)
+        ins.plot(t - t[0], T, "-", lw=1)
+        ins.set_title(f"T(t) at f1 = {near:g} Hz", fontsize=8)
         ins.set_xlabel("t [s]", fontsize=8)
         ins.set_ylabel("T [N]", fontsize=8)
         ins.tick_params(labelsize=7)
     fig.tight_layout()
-    fig.savefig(outdir / "sweep.png", dpi=120)
+    fig.savefig(path, dpi=120)
     plt.close(fig)
+    return path

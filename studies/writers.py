@@ -163,3 +163,28 @@ def dynamics_png(path: Path, rows: np.ndarray, target_rpm: float, title: str) ->
     for a in ax:
         a.grid(True, alpha=0.3)
     return _finish(fig, path, title, dpi=110)
+
+
+def write_npz(path: Path, arrays: dict) -> Path:
+    """Write arrays to an .npz atomically."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")
+    np.savez(tmp, **arrays)
+    os.replace(tmp, path)
+    return path
+
+
+def frames_xdmf(path: Path, frames) -> Path:
+    """The moving centre line with its fields, one XDMF step per frame
+    (``simulate.Frame``: t_s, s_m, x_m, tension_N, twist, alpha, spin)."""
+    from rawehelix.studies.xdmf_series import PolylineSeries
+    series = PolylineSeries(path)
+    try:
+        for f in frames:
+            series.write(f.t_s, f.x_m, {"s_m": f.s_m, "tension_N": f.tension_N,
+                                        "twist_rad_per_m": f.twist_rad_per_m,
+                                        "alpha_rad": f.alpha_rad, "spin_rpm": f.spin_rpm})
+    finally:
+        series.close()
+    return Path(path)

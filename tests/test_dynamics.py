@@ -80,9 +80,9 @@ def test_nominal_operation_against_spline_reference(nominal_run):
 def test_nominal_operation_converged_under_refinement():
     """Doubling N (p = 3) and tightening the step tolerance tenfold change the
     Fig. 6 curves by less than 1% of their scales (120 rpm, 25 Nm, 200 N)."""
-    base = series(DynamicsSolver(nominal(8)), 30.0, 0.05)
-    finer_N = series(DynamicsSolver(nominal(16)), 30.0, 0.05)
-    finer_t = series(DynamicsSolver(nominal(8), options={"ts_rtol": 1e-5, "ts_atol": 1e-5}), 30.0, 0.05)
+    base = series(DynamicsSolver.from_stationary(nominal(8)), 30.0, 0.05)
+    finer_N = series(DynamicsSolver.from_stationary(nominal(16)), 30.0, 0.05)
+    finer_t = series(DynamicsSolver.from_stationary(nominal(8), options={"ts_rtol": 1e-5, "ts_atol": 1e-5}), 30.0, 0.05)
     for other in (finer_N, finer_t):
         change = (np.abs(other[:, 1:] - base[:, 1:]) / SCALES).max(axis=0)
         print("\nrelative change under refinement:", np.round(change, 5))
@@ -97,23 +97,28 @@ def free_scene(elements=4, **time):
                      model={"drag": False, "gamma": "off"}, time=time)
 
 
-def perturb(lateral=1e-3, twist=1e-3):
-    """Initial state: stationary + lateral (y, out of plane) bump sin(pi s) and the lowest
-    torsional mode cos(pi s) (free ends: alpha' = 0)."""
-    def apply(solver):
-        w = solver.rod.w
-        solver.stationary_w = w.x.array.copy()
-        V_r = solver.rod.V_r
-        import dolfinx.fem
-        bump = dolfinx.fem.Function(V_r)
-        bump.interpolate(lambda x: np.stack([0 * x[0], lateral * np.sin(np.pi * x[0]), 0 * x[0]]))
-        r = w.sub(0).collapse()
-        r = r[0] if isinstance(r, tuple) else r
-        r.x.array[:] += bump.x.array
-        w.sub(0).interpolate(r)
-        w.sub(1).interpolate(lambda x: twist * np.cos(np.pi * x[0]))
-        w.x.scatter_forward()
-    return apply
+def perturbed(p, options, lateral=1e-3, twist=1e-3):
+    """A solver started from the stationary state + a lateral (y, out of plane) bump
+    sin(pi s) and the lowest torsional mode cos(pi s) (free ends: alpha' = 0);
+    ``solver.stationary_w`` keeps the stationary dofs."""
+    import dolfinx.fem
+    solver = DynamicsSolver.from_stationary(p, options=options)
+    state = solver.state()
+    solver.stationary_w = state.w.copy()
+    rod = solver.rod
+    w = dolfinx.fem.Function(rod.W)
+    rod.set_state(state, w=w)
+    bump = dolfinx.fem.Function(rod.V_r)
+    bump.interpolate(lambda x: np.stack([0 * x[0], lateral * np.sin(np.pi * x[0]), 0 * x[0]]))
+    r = w.sub(0).collapse()
+    r = r[0] if isinstance(r, tuple) else r
+    r.x.array[:] += bump.x.array
+    w.sub(0).interpolate(r)
+    w.sub(1).interpolate(lambda x: twist * np.cos(np.pi * x[0]))
+    w.x.scatter_forward()
+    state.w, state.offset = w.x.array.copy(), None
+    solver.set_state(state)
+    return solver
 
 
 def final_fields(solver):
@@ -135,7 +140,7 @@ def test_temporal_order(ts_type, order, until, dts):
     opts = {"ts_type": ts_type, "ts_adapt_type": "none"}
 
     def run(dt):
-        solver = DynamicsSolver(free_scene(dt_s=dt), options=opts, initial=perturb(1e-3, 1e-2))
+        solver = perturbed(free_scene(dt_s=dt), opts, 1e-3, 1e-2)
         series(solver, until, until)
         return final_fields(solver)
 
@@ -157,7 +162,7 @@ def test_without_twist_field(ts_type):
     runs = {}
     for twist in (True, False):
         p = free_scene(dt_s=0.01).replace(model={"twist": twist})
-        solver = DynamicsSolver(p, options=opts, initial=perturb(1e-3, 0.0))
+        solver = perturbed(p, opts, 1e-3, 0.0)
         series(solver, 0.3, 0.3)
         runs[twist] = solver.probes.fields()
     off, full = runs[False], runs[True]
@@ -188,9 +193,9 @@ def test_energy_is_conserved():
     T = q.chord_tension()
     period = 2 * math.pi / math.sqrt(T * math.pi**2 + q.mu * math.pi**4)  # pinned tensioned beam
     dt = period / 40
-    solver = DynamicsSolver(p.replace(time={"dt_s": q.time_s(dt)}),
-                            options={"ts_alpha_radius": 1.0, "ts_adapt_type": "none"},
-                            initial=perturb(lateral=1e-2 / q.L0, twist=1e-3))
+    solver = perturbed(p.replace(time={"dt_s": q.time_s(dt)}),
+                       {"ts_alpha_radius": 1.0, "ts_adapt_type": "none"},
+                       lateral=1e-2 / q.L0, twist=1e-3)
     E, y, work = [], [], [0.0]
     moving = solver.form.u.x.array.copy()
     solver.form.u.x.array[:] = solver.stationary_w
@@ -257,7 +262,7 @@ def test_same_numbers_on_one_and_two_ranks():
     if comm.size == 1:
         pytest.skip("compares 1 and 2 ranks: run under mpirun -n 2")
     p = nominal(8)
-    parallel = series(DynamicsSolver(p, comm), 2.0, 0.1)
+    parallel = series(DynamicsSolver.from_stationary(p, comm), 2.0, 0.1)
     if comm.rank == 0:
-        serial = series(DynamicsSolver(p, MPI.COMM_SELF), 2.0, 0.1)
+        serial = series(DynamicsSolver.from_stationary(p, MPI.COMM_SELF), 2.0, 0.1)
         assert np.allclose(parallel, serial, rtol=1e-8, atol=1e-8 * 120)

@@ -19,6 +19,7 @@ class SplineBackend:
 
     def __init__(self, q: Normalised, N: int, rtol: float = 1e-7, atol: float = 1e-9):
         self.q, self.N, self.rtol, self.atol = q, N, rtol, atol
+        self.q_now = q
 
     def stationary(self) -> np.ndarray:
         """Stationary state with the top at its position at t = 0 (phase 0)."""
@@ -26,8 +27,12 @@ class SplineBackend:
         start = stationary.chord_nodes(system, 0.0)
         return initial_state(system, stationary.solve(system, start=start).x)
 
-    def advance(self, x, q: Normalised, t0: float, t1: float, t_out):
-        system = SplineGalerkin(q, self.N)
+    def set_frequency(self, f1_Hz: float, t_start: float):
+        """The circle of Eq. (70) at f1, at phase 0 at the normalised time t_start."""
+        self.q_now = self.q.at_frequency(f1_Hz, t_start)
+
+    def advance(self, x, t0: float, t1: float, t_out):
+        system = SplineGalerkin(self.q_now, self.N)
         sol = solve_ivp(lambda t, y: system.f(y, t), (t0, t1), x, method="Radau",
                         t_eval=np.asarray(t_out), jac=lambda t, y: system.jacobian(y, t),
                         rtol=self.rtol, atol=self.atol)
@@ -49,4 +54,4 @@ class SplineBackend:
 
     @staticmethod
     def unpack(data) -> np.ndarray:
-        return np.asarray(data["x"])
+        return np.asarray(data["x"]).copy()

@@ -220,7 +220,7 @@ def dt_x10(until_s: float = 10.0):
     q = params.normalised()
     spins = {}
     for dt in (params.time.dt_s, params.time.dt_s / 10):
-        solver = DynamicsSolver(params.replace(time={"dt_s": dt}), MPI.COMM_SELF,
+        solver = DynamicsSolver.from_stationary(params.replace(time={"dt_s": dt}), MPI.COMM_SELF,
                                 options={"ts_adapt_type": "none"})
         solver.advance(until_s / q.t_scale)
         v = solver.probes.values()

@@ -1,0 +1,86 @@
+"""The public Python API of rawehelix: compose a run in a few lines.
+
+    import rawehelix as rh
+
+    scene = rh.load_scene("nominal_operation", elements=8)
+    st = rh.stationary(scene)          # st.s_m, st.centre_line_m, st.tension_N, st.summary
+    ts = rh.simulate(scene, until_s=10.0)
+    print(ts.spin_rpm[-1], ts.summary["settling_time_s"])
+    ts.write("results/spin_up")        # computing never writes files; write() does
+
+Every function takes a validated scene (:func:`load_scene`) and returns a
+result with SI numpy arrays, the ``summary`` dict that ``summary.json`` holds,
+and ``write(outdir)``.  Bad input raises :class:`SceneError`, whose message
+names the file or command, the key and what is allowed (the command line
+prints the same message); a solve that fails raises :class:`SolverError`
+saying what failed, where and what to try.  Under MPI every function is
+collective; the arrays are on rank 0.
+"""
+
+from __future__ import annotations
+
+from mpi4py import MPI
+
+from rawehelix.parameters import Parameters
+from rawehelix.solvers.snes import SolverError
+from rawehelix.studies.scene import SceneError
+
+__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "SceneError", "SolverError",
+           "Parameters"]
+
+
+def load_scene(name_or_path, elements: int | None = None, degree: int | None = None,
+               scheme: str | None = None, overrides: dict | None = None) -> Parameters:
+    """The validated scene: a TOML file, or the name of a shipped scene
+    (``stationary_table2``, ``nominal_operation``, ``mobile_end``).
+
+    ``elements`` (N), ``degree`` (p) and ``scheme`` ("fe" or "spline") set the
+    discretisation; ``overrides`` sets any dotted scene key, e.g.
+    ``{"helix.EI_Nm2": 9000.0, "time.dt_s": 5e-4}``, validated like the file."""
+    from rawehelix.studies import scene
+    return scene.load(name_or_path, elements=elements, degree=degree, scheme=scheme,
+                      overrides=overrides)
+
+
+def stationary(scene: Parameters, comm=MPI.COMM_WORLD):
+    """The stationary state with fixed ends (Sec. 5.1), checked against the
+    shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
+    with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``."""
+    from rawehelix.studies import stationary as study
+    return study.compute(scene, comm)
+
+
+def modes(scene: Parameters, count: int | None = None, comm=MPI.COMM_WORLD):
+    """The natural modes about the stationary state (Table 3): a list of modes,
+    each with ``family``, ``frequency_Hz``, ``decay_per_s``, ``period_s``,
+    ``eigenvalue`` (normalised) and its shape in SI; ``.summary``.
+
+    Default: the lowest 3 of each family and the rigid rotation; ``count``:
+    the ``count`` slowest modes.  ``scene.discretisation.scheme`` picks FE
+    (SLEPc) or the paper's spline scheme."""
+    from rawehelix.studies import modes as study
+    return study.compute(scene, count=count, comm=comm)
+
+
+def simulate(scene: Parameters, until_s: float | None = None, comm=MPI.COMM_WORLD,
+             options: dict | None = None, progress: bool | None = None):
+    """The dynamics from the stationary state (Secs. 5.2, 5.3) to ``until_s``
+    [s] (default ``time.until_s``): a :class:`~rawehelix.studies.simulate.TimeSeries`
+    with ``t_s``, ``spin_rpm`` (n x 3: s = 0, ~L0/2, L0), ``ground_torque_Nm``,
+    ``tension_s0_N``, ``tension_s1_N``, ``lateral_mid_m``, ``final_state`` and
+    ``summary``.  ``options``: PETSc options of the integrator without the
+    prefix, e.g. ``{"ts_type": "cn"}``."""
+    from rawehelix.studies import simulate as study
+    return study.compute(scene, until_s=until_s, comm=comm, options=options, progress=progress)
+
+
+def sweep(scene: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None):
+    """The periodic response of Sec. 5.3 at each forcing frequency f1 [Hz]
+    (default: the scene's [sweep] list), continued from one f1 to the next as
+    in the paper: a :class:`~rawehelix.studies.sweep.SweepResult` with
+    ``points`` (``f1_Hz``, ``tension_max_N``, ``tension_min_N``,
+    ``tension_mean_N``, ``periods``, ``periodic``) and ``summary``.
+    ``checkpoint``: a directory that keeps finished points, so that the same
+    call resumes a stopped sweep."""
+    from rawehelix.studies import sweep as study
+    return study.compute(scene, f1_Hz, comm=comm, checkpoint=checkpoint)
