@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms.kinematics import d, stretch, twist
+from rawehelix.forms.kinematics import d, internal_force, stretch, tension, twist
 from rawehelix.forms.rod import K_E, Coefficients, bending
 
 
@@ -48,7 +48,8 @@ def potential(r, alpha, c: Coefficients, degree: int, penalty, measures):
 
 def non_variational_power(r, alpha, r_t, c: Coefficients, dx):
     """Power of the parts of F_NL that are not the variation of E (see above):
-    P = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t'."""
-    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)
-    f = c.mu * ufl.dot(d(r, 2), d(r, 2)) * d(r) - c.beta * tau * ufl.cross(d(r), d(r, 2))
+    P = int (T r' - F_NL) . r_t' = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t',
+    with F_NL of Eq. (32) and its variational part T r'."""
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
+    f = tension(r, c.sigma) * d(r) - internal_force(r, tau, c.sigma, c.mu, c.beta)  # (29), (32)
     return ufl.inner(f, d(r_t)) * dx

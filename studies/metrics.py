@@ -1,19 +1,48 @@
-"""Time-series metrics (numpy only)."""
+"""Metrics of a time series: settling time and overshoot (numpy only).
+
+Used by ``rawehelix simulate`` (its summary) and ``rawehelix converge`` (the
+``settling_time`` and ``spin_overshoot`` quantities of Sec. 5.2), so that
+both report the same number for the same run.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-SETTLING_BAND = 0.02  # all three spins within 2% of the target
+#: the settling band: within 2 % of the target (Sec. 5.2, Fig. 6)
+SETTLING_BAND = 0.02
 
 
-def settling_time(t_s, spins_rpm, target_rpm) -> float | None:
-    """First time after which all three spins stay within 2% of the target (None if never)."""
-    if target_rpm == 0 or len(t_s) == 0:
+def settling_time(t_s, values, target, band: float = SETTLING_BAND) -> float | None:
+    """The time [s] after which every column of ``values`` stays within
+    ``band * |target|`` of ``target``.
+
+    The last exit from the band is located by linear interpolation between
+    the two samples around it (of the largest deviation of the columns), so
+    the result does not move with the sampling interval.  ``t_s[0]`` if the
+    series never leaves the band; None if it ends outside it (not settled
+    within the record), if it is empty, or if ``target`` is 0 (no band).
+
+    ``values``: one column per signal (the spins at s = 0, L0/2 and L0), or a
+    1-D array for one signal.
+    """
+    t = np.asarray(t_s, dtype=float)
+    v = np.asarray(values, dtype=float)
+    if target == 0 or len(t) == 0:
         return None
-    outside = np.any(np.abs(np.asarray(spins_rpm) - target_rpm) > SETTLING_BAND * abs(target_rpm),
-                     axis=1)
-    if outside[-1]:
+    if v.ndim == 1:
+        v = v[:, None]
+    dev = np.max(np.abs(v - target), axis=1) - band * abs(target)  # > 0: outside
+    outside = np.nonzero(dev > 0)[0]
+    if len(outside) == 0:
+        return float(t[0])
+    k = outside[-1]
+    if k + 1 >= len(t):
         return None
-    last_out = np.nonzero(outside)[0]
-    return float(t_s[last_out[-1] + 1]) if len(last_out) else float(t_s[0])
+    return float(t[k] + (t[k + 1] - t[k]) * dev[k] / (dev[k] - dev[k + 1]))
+
+
+def overshoot(values, target) -> float:
+    """The largest value above ``target``: max(values) - target (negative when
+    the signal stays below the target)."""
+    return float(np.max(values) - target)

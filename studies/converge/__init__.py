@@ -1,0 +1,30 @@
+"""`rawehelix converge`: refinement studies and work-precision figures.
+
+For one quantity of interest, runs every method over its refinement ladder
+(elements N for the space discretisations, time step dt for the time
+integrators), and records for each run the value, the error, the observed
+order and the wall time.
+
+Error: relative to the **finest run of the reference method** (the most
+accurate one: FE with the highest degree at the largest N for stationary and
+modal quantities), not a Richardson extrapolation; the reference's own
+distance to an independent reference (shooting, where one exists) is printed
+so that the floor of the table is known.  For a vector of values (the lowest
+eigenvalue of each family) the error is the largest relative error.
+
+Under ``mpirun -n k`` the runs are dealt round-robin to the ranks, each on
+its own communicator; rank 0 gathers and writes ``converge.csv``,
+``converge.md``, ``work_precision.png`` and ``summary.json``.
+
+Modules, one job each:
+
+- :mod:`.quantities`: what each quantity evaluates, and its ladders;
+- :mod:`.study`: the loop over the ladders, errors and observed orders;
+- :mod:`.cache`: finished (and failed) runs in ``DIR/runs/``, for resuming;
+- :mod:`.report`: ``converge.csv``, ``converge.md``, ``work_precision.png``.
+"""
+
+from rawehelix.studies.converge.quantities import Method, Quantity, quantities
+from rawehelix.studies.converge.study import Run, run
+
+__all__ = ["Method", "Quantity", "Run", "quantities", "run"]
