@@ -1,16 +1,19 @@
-"""The `rawehelix` command line.
+"""The `rawehelix` command line: a thin layer over the Python API (:mod:`rawehelix.api`).
 
     rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
-    rawehelix simulate SCENE [-o DIR] [--until T] [--elements N] [--degree p] [PETSc options]
+    rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
     rawehelix converge SCENE --quantity Q [-o DIR]
+    rawehelix extremes [CASE ...] [-o DIR]
 
 SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
-``nominal_operation``, ``mobile_end``).  Options that argparse does not know
-and that start with ``-`` go to PETSc (e.g. ``-rawehelix_snes_monitor``).
-Bad input exits with status 2 and one message naming file, key and what is
-allowed; nothing is written.
+``nominal_operation``, ``mobile_end``).  ``--set KEY=VALUE`` sets any dotted
+scene key.  Options that argparse does not know go to PETSc, with or without
+a value (``-rawehelix_snes_monitor``, ``-rawehelix_snes_linesearch_type bt``);
+put them after the scene.  ``-v`` shows more (``-vv`` everything).  Bad input
+exits with status 2 and one message naming file, key and what is allowed;
+nothing is written.  A failed solve exits with status 1.
 """
 
 from __future__ import annotations
@@ -18,12 +21,14 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+import tomllib
 import traceback
 from pathlib import Path
 
-from rawehelix.studies import scene as scenes
+from rawehelix.studies.scene import SceneError
 
 COMMANDS = ("stationary", "modes", "simulate", "sweep", "converge", "extremes")
+log = logging.getLogger("rawehelix")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -42,11 +47,17 @@ def _parser() -> argparse.ArgumentParser:
         p.add_argument("--degree", type=int, default=None, help="Lagrange degree p (FE)")
         p.add_argument("--scheme", choices=("fe", "spline"), default=None,
                        help="discretisation scheme (default: the scene's)")
+        p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                       help="set a dotted scene key, e.g. --set helix.EI_Nm2=9000 (repeatable)")
+        p.add_argument("-v", "--verbose", action="count", default=0,
+                       help="more messages (-vv: the solvers' and compilers' too)")
         if name == "modes":
-            p.add_argument("--count", type=int, default=None, help="number of modes to report")
+            p.add_argument("--count", type=int, default=None,
+                           help="report the k slowest modes (default: the lowest 3 of each family)")
         if name == "simulate":
             p.add_argument("--until", type=float, default=None,
                            help="end of the simulation [s] (default: the scene's time.until_s)")
+            p.add_argument("--no-gif", action="store_true", help="skip the animated GIF")
         if name == "converge":
             p.add_argument("--quantity", required=True,
                            help="quantity of interest: tension_s0, eigenvalues, ...")
@@ -58,6 +69,7 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("extremes", help="the scenes at the edges of the physics (studies/extremes)")
     p.add_argument("-o", "--output", type=Path, default=Path("results/extremes"),
                    help="output directory (default results/extremes)")
+    p.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
     p.add_argument("cases", nargs="*", help="case names (default: all)")
     return parser
 
@@ -67,110 +79,138 @@ def _fail(message: str) -> int:
     return 2
 
 
-def _frequencies(spec: str | None, params) -> list[float]:
-    """START:STOP:STEP in Hz, or the scene's [sweep] section."""
-    if spec is None:
-        return params.sweep.frequencies()
+def _overrides(args) -> dict:
+    """--set KEY=VALUE (values in TOML syntax: 9000, 1e-3, true, "graded") and
+    --f1 START:STOP:STEP, as dotted scene keys: validated by the scene loader."""
+    over = {}
+    for item in args.set:
+        key, sep, text = item.partition("=")
+        if not sep or not key:
+            raise SceneError("--set", item, "must be KEY=VALUE, e.g. helix.EI_Nm2=9000")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text  # a bare word: a string
+        over[key.strip()] = value
+    if getattr(args, "f1", None) is not None:
+        try:
+            start, stop, step = (float(v) for v in args.f1.split(":"))
+        except ValueError:
+            raise SceneError("--f1", args.f1, "is not START:STOP:STEP (numbers in Hz)") from None
+        over.update({"sweep.f1_start_Hz": start, "sweep.f1_stop_Hz": stop,
+                     "sweep.f1_step_Hz": step})
+    return over
+
+
+def main(argv: list[str] | None = None) -> int:
+    from rawehelix.studies import argv as argv_split, logs
+
+    argv = sys.argv[1:] if argv is None else argv
+    parser = _parser()
+    ours, petsc_args = argv_split.split(argv, parser)
+    args = parser.parse_args(ours)
+    logs.configure(args.verbose)
+    # PETSc reads its options once, at initialisation: before any import of PETSc.
+    import petsc4py
+    petsc4py.init([sys.argv[0], *petsc_args])
+    from mpi4py import MPI
+
+    import rawehelix as rh
+
+    comm = MPI.COMM_WORLD
     try:
-        start, stop, step = (float(v) for v in spec.split(":"))
-    except ValueError:
-        raise ValueError(f"{spec!r} is not START:STOP:STEP (numbers in Hz)") from None
-    if not (start > 0 and stop >= start and step > 0):
-        raise ValueError(f"{spec!r}: needs 0 < START <= STOP and STEP > 0")
-    from rawehelix.parameters import Sweep
-    import dataclasses
-    return dataclasses.replace(Sweep(), f1_start_Hz=start, f1_stop_Hz=stop,
-                               f1_step_Hz=step).frequencies()
+        if args.command == "extremes":
+            return _extremes(args)
+        params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
+                               scheme=args.scheme, overrides=_overrides(args))
+        outdir = args.output or Path("results") / params.name / args.command
+        return COMMAND[args.command](rh, params, args, outdir, comm)
+    except SceneError as err:
+        return _fail(str(err))
+    except rh.SolverError as err:
+        print(f"rawehelix: {err}", file=sys.stderr)
+        _abort_other_ranks(comm, 1)
+        return 1
+    except Exception:
+        if comm.size == 1:
+            raise
+        traceback.print_exc()
+        _abort_other_ranks(comm, 1)
+        raise
 
 
-def _extremes(args, petsc_args) -> int:
+def _say(comm, text: str):
+    """The command's result, on rank 0's stdout."""
+    if comm.rank == 0:
+        print(text, flush=True)
+
+
+def _stationary(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import stationary
+    result = rh.stationary(params, comm)
+    result.write(outdir)
+    _say(comm, stationary.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
+def _modes(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import modes
+    result = rh.modes(params, count=args.count, comm=comm)
+    result.write(outdir)
+    _say(comm, modes.report(result) + f"\nwrote {outdir}/")
+    return 0
+
+
+def _simulate(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import simulate
+
+    def checkpoint(partial):  # the last good state and the series so far, every minute
+        partial.write(outdir, pictures=False)
+
+    try:
+        result = simulate.compute(params, until_s=args.until, comm=comm, checkpoint=checkpoint)
+    except simulate.SimulationError as err:
+        err.partial.write(outdir, pictures=False)
+        raise rh.SolverError(f"{err} The series and the last good state are in "
+                             f"{outdir}/ (time_series.csv, state.npz).") from None
+    result.write(outdir, gif=not args.no_gif)
+    _say(comm, simulate.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
+def _sweep(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import sweep
+    try:
+        result = rh.sweep(params, comm=comm, checkpoint=outdir)
+    except sweep.SweepError as err:
+        raise SceneError("-o", str(outdir), str(err)) from None
+    result.write(outdir, series=args.series)
+    _say(comm, sweep.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
+def _converge(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import converge
+    if args.quantity not in converge.quantities():
+        raise SceneError("--quantity", args.quantity,
+                         f"is not one of {', '.join(converge.quantities())}")
+    converge.run(params, args.quantity, outdir, name=params.name,
+                 log=lambda m: _say(comm, m), comm=comm)
+    return 0
+
+
+def _extremes(args) -> int:
     from rawehelix.studies import extremes
     unknown = [c for c in args.cases if c not in extremes.CASES]
     if unknown:
-        return _fail(f"extremes: unknown case(s) {', '.join(unknown)}; "
-                     f"known: {', '.join(extremes.CASES)}")
-    import petsc4py
-    petsc4py.init([sys.argv[0], *petsc_args])
-    logging.getLogger().setLevel(logging.WARNING)
+        raise SceneError("extremes", ", ".join(unknown),
+                         f"unknown case(s); known: {', '.join(extremes.CASES)}")
     extremes.run(args.output, cases=args.cases or None)
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    args, petsc_args = _parser().parse_known_args(argv)
-    stray = [a for a in petsc_args if not a.startswith("-")]
-    if stray:
-        return _fail(f"unexpected argument(s) {' '.join(stray)}")
-    if args.command == "extremes":
-        return _extremes(args, petsc_args)
-    try:
-        params = scenes.load(args.scene, elements=args.elements, degree=args.degree,
-                             scheme=args.scheme)
-    except scenes.SceneError as err:
-        return _fail(str(err))
-    if args.command == "modes" and args.count is not None and args.count < 1:
-        return _fail("--count: must be an integer >= 1")
-    if args.command == "simulate" and args.until is not None and not args.until > 0:
-        return _fail("--until: must be a number of seconds > 0")
-    if args.command == "simulate" and params.discretisation.scheme != "fe":
-        return _fail(f"{scenes.resolve(args.scene)}: discretisation.scheme: 'simulate' runs the FE "
-                     "scheme (the spline reference is solvers.spline_galerkin.dynamics)")
-    path = scenes.resolve(args.scene)
-    name = path.stem
-    if args.command == "sweep":
-        try:
-            frequencies = _frequencies(args.f1, params)
-        except ValueError as err:
-            return _fail(f"--f1: {err}")
-    outdir = args.output or Path("results") / name / args.command
-
-    # PETSc reads its options once, at initialisation: before any import of PETSc.
-    import petsc4py
-    petsc4py.init([sys.argv[0], *petsc_args])
-    logging.getLogger().setLevel(logging.WARNING)  # quiet the JIT compilers
-    from mpi4py import MPI
-    from rawehelix.solvers.snes import SolverError
-    log = print if MPI.COMM_WORLD.rank == 0 else (lambda *a, **k: None)
-    try:
-        if args.command == "stationary":
-            if params.discretisation.scheme != "fe":
-                return _fail(f"{path}: discretisation.scheme: 'stationary' runs the FE scheme; "
-                             "the spline reference's stationary state is part of 'modes'")
-            from rawehelix.studies import stationary
-            stationary.run(params, outdir, name=name, title=scenes.title(path), log=log)
-        elif args.command == "modes":
-            from rawehelix.studies import modes
-            modes.run(params, outdir, count=args.count, log=log)
-        elif args.command == "simulate":
-            from rawehelix.studies import simulate
-            simulate.run(params, outdir, name=name, title=scenes.title(path), until_s=args.until,
-                         log=log)
-        elif args.command == "converge":
-            from rawehelix.studies import converge
-            if args.quantity not in converge.quantities():
-                return _fail(f"--quantity: {args.quantity!r} is not one of "
-                             f"{', '.join(converge.quantities())}")
-            converge.run(params, args.quantity, outdir, name=name, log=log)
-        elif args.command == "sweep":
-            from rawehelix.studies import sweep
-            try:
-                sweep.run(params, outdir, frequencies, name=name, log=log, series=args.series)
-            except sweep.SweepError as err:
-                return _fail(str(err))
-    except SolverError as err:
-        print(f"rawehelix: {err}", file=sys.stderr)
-        _abort_other_ranks(MPI.COMM_WORLD, 1)
-        return 1
-    except NotImplementedError as err:
-        return _fail(str(err))
-    except Exception:
-        if MPI.COMM_WORLD.size == 1:
-            raise
-        traceback.print_exc()
-        _abort_other_ranks(MPI.COMM_WORLD, 1)
-        raise
-    return 0
+COMMAND = {"stationary": _stationary, "modes": _modes, "simulate": _simulate, "sweep": _sweep,
+           "converge": _converge}
 
 
 def _abort_other_ranks(comm, code: int):

@@ -272,3 +272,19 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                  s.get("real_time_factor", 0.0))
     series.summary = comm.bcast(s, root=0)
     return series
+
+
+def report(result: TimeSeries) -> str:
+    """The lines a user reads after a run."""
+    s = result.summary
+    lines = [f"{s['scene']}: {s['simulated_s']:.2f} s simulated in {s['solve_s']:.1f} s "
+             f"({s['steps']} steps, {s['newton_iterations']} Newton iterations, real-time factor "
+             f"{s.get('real_time_factor', 0.0):.1f})"]
+    f = s.get("final")
+    if f:
+        settle = s.get("settling_time_s")
+        lines.append(f"  final spin {f['spin_rpm']['s0']:.3f} / {f['spin_rpm']['mid']:.3f} / "
+                     f"{f['spin_rpm']['L0']:.3f} rpm (s = 0, L0/2, L0), ground torque "
+                     f"{f['ground_torque_Nm']:.3f} Nm, T(0) = {f['tension_s0_N']:.2f} N"
+                     + (f"; settled (2 %) at {settle:.3f} s" if settle is not None else ""))
+    return "\n".join(lines)

@@ -410,3 +410,17 @@ def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def report(result: SweepResult) -> str:
+    """The lines a user reads after a sweep."""
+    s = result.summary
+    lines = [f"{s['scene']}: {len(s['points'])} points ({s['computed_now']} computed now), "
+             f"{s['scheme']} N = {s['elements']}, {s['ranks']} rank(s), {s['wall_s']:.1f} s"]
+    if s["resonance_Hz"] is not None:
+        lines.append(f"  largest T max at f1 = {s['resonance_Hz']} Hz: {s['peak_tension_N']:.1f} N")
+    for key, what in (("not_periodic_Hz", "not periodic (hit sweep.max_periods)"),
+                      ("slack_Hz", "slack (T <= 0)"), ("failed_Hz", "failed (see summary.json)")):
+        if s[key]:
+            lines.append(f"  {what}: f1 = {', '.join(f'{f:g}' for f in s[key])} Hz")
+    return "\n".join(lines)

@@ -172,13 +172,12 @@ def test_planar_reduction_is_exact(N):
 
 def test_stationary_command_says_which_model(tmp_path):
     from rawehelix.studies import stationary
-    s = stationary.run(table2(8), tmp_path / "a", log=lambda *a: None, comm=MPI.COMM_SELF)
+    s = stationary.compute(table2(8), MPI.COMM_SELF).summary
     assert s["model"].startswith("planar")
-    s = stationary.run(table2(8).replace(model={"reduction": "off"}), tmp_path / "b",
-                       log=lambda *a: None, comm=MPI.COMM_SELF)
+    s = stationary.compute(table2(8).replace(model={"reduction": "off"}), MPI.COMM_SELF).summary
     assert s["model"] == "full (r, alpha); terms: gravity, drag, bending"
-    s = stationary.run(table2(8).replace(model={"reduction": "off", "twist": False, "drag": False}),
-                       tmp_path / "c", log=lambda *a: None, comm=MPI.COMM_SELF)
+    s = stationary.compute(table2(8).replace(model={"reduction": "off", "twist": False,
+                                                    "drag": False}), MPI.COMM_SELF).summary
     assert s["model"].startswith("centre line only (model.twist = false")
     assert s["model"].endswith("terms: gravity, bending")
 

@@ -8,7 +8,6 @@ too (its values nan, its reason kept): it is a result, and is not retried.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 from pathlib import Path
@@ -24,7 +23,7 @@ class RunCache:
 
     def __init__(self, folder: Path | None, params: Parameters, quantity: str):
         self.folder = None if folder is None else Path(folder)
-        self.fingerprint = writers.digest([dataclasses.asdict(params), quantity])
+        self.fingerprint = writers.digest([params.as_dict(), quantity])
 
     def _path(self, label: str, value) -> Path:
         slug = "".join(c if c.isalnum() else "_" for c in label)

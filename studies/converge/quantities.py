@@ -144,7 +144,7 @@ def _spin_series(params: Parameters, method: Method, value):
         options["ts_adapt_type"] = "none"
     else:  # adaptive steps, tight enough that space dominates the error
         options.update({"ts_rtol": 1e-6, "ts_atol": 1e-6})
-    solver = DynamicsSolver(p, MPI.COMM_SELF, options=options)
+    solver = DynamicsSolver.from_stationary(p, MPI.COMM_SELF, options=options)
     rows = []
 
     def sample(s):
