@@ -3,11 +3,14 @@
 Bad input exits with status 2, one message naming file, key and what is
 allowed, and no output directory."""
 
+import dataclasses
 import math
+import re
 import tomllib
 
 import pytest
 
+from rawehelix import parameters
 from rawehelix.studies import cli, scene
 from tests_util import write_scene
 
@@ -39,6 +42,36 @@ def test_mobile_end_top_follows_eq70():
     centre = q.top_position(0.0) - q.r1 * (q.top_position(0.0) - q.top_position(math.pi / q.omega1)) / (2 * q.r1)
     for t in (0.1, 0.37, 1.2):
         assert abs(abs(sum((q.top_position(t) - centre) ** 2)) ** 0.5 - q.r1) < 1e-12
+
+
+# The keys of example.toml that do not show their default, on purpose: the
+# required ones have none (their values there are Table 2's).
+EXAMPLE_NOT_DEFAULT = {"helix.length_m", "helix.mass_kg", "helix.EA_N", "helix.EI_Nm2",
+                       "helix.GJ_Nm2", "ends.elongation", "ends.elevation_deg"}
+
+
+def test_example_documents_every_key_with_its_default():
+    """example.toml names every section and key of the parameter dataclasses,
+    shows each default, and comments every key line."""
+    path = scene.resolve("example")
+    data = tomllib.loads(path.read_text())
+    required = set()
+    for section in dataclasses.fields(parameters.Parameters):
+        table = data.get(section.name)
+        assert isinstance(table, dict), f"[{section.name}] is missing"
+        fields = dataclasses.fields(getattr(parameters, section.type))  # type names: annotations
+        assert set(table) == {f.name for f in fields}, f"[{section.name}]: keys differ"
+        for f in fields:
+            key = f"{section.name}.{f.name}"
+            if f.default is dataclasses.MISSING:
+                required.add(key)
+            elif key not in EXAMPLE_NOT_DEFAULT:
+                assert table[f.name] == f.default and type(table[f.name]) is type(f.default), \
+                    f"{key} = {table[f.name]!r}, default {f.default!r}"
+    assert required == EXAMPLE_NOT_DEFAULT
+    for line in path.read_text().splitlines():
+        if re.match(r"\s*\w+\s*=", line):
+            assert "#" in line, f"example.toml: {line!r} has no comment"
 
 
 BAD = [

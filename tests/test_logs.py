@@ -1,0 +1,68 @@
+"""studies.logs: one handler on stderr, and no JIT-compiler chatter on a cold
+form cache unless -vv.  Each test runs a fresh interpreter with its own empty
+XDG_CACHE_HOME (the form cache of FFCx), so the forms really compile."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+# A small form compiled on the cold cache, and one message at each level.
+SMALL_FORM = """
+import sys
+from rawehelix.studies import logs
+logs.configure(int(sys.argv[1]))
+import logging
+import ufl
+from mpi4py import MPI
+from dolfinx import fem, mesh
+log = logging.getLogger("rawehelix.test")
+log.info("an info message")
+log.debug("a debug message")
+log.warning("a warning")
+domain = mesh.create_unit_interval(MPI.COMM_SELF, 2)
+V = fem.FunctionSpace(domain, ("Lagrange", 1))
+u = fem.Function(V)
+fem.form(u * u * ufl.dx)
+"""
+
+
+def _run(code, tmp_path, *args):
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    result = subprocess.run([sys.executable, "-c", textwrap.dedent(code), *args], env=env,
+                            capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "cache" / "fenics").is_dir()  # the forms compiled there
+    return result.stderr.splitlines()
+
+
+@pytest.mark.parametrize("verbosity,expected", [
+    (0, ["rawehelix: a warning"]),
+    (1, ["rawehelix: an info message", "rawehelix: a warning"]),
+])
+def test_levels_without_jit_chatter(tmp_path, verbosity, expected):
+    assert _run(SMALL_FORM, tmp_path, str(verbosity)) == expected
+
+
+def test_vv_shows_the_compiler(tmp_path):
+    err = _run(SMALL_FORM, tmp_path, "2")
+    assert err[:3] == ["rawehelix: an info message", "rawehelix: a debug message",
+                       "rawehelix: a warning"]
+    assert all(line.startswith("rawehelix: ") for line in err)
+    assert any("gcc" in line for line in err)  # the C compiler's command lines
+
+
+def test_stationary_on_a_cold_cache_prints_nothing_on_stderr(tmp_path):
+    """The whole `stationary` command (every form of the rod) on a cold cache:
+    the summary on stdout, nothing on stderr."""
+    code = f"""
+    import sys
+    from rawehelix.studies import cli, logs
+    logs.configure(0)
+    sys.exit(cli.main(["stationary", "stationary_table2", "--elements", "4",
+                       "-o", {str(tmp_path / "out")!r}]))
+    """
+    assert _run(code, tmp_path) == []
+    assert (tmp_path / "out" / "summary.json").is_file()
