@@ -1,8 +1,9 @@
 """Logging of the `rawehelix` command: one handler on stderr, ``rawehelix: message``.
 
 rawehelix code logs on ``logging.getLogger(__name__)`` (``rawehelix.*``).
-The verbosity counts ``-v``: 0 shows warnings and errors, 1 adds INFO, 2 adds
-DEBUG and the chatter of the form compilers.
+The verbosity counts ``-v``: 0 shows rawehelix's own progress (INFO, e.g. a
+sweep's points) and everybody's warnings and errors, 1 adds rawehelix's
+DEBUG, 2 adds everything else: the solvers' and the form compilers' chatter.
 
 The chatter, on a cold form cache (DOLFINx 0.5): FFCx calls
 ``cffi.FFI.compile(verbose=True)``, which sets the threshold of distutils'
@@ -26,18 +27,22 @@ import sys
 # the loggers of the form compilers and of the build of their C code
 # ("root": setuptools' distutils logs on the root logger)
 JIT_LOGGERS = ("root", "ffcx", "UFL", "ufl", "cffi", "distutils", "setuptools")
-LEVELS = (logging.WARNING, logging.INFO, logging.DEBUG)
+LEVELS = (logging.INFO, logging.DEBUG, logging.DEBUG)  # of rawehelix's own loggers
 FORMAT = "rawehelix: %(message)s"
 
 
+def _ours(record: logging.LogRecord) -> bool:
+    return record.name.split(".")[0] == "rawehelix"
+
+
 def _not_jit_chatter(record: logging.LogRecord) -> bool:
-    return record.levelno >= logging.WARNING or record.name.split(".")[0] not in JIT_LOGGERS
+    return record.levelno >= logging.WARNING or _ours(record)
 
 
 def configure(verbosity: int = 0) -> logging.Handler:
-    """Log WARNING and above (``verbosity`` 0), INFO (1) or DEBUG (2 or more)
-    to stderr as ``rawehelix: message``; the form compilers' INFO and DEBUG
-    only at 2.  Replaces any handler already on the root logger (ffcx's
+    """Log to stderr as ``rawehelix: message``: rawehelix's INFO and above
+    (``verbosity`` 0) or DEBUG (1 or more), other loggers' WARNING and above;
+    their INFO and DEBUG (the form compilers') only at 2.  Replaces any handler already on the root logger (ffcx's
     ``basicConfig``), so calling it again reconfigures.  Returns the handler."""
     level = LEVELS[min(max(verbosity, 0), len(LEVELS) - 1)]
     handler = logging.StreamHandler(sys.stderr)

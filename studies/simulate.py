@@ -267,7 +267,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     series = result(True)
     s = series.summary
     if comm.rank == 0:
-        log.info("%s: %d steps, %d Newton iterations, %.1f s, real-time factor %.1f",
+        log.debug("%s: %d steps, %d Newton iterations, %.1f s, real-time factor %.1f",
                  params.name, s["steps"], s["newton_iterations"], s["solve_s"],
                  s.get("real_time_factor", 0.0))
     series.summary = comm.bcast(s, root=0)

@@ -95,7 +95,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
             "residual_at_shooting": float(residual_at_shooting),
             "wall_s": time.perf_counter() - start,
         }
-        log.info("%s: %s model, N = %d, p = %d: %d Newton iterations, %.2f s", params.name,
+        log.debug("%s: %s model, N = %d, p = %d: %d Newton iterations, %.2f s", params.name,
                  "planar" if planar else "full", disc.elements, disc.degree,
                  result.newton_iterations, summary["wall_s"])
     out.summary = comm.bcast(summary, root=0)

@@ -39,8 +39,8 @@ def _run(code, tmp_path, *args):
 
 
 @pytest.mark.parametrize("verbosity,expected", [
-    (0, ["rawehelix: a warning"]),
-    (1, ["rawehelix: an info message", "rawehelix: a warning"]),
+    (0, ["rawehelix: an info message", "rawehelix: a warning"]),  # our progress, by default
+    (1, ["rawehelix: an info message", "rawehelix: a debug message", "rawehelix: a warning"]),
 ])
 def test_levels_without_jit_chatter(tmp_path, verbosity, expected):
     assert _run(SMALL_FORM, tmp_path, str(verbosity)) == expected

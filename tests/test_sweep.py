@@ -190,7 +190,7 @@ def test_fe_sweep_resumes(tmp_path):
     whole = tmp_path / "whole"
 
     def run(outdir):
-        return sweep.run(params, outdir, FE_F1, comm=MPI.COMM_SELF, log=lambda *a: None)
+        return sweep.compute(params, FE_F1, comm=MPI.COMM_SELF, checkpoint=outdir).summary
 
     first = run(whole)
     assert computed_f1(whole) == FE_F1 and first["computed_now"] == 2
