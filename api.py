@@ -14,19 +14,25 @@ and ``write(outdir)``.  Bad input raises :class:`SceneError`, whose message
 names the file or command, the key and what is allowed (the command line
 prints the same message); a solve that fails raises :class:`SolverError`
 saying what failed, where and what to try.  Under MPI every function is
-collective; the arrays are on rank 0.
+collective (``comm``: default MPI.COMM_WORLD); the arrays are on rank 0.
 """
 
 from __future__ import annotations
 
-from mpi4py import MPI
-
+from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
-from rawehelix.solvers.snes import SolverError
-from rawehelix.studies.scene import SceneError
 
 __all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "SceneError", "SolverError",
            "Parameters"]
+
+
+def _world(comm):
+    """The communicator of a call: MPI.COMM_WORLD unless given (imported late:
+    ``import rawehelix`` loads neither MPI nor FEniCSx)."""
+    if comm is not None:
+        return comm
+    from mpi4py import MPI
+    return MPI.COMM_WORLD
 
 
 def load_scene(name_or_path, elements: int | None = None, degree: int | None = None,
@@ -42,15 +48,15 @@ def load_scene(name_or_path, elements: int | None = None, degree: int | None = N
                       overrides=overrides)
 
 
-def stationary(scene: Parameters, comm=MPI.COMM_WORLD):
+def stationary(scene: Parameters, comm=None):
     """The stationary state with fixed ends (Sec. 5.1), checked against the
     shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
     with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``."""
     from rawehelix.studies import stationary as study
-    return study.compute(scene, comm)
+    return study.compute(scene, _world(comm))
 
 
-def modes(scene: Parameters, count: int | None = None, comm=MPI.COMM_WORLD):
+def modes(scene: Parameters, count: int | None = None, comm=None):
     """The natural modes about the stationary state (Table 3): a list of modes,
     each with ``family``, ``frequency_Hz``, ``decay_per_s``, ``period_s``,
     ``eigenvalue`` (normalised) and its shape in SI; ``.summary``.
@@ -59,10 +65,10 @@ def modes(scene: Parameters, count: int | None = None, comm=MPI.COMM_WORLD):
     the ``count`` slowest modes.  ``scene.discretisation.scheme`` picks FE
     (SLEPc) or the paper's spline scheme."""
     from rawehelix.studies import modes as study
-    return study.compute(scene, count=count, comm=comm)
+    return study.compute(scene, count=count, comm=_world(comm))
 
 
-def simulate(scene: Parameters, until_s: float | None = None, comm=MPI.COMM_WORLD,
+def simulate(scene: Parameters, until_s: float | None = None, comm=None,
              options: dict | None = None, progress: bool | None = None):
     """The dynamics from the stationary state (Secs. 5.2, 5.3) to ``until_s``
     [s] (default ``time.until_s``): a :class:`~rawehelix.studies.simulate.TimeSeries`
@@ -71,10 +77,11 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     ``summary``.  ``options``: PETSc options of the integrator without the
     prefix, e.g. ``{"ts_type": "cn"}``."""
     from rawehelix.studies import simulate as study
-    return study.compute(scene, until_s=until_s, comm=comm, options=options, progress=progress)
+    return study.compute(scene, until_s=until_s, comm=_world(comm), options=options,
+                         progress=progress)
 
 
-def sweep(scene: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None):
+def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
     """The periodic response of Sec. 5.3 at each forcing frequency f1 [Hz]
     (default: the scene's [sweep] list), continued from one f1 to the next as
     in the paper: a :class:`~rawehelix.studies.sweep.SweepResult` with
@@ -83,4 +90,4 @@ def sweep(scene: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None):
     ``checkpoint``: a directory that keeps finished points, so that the same
     call resumes a stopped sweep."""
     from rawehelix.studies import sweep as study
-    return study.compute(scene, f1_Hz, comm=comm, checkpoint=checkpoint)
+    return study.compute(scene, f1_Hz, comm=_world(comm), checkpoint=checkpoint)

@@ -8,6 +8,7 @@ import ufl
 from petsc4py import PETSc
 
 from rawehelix import compat
+from rawehelix.errors import SolverError  # noqa: F401  (raised here, re-exported)
 
 SNES_DEFAULTS = {
     "snes_type": "newtonls",
@@ -23,10 +24,6 @@ SNES_DEFAULTS = {
     "ksp_type": "preonly",
     "pc_type": "lu",  # with lu_options(comm)
 }
-
-
-class SolverError(RuntimeError):
-    """A solve failed; the message says what, where and what to try."""
 
 
 def lu_options(comm) -> dict:

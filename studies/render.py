@@ -22,11 +22,26 @@ False and every function returns None.
 
 from __future__ import annotations
 
+import functools
+import logging
 import math
+import os
+import pickle
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+#: VTK's wheels and DOLFINx's libraries clash when DOLFINx is loaded first: the
+#: first colour bar drawn then dies in std::regex (std::bad_alloc inside
+#: vtkScalarBarActor::LayoutTicks, a C++ library ABI clash), killing the
+#: process.  So once DOLFINx is loaded before VTK, every picture is drawn in a
+#: fresh interpreter that loads this file alone (it imports nothing of
+#: rawehelix): :func:`_in_clean_process`.
+_VTK_AFTER_DOLFINX = "dolfinx" in sys.modules
 
 try:  # optional: the rest of rawehelix works without it
     import pyvista
@@ -347,7 +362,42 @@ def _save_gif(path, images, fps) -> Path:
     return path
 
 
+# -- a fresh interpreter for the drawing --------------------------------------------------
+_WORKER = ("import importlib.util, pickle, sys\n"
+           "spec = importlib.util.spec_from_file_location('rawehelix_render', sys.argv[1])\n"
+           "mod = importlib.util.module_from_spec(spec); spec.loader.exec_module(mod)\n"
+           "name, args, kwargs = pickle.load(open(sys.argv[2], 'rb'))\n"
+           "getattr(mod, name).__wrapped__(*args, **kwargs)\n")
+
+
+def _in_clean_process(func):
+    """Draw in a fresh interpreter when DOLFINx was loaded before VTK (see
+    ``_VTK_AFTER_DOLFINX``); a failed drawing is a warning, never the end of a run."""
+    @functools.wraps(func)
+    def call(path, *args, **kwargs):
+        if pyvista is None:
+            return None
+        if not _VTK_AFTER_DOLFINX:
+            return func(path, *args, **kwargs)
+        with tempfile.NamedTemporaryFile(suffix=".pkl", delete=False) as f:
+            pickle.dump((func.__name__, (str(path), *args), kwargs), f)
+        try:
+            env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+            done = subprocess.run([sys.executable, "-c", _WORKER, __file__, f.name], env=env,
+                                  capture_output=True, text=True, timeout=600)
+        finally:
+            os.unlink(f.name)
+        if done.returncode != 0 or not Path(path).exists():
+            tail = " ".join(done.stderr.strip().splitlines()[-3:])
+            logging.getLogger("rawehelix").warning(
+                "picture %s not drawn (exit %s): %s", path, done.returncode, tail)
+            return None
+        return Path(path)
+    return call
+
+
 # -- public ---------------------------------------------------------------------------------
+@_in_clean_process
 def helix_png(path, x_m, alpha_rad, tension_N, radius_m: float, title: str, time_s=None,
               reference_m=None, magnification=None, radius_magnification=None,
               reference_label="the reference", size=PNG_SIZE):
@@ -380,6 +430,7 @@ def _pick(frames, count):
     return [frames[int(round(k))] for k in np.linspace(0, len(frames) - 1, count)]
 
 
+@_in_clean_process
 def helix_gif(path, frames, radius_m: float, title: str = "", reference_m=None,
               magnification=None, radius_magnification=None, reference_label="the reference",
               size=GIF_SIZE, max_frames: int = GIF_FRAMES, fps: int = 8):
@@ -405,6 +456,7 @@ def helix_gif(path, frames, radius_m: float, title: str = "", reference_m=None,
     return _save_gif(path, images, fps)
 
 
+@_in_clean_process
 def mode_animation(path, s_m, x0_m, displacement, alpha_rad, radius_m: float, title: str,
                    magnification=None, radius_magnification=None, size=GIF_SIZE,
                    frames: int = MODE_FRAMES, fps: int = 12):
@@ -441,18 +493,3 @@ def mode_animation(path, s_m, x0_m, displacement, alpha_rad, radius_m: float, ti
         drawing.close()
     del s_m  # the shape is given node by node; s_m is for the caller's labels
     return _save_gif(path, images, fps)
-
-
-# -- the former interface (studies/simulate.py) ----------------------------------------------
-def png(path: Path, x_m, alpha, radius_m: float, label: str = "", size=PNG_SIZE):
-    """Former call: :func:`helix_png` without tension nor reference."""
-    return helix_png(path, x_m, alpha, None, radius_m, label, size=size)
-
-
-def gif(path: Path, frames, radius_m: float, size=GIF_SIZE, fps: int = 8):
-    """Former call: frames [(label, x_m, alpha), ...] with labels 't = 1.00 s'."""
-    if not frames:
-        return None
-    timed = [(float(label.split("=")[-1].split()[0]) if "=" in label else None, x, a, None)
-             for label, x, a in frames]
-    return helix_gif(path, timed, radius_m, size=size, fps=fps)

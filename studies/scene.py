@@ -16,6 +16,7 @@ import dataclasses
 import tomllib
 from pathlib import Path
 
+from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
 from rawehelix.parameters import (Controller, Discretisation, Ends, Environment,
                                         Helix, Model, ParameterError, Parameters, Sweep,
                                         Time, Torque)
@@ -28,14 +29,6 @@ SECTIONS = {
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"
-
-
-class SceneError(ValueError):
-    """Bad scene input: ``file: key: what is allowed``."""
-
-    def __init__(self, path, key: str, allowed: str):
-        self.path, self.key, self.allowed = str(path), key, allowed
-        super().__init__(f"{self.path}: {key}: {allowed}")
 
 
 _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "bool": "true or false"}

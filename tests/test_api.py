@@ -1,0 +1,64 @@
+"""The README's Python example runs as it stands, and the API refuses bad input
+with the command line's messages."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+import rawehelix as rh
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def readme_example() -> str:
+    text = README.read_text()
+    section = text.split("## Python API", 1)[1]
+    return re.search(r"```python\n(.*?)```", section, re.S).group(1)
+
+
+def test_readme_example_runs(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    exec(compile(readme_example(), "README.md", "exec"), {})
+    out = capsys.readouterr().out
+    assert re.search(r"T\(0\) = 202\.\d\d N", out)  # Table 2: 202.9 N (shooting 202.885 N)
+    assert "torsional" in out and "lateral_in_plane" in out
+    assert re.search(r"f1 = 10\.0 Hz: T max \d+\.\d N", out)
+    assert (tmp_path / "results" / "api_example" / "summary.json").is_file()
+    assert (tmp_path / "results" / "api_example" / "time_series.csv").is_file()
+
+
+@pytest.mark.parametrize("kwargs,words", [
+    ({"overrides": {"helix.EI_Nm2": -1.0}}, "helix.EI_Nm2"),
+    ({"overrides": {"helix.stiffness": 1.0}}, "unknown key"),
+    ({"elements": 0}, "discretisation.elements"),
+    ({"scheme": "hermite"}, "discretisation.scheme"),
+])
+def test_bad_scene_values_raise_the_cli_message(kwargs, words):
+    with pytest.raises(rh.SceneError, match=words) as err:
+        rh.load_scene("stationary_table2", **kwargs)
+    assert "stationary_table2.toml" in str(err.value)
+
+
+def test_refusals_live_in_the_library():
+    spline = rh.load_scene("nominal_operation", scheme="spline", elements=2)
+    with pytest.raises(rh.SceneError, match="FE scheme"):
+        rh.stationary(spline)
+    with pytest.raises(rh.SceneError, match="FE scheme"):
+        rh.simulate(spline)
+    with pytest.raises(rh.SceneError, match="until"):
+        rh.simulate(rh.load_scene("nominal_operation", elements=2), until_s=-1.0)
+    with pytest.raises(rh.SceneError, match="count"):
+        rh.modes(rh.load_scene("stationary_table2", elements=2), count=0)
+    with pytest.raises(rh.SceneError, match="f1"):
+        rh.sweep(rh.load_scene("mobile_end", scheme="spline", elements=2), f1_Hz=[5.0, -1.0])
+
+
+def test_import_is_light():
+    """`import rawehelix` loads neither MPI nor FEniCSx (rendering subprocesses rely on it)."""
+    import subprocess
+    import sys
+    code = ("import sys, rawehelix; heavy = [m for m in ('dolfinx', 'mpi4py', 'petsc4py', 'ufl')"
+            " if m in sys.modules]; print(heavy)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
