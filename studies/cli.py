@@ -109,8 +109,6 @@ def main(argv: list[str] | None = None) -> int:
                              scheme=args.scheme)
     except scenes.SceneError as err:
         return _fail(str(err))
-    if args.command == "modes" and args.count is not None and args.count < 1:
-        return _fail("--count: must be an integer >= 1")
     if args.command == "simulate" and args.until is not None and not args.until > 0:
         return _fail("--until: must be a number of seconds > 0")
     if args.command == "simulate" and params.discretisation.scheme != "fe":
@@ -158,6 +156,8 @@ def main(argv: list[str] | None = None) -> int:
                 sweep.run(params, outdir, frequencies, name=name, log=log, series=args.series)
             except sweep.SweepError as err:
                 return _fail(str(err))
+    except scenes.SceneError as err:  # e.g. modes: count (checked by the library)
+        return _fail(str(err))
     except SolverError as err:
         print(f"rawehelix: {err}", file=sys.stderr)
         _abort_other_ranks(MPI.COMM_WORLD, 1)

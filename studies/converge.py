@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix.families import VIBRATIONS
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers
@@ -116,24 +117,15 @@ def _shooting_tension_s0(params: Parameters):
     return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
 
 
-FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional")
-
-
 def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
     """|lambda| [1/s] of the lowest mode of each family (Sec. 5.1, Table 3)."""
-    p = _with(params, method, value)
-    if method.scheme == "spline":
-        from rawehelix.studies.modes import spline_modes
-        modes = spline_modes(p)
-    else:
-        from rawehelix.studies.modes import fe_modes
-        modes = fe_modes(p, None, comm=MPI.COMM_SELF, log=lambda *a: None)["modes"]
+    from rawehelix.studies import modes
     lowest = {}
-    for m in modes:
-        lam = complex(*m["eigenvalue_per_s"])
-        if m["family"] in FAMILIES and abs(lam) > 1e-9:
-            lowest[m["family"]] = min(lowest.get(m["family"], math.inf), abs(lam))
-    return np.array([lowest.get(f, math.nan) for f in FAMILIES])
+    for m in modes.compute(_with(params, method, value), comm=MPI.COMM_SELF):
+        lam = abs(m.eigenvalue_per_s)
+        if m.family in VIBRATIONS and lam > 1e-9:
+            lowest[m.family] = min(lowest.get(m.family, math.inf), lam)
+    return np.array([lowest.get(f, math.nan) for f in VIBRATIONS])
 
 
 # -- dynamics (Sec. 5.2) -------------------------------------------------------------
@@ -246,7 +238,7 @@ def quantities() -> dict:
         "eigenvalues": Quantity("eigenvalues", "1/s",
                                 [Method(f"FE p={p}", "fe", p, (2, 4, 8, 16, 32)) for p in (2, 3, 4)]
                                 + [Method("spline", "spline", None, (2, 4, 8, 16))],
-                                "FE p=4", eigenvalues, list(FAMILIES)),
+                                "FE p=4", eigenvalues, list(VIBRATIONS)),
         **{name: Quantity(name, unit, _dynamic_methods(ladder_fe, ladder_spline, dts, N), "FE p=4",
                           fn, [label], time_reference=f"FE N={N} p=3 alpha2 (dt)",
                           **(SPIN_SCALE if name == "spin_overshoot" else {}))
