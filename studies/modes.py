@@ -277,7 +277,7 @@ def format_table(result) -> str:
             dom = dom[:31] + "..."
         period = "N/A" if m.period_s is None else f"{m.period_s:.3f}"
         lines.append(f"{ev:>24}  {dom:<34} {FAMILY_LABELS.get(m.family, m.family):<15} "
-                     f"{period:>10} {m.frequency_Hz:>9.3f} {m.decay_per_s + 0.0:>11.3f}")
+                     f"{period:>10} {m.frequency_Hz:>9.3f} {round(m.decay_per_s, 3) + 0.0:>11.3f}")
     return "\n".join(lines)
 
 

@@ -333,8 +333,23 @@ def test_compute_default_selection_fe(tmp_path, monkeypatch):
     assert np.linalg.norm(lon.displacement, axis=1).max() == pytest.approx(1.0)
     assert result.x0_m.shape == (len(lon.s_m), 3)
     assert "Rigid rotation" in study.format_table(result)
+    # the animation of studies.render, when it is there: one GIF per family's first mode
+    from rawehelix.studies import render
+    calls = []
+
+    def animation(path, s_m, x0_m, displacement, alpha_rad, radius_m, title):
+        assert x0_m.shape == displacement.shape and alpha_rad.shape == s_m.shape
+        assert radius_m == params.helix.radius_m
+        calls.append(title)
+        path.write_bytes(b"GIF89a")
+        return path
+
+    monkeypatch.setattr(render, "mode_animation", animation, raising=False)
+    monkeypatch.setattr(render, "available", lambda: True, raising=False)
     paths = result.write(tmp_path / "out")
-    assert {p.name for p in paths} >= {"summary.json", "modes.png", "modes.xdmf"}
+    assert {p.name for p in paths} == {"summary.json", "modes.png", "modes.xdmf",
+                                       *(f"mode_{f}.gif" for f in VIBRATIONS)}
+    assert len(calls) == 4 and calls[0].startswith("Longitudinal")
 
 
 def test_compute_default_selection_spline():
