@@ -29,10 +29,10 @@ logging.disable(logging.INFO)
 
 from mpi4py import MPI  # noqa: E402
 
+from rawehelix.families import VIBRATIONS as FAMILIES  # noqa: E402
 from rawehelix.solvers.modal import ModalSolver  # noqa: E402
 from rawehelix.studies import scene  # noqa: E402
 
-FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional")
 ELEMENTS = (2, 4, 8, 16, 32, 64)
 DEGREES = (2, 3, 4)
 REFERENCE = (32, 4)
@@ -43,8 +43,7 @@ def lowest(N: int, p: int, gamma: str = "off"):
     """({family: lowest eigenvalue}, wall time [s], dofs)."""
     params = scene.load("stationary_table2", elements=N, degree=p).replace(model={"gamma": gamma})
     start = time.perf_counter()
-    solver = ModalSolver(params, MPI.COMM_SELF, scene="stationary_table2")
-    solver.linearise()
+    solver = ModalSolver.from_stationary(params, MPI.COMM_SELF, scene="stationary_table2")
     modes = solver.solve(per_family=1, keep_vectors=False, require_families=False)
     wall = time.perf_counter() - start
     found = {}

@@ -27,6 +27,7 @@ logging.disable(logging.INFO)
 from mpi4py import MPI  # noqa: E402
 
 from rawehelix.solvers.modal import ModalSolver  # noqa: E402
+from rawehelix.solvers.stationary import StationarySolver  # noqa: E402
 from rawehelix.studies import modes as study  # noqa: E402
 from rawehelix.studies import scene  # noqa: E402
 
@@ -41,11 +42,12 @@ def main():
     log = print if comm.rank == 0 else (lambda *a: None)
     params = scene.load("stationary_table2", elements=N, degree=P)
     t0 = time.perf_counter()
-    solver = ModalSolver(params, comm, scene="stationary_table2")
+    stationary = StationarySolver(params, comm, scene="stationary_table2")
+    solver = ModalSolver(params, comm, scene="stationary_table2", rod=stationary.rod)
     t1 = time.perf_counter()
-    solver.stationary_result = solver.stationary.solve()
+    solver.stationary_result = stationary.solve()
     t2 = time.perf_counter()
-    solver.linearise()
+    solver.linearise(solver.stationary_result.state)
     t3 = time.perf_counter()
     found = solver.solve(nev=NEV, keep_vectors=False)
     t4 = time.perf_counter()
@@ -56,9 +58,8 @@ def main():
     log(f"  assembly of K, C, M        {t3 - t2:6.2f} s")
     log(f"  SLEPc PEP solve            {t4 - t3:6.2f} s ({len(found)} modes from {NEV} eigenpairs)")
     log(f"  total                      {t4 - t0:6.2f} s")
-    entries = [study.mode_entry(m.eigenvalue, m.family, m.dominant, solver.q.t_scale)
-               for m in found]
-    log(study.format_table(entries))
+    log(study.format_table([study.ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions,
+                                                solver.q) for m in found]))
 
 
 if __name__ == "__main__":

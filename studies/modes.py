@@ -1,201 +1,307 @@
-"""``rawehelix modes``: stationary state and its modes, printed like Table 3.
+"""Natural modes of the stationary state (Sec. 5.1, Table 3): the public API.
 
-:func:`format_table` and :func:`write_summary` are scheme-independent: they
-take the ``modes`` entries of the summary (keys ``family``, ``eigenvalue``,
-``eigenvalue_per_s``, ``period_s``, ``dominant``).
+:func:`compute` solves the stationary state, linearises about it and returns
+a :class:`ModesResult` for either scheme:
+
+* ``fe``: SLEPc on the linearised Eqs. (30)-(31) (:mod:`rawehelix.solvers.modal`),
+  with the mode shapes;
+* ``spline``: the paper's spline-Galerkin reference (eigenvalues of the
+  Jacobian of Eq. 61, :mod:`rawehelix.solvers.spline_galerkin.spectrum`),
+  without mode shapes (``s_m``, ``displacement`` and ``alpha_rad`` are None).
+
+Computing never writes files; :meth:`ModesResult.write` does.  ``rawehelix
+modes`` is :func:`run`: compute, print the table (:func:`format_table`), write.
+
+Selection: by default the lowest 3 modes of each family and the rigid
+rotation (the FE scheme reports it once; the spline reference every zero
+eigenvalue, as Table 3 does); with ``count = k`` the k slowest modes.  Either
+way in the order of Table 3: decreasing |Im lambda|, then decreasing |lambda|.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import pathlib
 import time
+from dataclasses import dataclass, field
 
+import numpy as np
+
+from rawehelix.families import FAMILY_LABELS, VIBRATIONS
 from rawehelix.parameters import Parameters
 
-FAMILY_LABELS = {
-    "longitudinal": "Longitudinal",
-    "lateral_in_plane": "Lateral (x-z)",
-    "lateral_out_of_plane": "Lateral (y)",
-    "torsional": "Torsional",
-    "rigid": "Rigid rotation",
-}
+PER_FAMILY = 3  # modes of each family in the default selection
+ZERO_TOL = 1e-4  # |Im lambda| (normalised) below which a mode has no period
 
 
-def mode_entry(eigenvalue: complex, family: str, dominant: list, t_scale: float,
-               zero_tol: float = 1e-4) -> dict:
-    """One summary entry; eigenvalue normalised, t_scale in s (Eq. 25)."""
-    lam = complex(eigenvalue)
-    oscillatory = family != "rigid" and abs(lam.imag) > zero_tol
-    return {
-        "family": family,
-        "eigenvalue": [lam.real, lam.imag],
-        "eigenvalue_per_s": [lam.real / t_scale, lam.imag / t_scale],
-        "period_s": 2 * math.pi / abs(lam.imag) * t_scale if oscillatory else None,
-        "dominant": list(dominant),
-    }
+@dataclass
+class ModeResult:
+    """One mode (an eigenvalue with Im >= 0 stands for its conjugate pair), in SI.
+
+    The shape is the real part of the eigenvector turned to make its largest
+    entry real, scaled so that max(max |displacement| [m], max |alpha| [rad])
+    = 1: the ratio of displacement to twist is the physical one."""
+
+    family: str  # one of rawehelix.families.FAMILIES
+    eigenvalue: complex  # normalised (1 / t_scale), Eq. (25)
+    frequency_Hz: float  # |Im lambda| / (2 pi t_scale)
+    decay_per_s: float  # -Re lambda / t_scale (> 0: damped)
+    period_s: float | None  # 1 / frequency_Hz; None for the rigid rotation
+    dominant: list  # dominant components of the eigenvector
+    fractions: dict = field(default_factory=dict)  # kinetic-energy fraction per family
+    s_m: np.ndarray | None = field(default=None, repr=False)  # arc length of the nodes [m]
+    displacement: np.ndarray | None = field(default=None, repr=False)  # (n, 3) [m]
+    alpha_rad: np.ndarray | None = field(default=None, repr=False)  # (n,) twist [rad]
+
+    @classmethod
+    def of(cls, eigenvalue: complex, family: str, dominant, fractions, q, shape=None):
+        """From a normalised eigenvalue; ``shape`` = (s, u (n, 3), alpha) normalised."""
+        lam = complex(eigenvalue)
+        frequency = abs(lam.imag) / (2 * math.pi * q.t_scale)
+        oscillatory = family != "rigid" and abs(lam.imag) > ZERO_TOL
+        mode = cls(family=family, eigenvalue=lam, frequency_Hz=frequency,
+                   decay_per_s=-lam.real / q.t_scale,
+                   period_s=1.0 / frequency if oscillatory else None, dominant=list(dominant),
+                   fractions={k: float(v) for k, v in fractions.items()})
+        if shape is not None:
+            s, u, alpha = shape
+            u_m = q.length_m(u)
+            scale = max(np.linalg.norm(u_m, axis=1).max(), np.abs(alpha).max()) or 1.0
+            mode.s_m, mode.displacement, mode.alpha_rad = q.length_m(s), u_m / scale, alpha / scale
+        return mode
+
+    @property
+    def eigenvalue_per_s(self) -> complex:
+        return complex(-self.decay_per_s, math.copysign(2 * math.pi * self.frequency_Hz,
+                                                        self.eigenvalue.imag))
+
+    def entry(self) -> dict:
+        """The summary.json entry of the mode."""
+        lam, lam_s = self.eigenvalue, self.eigenvalue_per_s
+        return {"family": self.family, "eigenvalue": [lam.real, lam.imag],
+                "eigenvalue_per_s": [lam_s.real, lam_s.imag], "frequency_Hz": self.frequency_Hz,
+                "decay_per_s": self.decay_per_s, "period_s": self.period_s,
+                "dominant": list(self.dominant)}
 
 
-def format_table(modes: list[dict]) -> str:
-    """Table 3 layout: eigenvalue (normalised), dominant components, mode, period (s)."""
-    head = f"{'Eigenvalue':>24}  {'Dominant components':<34} {'Mode':<15} {'Period (s)':>10}"
-    lines = [head, "-" * len(head)]
-    for m in modes:
-        re, im = (round(v, 2) + 0.0 for v in m["eigenvalue"])  # + 0.0: no "-0.00"
-        ev = f"{re:.2f} {'±' if im else '+'} {abs(im):.2f}i"
-        dom = ", ".join(m["dominant"])  # state names as in Table 3: xdot_1, alphadot_0
-        if len(dom) > 34:
-            dom = dom[:31] + "..."
-        period = "N/A" if m["period_s"] is None else f"{m['period_s']:.3f}"
-        lines.append(f"{ev:>24}  {dom:<34} {FAMILY_LABELS.get(m['family'], m['family']):<15} "
-                     f"{period:>10}")
-    return "\n".join(lines)
+class ModesResult(list):
+    """The selected :class:`ModeResult` objects in Table 3 order, with what
+    describes the run (``info``) and the stationary centre line ``x0_m`` (n, 3)
+    [m, FE only] about which they were computed."""
+
+    def __init__(self, modes, info: dict, x0_m=None, radius_m: float = 0.0):
+        super().__init__(modes)
+        self.info, self.x0_m, self.radius_m = info, x0_m, radius_m
+        self.rank = 0  # write() writes on rank 0 only
+
+    @property
+    def summary(self) -> dict:
+        """Exactly what :meth:`write` puts into summary.json."""
+        return {**self.info, "modes": [m.entry() for m in self],
+                # per mode (same order); the twist with beta/delta (Eq. 27)
+                "kinetic_energy_fractions": [dict(m.fractions) for m in self]}
+
+    def firsts(self) -> dict:
+        """The slowest selected mode of each vibrating family that has a shape."""
+        out = {}
+        for m in sorted(self, key=lambda m: abs(m.eigenvalue)):
+            if m.family != "rigid" and m.displacement is not None:
+                out.setdefault(m.family, m)
+        return {f: out[f] for f in VIBRATIONS if f in out}
+
+    def write(self, outdir) -> list[pathlib.Path]:
+        """summary.json (atomic), and with mode shapes modes.png, modes.xdmf
+        and, where pyvista works, one animated GIF per family's first mode.
+        Returns the paths written."""
+        from rawehelix.studies import writers
+        outdir = pathlib.Path(outdir)
+        if self.rank != 0:
+            return []
+        outdir.mkdir(parents=True, exist_ok=True)
+        paths = [writers.write_json(outdir / "summary.json", self.summary)]
+        firsts = self.firsts()
+        if firsts:
+            paths += self._write_shapes(outdir, firsts)
+        return paths
+
+    def _write_shapes(self, outdir: pathlib.Path, firsts: dict) -> list[pathlib.Path]:
+        from rawehelix.studies import writers
+        x0 = self.x0_m
+        L0 = float(np.max(next(iter(firsts.values())).s_m))
+        chord = x0[-1] / np.linalg.norm(x0[-1])
+        normal = np.cross([0.0, 1.0, 0.0], chord)
+        panels, point_data = {}, {"s_m": next(iter(firsts.values())).s_m}
+        for f, m in firsts.items():
+            u, alpha = m.displacement, m.alpha_rad
+            u_max = np.linalg.norm(u, axis=1).max() or 1.0
+            a_max = np.abs(alpha).max() or 1.0
+            # a part below 1e-4 of the other one (normalised units: u / L0) is
+            # round-off or a weak slaved response: drawn as zero, not blown up to 1
+            u_scale = u_max if u_max / L0 >= 1e-4 * a_max else math.inf
+            a_scale = a_max if a_max >= 1e-4 * u_max / L0 else math.inf
+            label = (f"{FAMILY_LABELS[f]}: {m.frequency_Hz:.2f} Hz, decay "
+                     f"{m.decay_per_s:.2f} 1/s\nmax|alpha| / max|displacement| = "
+                     f"{a_max / u_max:.2g} rad/m")
+            panels[label] = (u @ chord / u_scale, u @ normal / u_scale, u[:, 1] / u_scale,
+                             alpha / a_scale)
+            point_data[f"{f}_displacement"] = u
+            point_data[f"{f}_alpha"] = alpha
+        info = self.info
+        paths = [
+            writers.mode_shapes_png(outdir / "modes.png", point_data["s_m"], panels,
+                                    f"First modes of each family, FE N = {info['elements']}, "
+                                    f"p = {info['degree']} (displacement and twist each "
+                                    f"scaled to 1)"),
+            writers.centre_line_xdmf(outdir / "modes.xdmf", x0, point_data)]
+        from rawehelix.studies import render
+        animate = getattr(render, "mode_animation", None)
+        available = getattr(render, "available", None)
+        if animate is not None and available is not None and available():
+            for f, m in firsts.items():
+                path = animate(outdir / f"mode_{f}.gif", m.s_m, x0, m.displacement, m.alpha_rad,
+                               self.radius_m, f"{FAMILY_LABELS[f]}, {m.frequency_Hz:.2f} Hz")
+                if path is not None:
+                    paths.append(pathlib.Path(path))
+        return paths
 
 
-def write_summary(outdir: pathlib.Path, summary: dict) -> pathlib.Path:
-    """Write ``outdir/summary.json`` (creating outdir) and return its path."""
-    outdir = pathlib.Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    path = outdir / "summary.json"
-    path.write_text(json.dumps(summary, indent=2) + "\n")
-    return path
+def _table3_order(modes: list) -> list:
+    return sorted(modes, key=lambda m: (-abs(m.eigenvalue.imag), -abs(m.eigenvalue)))
 
 
-def _select(modes: list, count: int | None) -> list:
-    """The ``count`` slowest modes (smallest |lambda|), kept in Table 3 order."""
-    if count is None or count >= len(modes):
-        return modes
-    keep = sorted(range(len(modes)), key=lambda k: abs(modes[k].eigenvalue))[:max(count, 0)]
-    return [modes[k] for k in sorted(keep)]
+def select(modes: list, count: int | None) -> list:
+    """The lowest PER_FAMILY modes of each family and the rigid ones (count
+    None), or the ``count`` slowest; in Table 3 order."""
+    if count is None:
+        keep = [m for m in modes if m.family == "rigid"]
+        for f in VIBRATIONS:
+            keep += sorted((m for m in modes if m.family == f),
+                           key=lambda m: abs(m.eigenvalue))[:PER_FAMILY]
+    else:
+        keep = sorted(modes, key=lambda m: abs(m.eigenvalue))[:count]
+    return _table3_order(keep)
 
 
-def spline_modes(params: Parameters, count: int | None = None) -> list[dict]:
+def _missing(modes: list, families) -> dict:
+    found = {f: sum(m.family == f for m in modes) for f in families}
+    return {f: k for f, k in found.items() if k < PER_FAMILY}
+
+
+def check_count(count):
+    from rawehelix.studies.scene import SceneError
+    if count is not None and (isinstance(count, bool) or not isinstance(count, (int, np.integer))
+                              or count < 1):
+        raise SceneError("modes", "count", "must be an integer >= 1")
+
+
+def spline_modes(params: Parameters, count: int | None = None) -> ModesResult:
     """Stationary state (Newton from the shooting solution) and spectrum, spline scheme."""
     from rawehelix.solvers.spline_galerkin import spectrum, stationary
     from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
 
-    nd = params.normalised()
-    system = SplineGalerkin(nd, params.discretisation.elements)
-    state = stationary.solve(system)
-    found = _select(spectrum.modes(system, state.x), count)
-    return [mode_entry(m.eigenvalue, m.family, m.dominant, nd.t_scale) for m in found]
+    start = time.perf_counter()
+    q = params.normalised()
+    system = SplineGalerkin(q, params.discretisation.elements)
+    found = spectrum.modes(system, stationary.solve(system).x)
+    chosen = select(found, count)
+    info = {"scheme": "spline", "elements": params.discretisation.elements,
+            "gamma": "off", "model": params.model.describe(),
+            "missing_families": _missing(found, VIBRATIONS) if count is None else {},
+            "wall_s": time.perf_counter() - start}
+    return ModesResult([ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions, q)
+                        for m in chosen], info, radius_m=params.helix.radius_m)
 
 
-def fe_modes(params: Parameters, outdir: pathlib.Path | None, count: int | None = None,
-             comm=None, log=print, scene: str = "scene") -> dict:
-    """Stationary state, its modes (SLEPc, :mod:`rawehelix.solvers.modal`) and the outputs.
-
-    Writes on rank 0 only: ``summary.json``, ``modes.png`` (the first mode of
-    each family) and ``modes.xdmf`` (the stationary centre line with those
-    modes as point data, for ParaView).  Returns the summary on every rank."""
-    import numpy as np
+def fe_modes(params: Parameters, count: int | None = None, comm=None,
+             scene: str = "scene") -> ModesResult:
+    """Stationary state and its modes (SLEPc), FE scheme; the same result on every rank."""
     from mpi4py import MPI
 
-    from rawehelix.solvers.modal import FAMILIES, ModalSolver
-    from rawehelix.studies import writers
+    from rawehelix.solvers.modal import ModalSolver
 
     comm = comm or MPI.COMM_WORLD
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
-    solver = ModalSolver(params, comm, scene=scene)
-    solver.linearise()
+    solver = ModalSolver.from_stationary(params, comm, scene=scene)
     nev = None if count is None else max(solver.default_nev(), 2 * count + 4)
     found = solver.solve(nev=nev, require_families=False)
-    if count is None:
-        missing = solver.missing
-    else:
-        missing = {}
-    modes = _select(found, count)
-    wall = time.perf_counter() - start
-    firsts = {}
-    for m in found:  # sorted by |lambda|: the first of each family
-        if m.family != "rigid" and m.family not in firsts:
-            firsts[m.family] = m
-    firsts = {f: firsts[f] for f in FAMILIES if f in firsts}
-    shapes = {f: solver.mode_shape(m) for f, m in firsts.items()}  # collective
-    stationary = solver.stationary.gather()  # collective
-    summary = None
+    chosen = select(found, count)
+    shapes = [solver.mode_shape(m) for m in chosen]  # collective
+    _, x0 = solver.centre_line()  # collective
+    result = None
     if comm.rank == 0:
-        summary = {
-            "scheme": "fe",
-            "elements": disc.elements,
-            "degree": disc.degree,
-            "dofs": solver.rod.dof_count(),
-            "ranks": comm.size,
-            "gamma": params.model.gamma,
-            "model": params.model.describe(),
-            "mean_tension_N": float(q.tension_N(solver.mean_tension_value)),
-            "missing_families": missing,
-            "wall_s": wall,
-            "modes": [mode_entry(m.eigenvalue, m.family, m.dominant, q.t_scale) for m in modes],
-        }
-        # per mode (same order): kinetic-energy fractions, twist with beta/delta (Eq. 27)
-        summary["kinetic_energy_fractions"] = [
-            {k: float(v) for k, v in m.fractions.items()} for m in modes]
-        if outdir is not None:
-            outdir = pathlib.Path(outdir)
-            outdir.mkdir(parents=True, exist_ok=True)
-            x = stationary.centre_line
-            chord = q.top_position() / np.linalg.norm(q.top_position())
-            normal = np.cross([0.0, 1.0, 0.0], chord)
-            panels, point_data = {}, {"s_m": q.length_m(stationary.s)}
-            for f, m in firsts.items():
-                s, u, alpha = shapes[f]
-                lam = m.eigenvalue
-                u_max = np.linalg.norm(u, axis=1).max() or 1.0
-                a_max = np.abs(alpha).max() or 1.0
-                # a part below 1e-4 of the other one (normalised units) is round-off
-                # or a weak slaved response: drawn as zero, not blown up to 1
-                u_scale = u_max if u_max >= 1e-4 * a_max else math.inf
-                a_scale = a_max if a_max >= 1e-4 * u_max else math.inf
-                label = (f"{FAMILY_LABELS[f]}: lambda = {lam.real:.2f} + {lam.imag:.2f}i, "
-                         f"{abs(lam.imag) / (2 * math.pi * q.t_scale):.2f} Hz\n"
-                         f"max|alpha| / max|r~ displacement| = {a_max / u_max:.2g}")
-                panels[label] = (u @ chord / u_scale, u @ normal / u_scale, u[:, 1] / u_scale,
-                                 alpha / a_scale)
-                point_data[f"{f}_displacement"] = u
-                point_data[f"{f}_alpha"] = alpha
-            writers.mode_shapes_png(outdir / "modes.png", q.length_m(stationary.s), panels,
-                                    f"First modes of each family, FE N = {disc.elements}, "
-                                    f"p = {disc.degree} (displacement and twist each scaled to 1)")
-            writers.centre_line_xdmf(outdir / "modes.xdmf", q.length_m(x), point_data)
-            writers.write_json(outdir / "summary.json", summary)
-    return comm.bcast(summary, root=0)
+        info = {"scheme": "fe", "elements": disc.elements, "degree": disc.degree,
+                "dofs": solver.rod.dof_count(), "ranks": comm.size, "gamma": params.model.gamma,
+                "model": params.model.describe(),
+                "mean_tension_N": float(q.tension_N(solver.mean_tension_value)),
+                "missing_families": solver.missing if count is None else {},
+                "wall_s": time.perf_counter() - start}
+        result = ModesResult([ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions, q,
+                                            shape) for m, shape in zip(chosen, shapes)],
+                             info, x0_m=q.length_m(x0), radius_m=params.helix.radius_m)
+    result = comm.bcast(result, root=0)
+    result.rank = comm.rank
+    return result
 
 
-def run(params: Parameters, outdir: pathlib.Path, count: int | None = None, log=print) -> dict:
-    """Modes of the stationary state; prints the table and writes ``summary.json``.
+def compute(params: Parameters, count: int | None = None, comm=None,
+            scene: str | None = None) -> ModesResult:
+    """Modes of the stationary state for ``params.discretisation.scheme``.
 
     Parameters
     ----------
-    params : the scene; ``params.discretisation.scheme`` picks the solver.
-    outdir : created only after the computation succeeded.
-    count : keep the ``count`` slowest modes (all when None).
+    params : the scene (scheme ``fe`` or ``spline``).
+    count : the ``count`` slowest modes; None: the lowest 3 of each family
+        and the rigid rotation.
+    comm : MPI communicator of the FE scheme (COMM_WORLD by default).
+    scene : name used in error messages (default: the scene's name).
+
+    Raises SceneError for a bad count, SolverError if a solve fails.
     """
+    check_count(count)
     scheme = params.discretisation.scheme
     if scheme == "fe":
-        summary = fe_modes(params, outdir, count, log=log)
-        log(f"Modes of the stationary state, scheme fe, N = {summary['elements']}, "
-            f"p = {summary['degree']} ({summary['dofs']} dofs, {summary['wall_s']:.2f} s)")
-        log(format_table(summary["modes"]))
-        if summary["missing_families"]:
-            log(f"note: fewer than 3 modes found for {summary['missing_families']}: "
-                "try more elements (--elements) or -rawehelix_pep_nev")
-        log(f"wrote {outdir}/summary.json, modes.png, modes.xdmf")
-        return summary
-    if scheme != "spline":
+        result = fe_modes(params, count, comm, scene or params.name)
+    elif scheme == "spline":
+        result = spline_modes(params, count)
+    else:
         raise ValueError(f"unknown scheme {scheme!r}")
-    start = time.perf_counter()
-    modes = spline_modes(params, count)
-    summary = {
-        "scheme": scheme,
-        "elements": params.discretisation.elements,
-        "wall_s": time.perf_counter() - start,
-        "modes": modes,
-    }
-    log(f"Modes of the stationary state, scheme {scheme}, N = {summary['elements']}")
-    log(format_table(modes))
-    write_summary(outdir, summary)
-    return summary
+    result.info = {"scene": params.name, **result.info}
+    return result
+
+
+def format_table(result) -> str:
+    """Table 3 layout: eigenvalue (normalised), dominant components, mode,
+    period and frequency (SI)."""
+    head = (f"{'Eigenvalue':>24}  {'Dominant components':<34} {'Mode':<15} {'Period (s)':>10} "
+            f"{'f (Hz)':>9} {'Decay (1/s)':>11}")
+    lines = [head, "-" * len(head)]
+    for m in result:
+        re, im = (round(v, 2) + 0.0 for v in (m.eigenvalue.real, m.eigenvalue.imag))  # no "-0.00"
+        ev = f"{re:.2f} {'±' if im else '+'} {abs(im):.2f}i"
+        dom = ", ".join(m.dominant)  # state names as in Table 3: xdot_1, alphadot_0
+        if len(dom) > 34:
+            dom = dom[:31] + "..."
+        period = "N/A" if m.period_s is None else f"{m.period_s:.3f}"
+        lines.append(f"{ev:>24}  {dom:<34} {FAMILY_LABELS.get(m.family, m.family):<15} "
+                     f"{period:>10} {m.frequency_Hz:>9.3f} {round(m.decay_per_s, 3) + 0.0:>11.3f}")
+    return "\n".join(lines)
+
+
+def report(result: ModesResult) -> str:
+    """What ``rawehelix modes`` prints: a header, the table, and a note on
+    any family with fewer modes than asked for."""
+    info = result.info
+    disc = (f"N = {info['elements']}, p = {info['degree']} ({info['dofs']} dofs, "
+            if info["scheme"] == "fe" else f"N = {info['elements']} (")
+    lines = [f"Modes of the stationary state, scheme {info['scheme']}, {disc}"
+             f"{info['wall_s']:.2f} s)", format_table(result)]
+    if info["missing_families"]:
+        lines.append(f"note: fewer than {PER_FAMILY} modes found for {info['missing_families']}: "
+                     "try more elements (--elements)" + (" or -rawehelix_pep_nev"
+                                                          if info["scheme"] == "fe" else ""))
+    return "\n".join(lines)
+
+
+__all__ = ["ModeResult", "ModesResult", "compute", "format_table", "report", "select"]

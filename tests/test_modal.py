@@ -51,13 +51,17 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from rawehelix.families import VIBRATIONS
 from rawehelix.parameters import (Discretisation, Ends, Environment, Helix, Model, ParameterError,
-                                        Parameters)
-from rawehelix.solvers import shooting
-from rawehelix.solvers.modal import ModalSolver, create_pep
+                                  Parameters)
+from rawehelix.solvers import analytic, shooting
+from rawehelix.solvers.modal import ModalSolver
+from rawehelix.solvers.pep import create_pep
+from rawehelix.solvers.stationary import StationarySolver
+from rawehelix.studies import modes as study
 from rawehelix.studies import scene
+from rawehelix.studies.scene import SceneError
 
-FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional")
 N, P = 8, 3
 
 
@@ -84,13 +88,12 @@ SCENES = {"table2": table2, "second": second_helix}
 
 
 def classical(q, T, family, n):
-    """omega_n of the classical model of ``family`` (module docstring)."""
-    k = n * math.pi
+    """omega_n of the classical model of ``family`` (module docstring, solvers.analytic)."""
     if family == "longitudinal":
-        return math.sqrt(q.sigma * (1 + 2 * T / q.sigma) * k**2 + q.mu * k**4)
+        return float(analytic.bar(q, n, T))
     if family.startswith("lateral"):
-        return math.sqrt(T * k**2 + q.mu * k**4)
-    return k * math.sqrt(q.delta)
+        return float(analytic.beam(q, n, T))
+    return float(analytic.shaft(q, n))
 
 
 @functools.lru_cache
@@ -107,8 +110,7 @@ _cache = {}
 def spectrum(name, comm=MPI.COMM_SELF, gamma="off", N=N, p=P):
     key = (name, comm.size, gamma, N, p)
     if key not in _cache:
-        solver = ModalSolver(SCENES[name](N, p, gamma), comm)
-        solver.linearise()
+        solver = ModalSolver.from_stationary(SCENES[name](N, p, gamma), comm)
         _cache[key] = (solver, solver.solve())
     return _cache[key]
 
@@ -118,7 +120,7 @@ def first(modes, family, count=3):
 
 
 @pytest.mark.parametrize("name", SCENES)
-@pytest.mark.parametrize("family", FAMILIES)
+@pytest.mark.parametrize("family", VIBRATIONS)
 def test_classical_frequencies(name, family):
     """|lambda_n| of the first three modes of each family within 0.5 % of the
     classical omega_n (bar, tensioned pinned beam, free-free shaft)."""
@@ -132,7 +134,7 @@ def test_classical_frequencies(name, family):
     assert max(abs(e) for e in errors) < 5e-3, errors
 
 
-@pytest.mark.parametrize("family", FAMILIES)
+@pytest.mark.parametrize("family", VIBRATIONS)
 def test_damping_table2(family):
     """Re lambda = -c/2, c = nu v_w0 (1 + (e.i_E)^2), within 2 %: e along the
     chord (longitudinal), normal to it in the x-z plane, and along y; the twist
@@ -168,7 +170,7 @@ def test_rigid_rotation(name):
     assert abs(rigid[0].eigenvalue) < 1e-4
     assert rigid[0].fractions["torsional"] > 0.999
     others = min(abs(m.eigenvalue) for m in modes if m.family != "rigid")
-    assert others == pytest.approx(math.pi * math.sqrt(solver.q.delta), rel=5e-3)
+    assert others == pytest.approx(float(analytic.shaft(solver.q, 1)), rel=5e-3)
 
 
 def test_dirichlet_rows_give_no_spurious_eigenvalues():
@@ -185,7 +187,7 @@ def test_dirichlet_rows_give_no_spurious_eigenvalues():
     assert all(solver.bc_amplitude(m) < 100 * m.error + 1e-12 for m in modes)
     assert all(abs(abs(m.eigenvalue) - 1.0) > 0.5 for m in modes)
     import dolfinx.fem.petsc
-    M1 = dolfinx.fem.petsc.assemble_matrix(solver.a_M, bcs=solver.bcs, diagonal=1.0)
+    M1 = dolfinx.fem.petsc.assemble_matrix(solver.lin.a_M, bcs=solver.bcs, diagonal=1.0)
     M1.assemble()
     pep = create_pep(MPI.COMM_SELF, [solver.K, solver.C, M1], 16, 0.5,
                     solver.finite_eigenvalue_count(), prefix="rawehelix_naive_")
@@ -227,12 +229,11 @@ def test_without_twist_field():
     twist-free stationary state, so the block-triangular spectrum keeps the
     centre-line eigenvalues of the full model: equal to 1e-8 here (N = 8)."""
     _, full = spectrum("table2")
-    solver = ModalSolver(table2().replace(model={"twist": False}), MPI.COMM_SELF)
-    solver.linearise()
+    solver = ModalSolver.from_stationary(table2().replace(model={"twist": False}), MPI.COMM_SELF)
     modes = solver.solve()
-    assert solver.families == FAMILIES[:3]
+    assert solver.families == VIBRATIONS[:3]
     assert not [m for m in modes if m.family in ("torsional", "rigid")]
-    for family in FAMILIES[:3]:
+    for family in VIBRATIONS[:3]:
         a, b = np.array(first(modes, family)), np.array(first(full, family))
         assert len(a) == 3 and np.max(np.abs(a - b) / np.abs(b)) < 1e-8, (family, a, b)
     assert max(solver.bc_amplitude(m) for m in modes[:10]) < 1e-9  # alpha = 0 holds
@@ -263,16 +264,103 @@ def test_cli_writes_outputs(tmp_path):
     """``rawehelix modes`` with the FE scheme: table, summary.json (the spline
     reference's mode keys plus discretisation and wall time), PNG and XDMF."""
     import json
-    from rawehelix.studies import modes as study
     lines = []
-    summary = study.run(table2(4, 3, gamma="regularised"), tmp_path, count=6, log=lines.append)
+    result = study.compute(table2(4, 3, gamma="regularised"), count=6, comm=MPI.COMM_SELF)
+    lines = study.report(result).splitlines()
+    result.write(tmp_path)
+    summary = result.summary
     saved = json.loads((tmp_path / "summary.json").read_text())
+    assert saved == summary
     assert saved["elements"] == 4 and saved["degree"] == 3 and saved["wall_s"] > 0
-    assert len(saved["modes"]) == 6 == len(summary["modes"])
+    assert len(saved["modes"]) == 6
     for m in saved["modes"]:
-        assert set(m) == {"family", "eigenvalue", "eigenvalue_per_s", "period_s", "dominant"}
+        assert set(m) == {"family", "eigenvalue", "eigenvalue_per_s", "frequency_Hz",
+                          "decay_per_s", "period_s", "dominant"}
     assert len(saved["kinetic_energy_fractions"]) == 6
-    assert saved["modes"][0]["family"] == "rigid"
+    assert saved["modes"][-1]["family"] == "rigid"  # Table 3 order: the zero eigenvalue last
     assert (tmp_path / "modes.png").stat().st_size > 1000
     assert "lateral_in_plane_displacement" in (tmp_path / "modes.xdmf").read_text()
     assert any("Torsional" in line for line in lines)
+
+
+def test_solver_takes_a_state():
+    """ModalSolver runs no Newton: it linearises about the state it is given,
+    here a stationary state of another rod of the same discretisation, and
+    finds the spectrum of ModalSolver.from_stationary."""
+    params = table2(4)
+    solver = ModalSolver(params, MPI.COMM_SELF)
+    assert solver.stationary_result is None and not np.any(solver.rod.w.x.array)
+    with pytest.raises(RuntimeError, match="linearise"):
+        solver.solve()
+    state = StationarySolver(params, MPI.COMM_SELF).solve().state
+    solver.linearise(state)
+    assert np.array_equal(solver.rod.w.x.array, state.w)
+    shared = ModalSolver.from_stationary(params, MPI.COMM_SELF)
+    assert shared.stationary_result.newton_iterations > 0
+    a = np.array([m.eigenvalue for m in solver.solve(nev=12)])
+    b = np.array([m.eigenvalue for m in shared.solve(nev=12)])
+    assert np.allclose(a, b, rtol=1e-9, atol=1e-7)
+
+
+def _check_default_selection(result, families):
+    for family in families:
+        assert sum(m.family == family for m in result) == 3, [(m.family, m.eigenvalue)
+                                                             for m in result]
+    assert result[-1].family == "rigid" and all(m.period_s is None for m in result
+                                                if m.family == "rigid")
+    im = [abs(m.eigenvalue.imag) for m in result]
+    assert im == sorted(im, reverse=True)  # Table 3 order
+    assert result.summary["missing_families"] == {}
+
+
+def test_compute_default_selection_fe(tmp_path, monkeypatch):
+    """compute(): the lowest 3 modes of each family and the rigid rotation, in
+    SI; the shapes at unit amplitude; nothing written until write()."""
+    monkeypatch.chdir(tmp_path)
+    params = table2(4)
+    q = params.normalised()
+    result = study.compute(params, comm=MPI.COMM_SELF)
+    assert not list(tmp_path.iterdir())
+    _check_default_selection(result, VIBRATIONS)
+    assert sum(m.family == "rigid" for m in result) == 1
+    for m in result:
+        assert m.frequency_Hz == pytest.approx(abs(m.eigenvalue.imag) / (2 * math.pi * q.t_scale))
+        assert m.decay_per_s == pytest.approx(-m.eigenvalue.real / q.t_scale)
+        n = len(m.s_m)
+        assert m.displacement.shape == (n, 3) and m.alpha_rad.shape == (n,)
+        amp = max(np.linalg.norm(m.displacement, axis=1).max(), np.abs(m.alpha_rad).max())
+        assert amp == pytest.approx(1.0)
+        assert m.s_m[0] == 0.0 and m.s_m[-1] == pytest.approx(params.helix.length_m)
+    lon = next(m for m in result if m.family == "longitudinal")
+    assert np.linalg.norm(lon.displacement, axis=1).max() == pytest.approx(1.0)
+    assert result.x0_m.shape == (len(lon.s_m), 3)
+    assert "Rigid rotation" in study.format_table(result)
+    # the animation of studies.render, when it is there: one GIF per family's first mode
+    from rawehelix.studies import render
+    calls = []
+
+    def animation(path, s_m, x0_m, displacement, alpha_rad, radius_m, title):
+        assert x0_m.shape == displacement.shape and alpha_rad.shape == s_m.shape
+        assert radius_m == params.helix.radius_m
+        calls.append(title)
+        path.write_bytes(b"GIF89a")
+        return path
+
+    monkeypatch.setattr(render, "mode_animation", animation, raising=False)
+    monkeypatch.setattr(render, "available", lambda: True, raising=False)
+    paths = result.write(tmp_path / "out")
+    assert {p.name for p in paths} == {"summary.json", "modes.png", "modes.xdmf",
+                                       *(f"mode_{f}.gif" for f in VIBRATIONS)}
+    assert len(calls) == 4 and calls[0].startswith("Longitudinal")
+
+
+def test_compute_default_selection_spline():
+    result = study.compute(scene.load("stationary_table2", scheme="spline", elements=4))
+    _check_default_selection(result, VIBRATIONS)
+    assert all(m.displacement is None for m in result)  # no shapes from the reference
+
+
+@pytest.mark.parametrize("count", [0, -2, 2.5, True, "3"])
+def test_compute_refuses_a_bad_count(count):
+    with pytest.raises(SceneError, match="modes: count: must be an integer >= 1"):
+        study.compute(table2(4), count=count, comm=MPI.COMM_SELF)

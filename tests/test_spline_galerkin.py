@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from rawehelix.solvers import analytic
 from rawehelix.solvers.spline_galerkin import dynamics, spectrum, stationary
 from rawehelix.solvers.spline_galerkin.basis import SplineBasis
 from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
@@ -153,23 +154,19 @@ def test_spectrum_N8_against_analytic_estimates(nd):
     T = nd.sigma * nd.eps0
     tors = _family(modes, "torsional")
     for n in (1, 2, 3):
-        assert abs(tors[n - 1]) == pytest.approx(n * math.pi * math.sqrt(nd.delta), rel=0.01)
+        assert abs(tors[n - 1]) == pytest.approx(analytic.shaft(nd, n), rel=0.01)
         assert abs(tors[n - 1].real) < 1e-6
     c_in = nd.nu * nd.v_w0 * (1 + math.cos(nd.Gamma0) ** 2)
     c_out = nd.nu * nd.v_w0
     for family, c in (("lateral_in_plane", c_in), ("lateral_out_of_plane", c_out)):
         lat = _family(modes, family)
         for n in (1, 2):
-            k = n * math.pi
-            assert abs(lat[n - 1]) == pytest.approx(math.sqrt(k**2 * T + nd.mu * k**4), rel=0.02)
+            assert abs(lat[n - 1]) == pytest.approx(analytic.beam(nd, n, T), rel=0.02)
             assert -lat[n - 1].real == pytest.approx(c / 2, rel=0.02)
     lon = _family(modes, "longitudinal")
-    assert abs(lon[0]) == pytest.approx(math.pi * math.sqrt(nd.sigma), rel=0.02)
     # the model's own bar: d(T r')/d|r'| = sigma (1 + 2 eps0), and the bending term
-    # mu r^(4) acts on the axial component too (Eqs. 30, 33):
-    # omega^2 = pi^2 sigma (1 + 2 eps0) + mu pi^4
-    refined = math.sqrt(math.pi**2 * nd.sigma * (1 + 2 * nd.eps0) + nd.mu * math.pi**4)
-    assert abs(lon[0]) == pytest.approx(refined, rel=0.002)
+    # mu r^(4) acts on the axial component too (Eqs. 30, 33): within 0.2 %
+    assert abs(lon[0]) == pytest.approx(analytic.bar(nd, 1, T), rel=0.002)
     assert -lon[0].real == pytest.approx(c_in / 2, rel=0.02)
 
 
@@ -197,14 +194,24 @@ def test_nominal_operation_settles_at_120_rpm():
 
 
 # -- studies/modes.py -------------------------------------------------------------------
+def run_modes(params, outdir, count=None, log=lambda *a: None):
+    """What `rawehelix modes` does: compute, print, write; returns the summary."""
+    result = modes_study.compute(params, count)
+    for line in modes_study.report(result).splitlines():
+        log(line)
+    result.write(outdir)
+    return result.summary
+
+
 def test_modes_run_writes_summary(tmp_path):
     params = scene.load("stationary_table2", scheme="spline", elements=2)
     out = tmp_path / "modes"
     lines = []
-    summary = modes_study.run(params, out, log=lines.append)
+    summary = run_modes(params, out, log=lines.append)
     data = json.loads((out / "summary.json").read_text())
     assert data["scheme"] == "spline" and data["elements"] == 2 and data["wall_s"] >= 0
-    keys = {"family", "eigenvalue", "eigenvalue_per_s", "period_s", "dominant"}
+    keys = {"family", "eigenvalue", "eigenvalue_per_s", "frequency_Hz", "decay_per_s", "period_s",
+            "dominant"}
     assert all(set(m) == keys for m in data["modes"])
     lon = [m for m in data["modes"] if m["family"] == "longitudinal"][0]
     assert lon["period_s"] == pytest.approx(0.03, abs=0.002)  # Table 3
@@ -212,7 +219,7 @@ def test_modes_run_writes_summary(tmp_path):
     assert all(m["period_s"] is None for m in data["modes"] if m["family"] == "rigid")
     assert "Longitudinal" in "\n".join(lines)
     assert summary["modes"] == data["modes"]
-    few = modes_study.run(params, tmp_path / "few", count=3, log=lambda *a: None)
+    few = run_modes(params, tmp_path / "few", count=3, log=lambda *a: None)
     assert len(few["modes"]) == 3
 
 
@@ -226,7 +233,7 @@ def test_modes_run_fe_failure_leaves_no_output(tmp_path, monkeypatch):
     monkeypatch.setattr(modal.ModalSolver, "solve", boom)
     params = scene.load("stationary_table2", scheme="fe", elements=2)
     with pytest.raises(SolverError):
-        modes_study.run(params, tmp_path / "fe")
+        run_modes(params, tmp_path / "fe")
     assert not (tmp_path / "fe").exists()
 
 
@@ -236,5 +243,5 @@ def test_modes_run_failure_leaves_no_output(tmp_path, monkeypatch):
     monkeypatch.setattr(modes_study, "spline_modes", boom)
     params = scene.load("stationary_table2", scheme="spline", elements=2)
     with pytest.raises(RuntimeError):
-        modes_study.run(params, tmp_path / "x")
+        run_modes(params, tmp_path / "x")
     assert not (tmp_path / "x").exists()

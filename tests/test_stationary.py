@@ -195,7 +195,5 @@ def test_solver_defaults_do_not_leak_into_the_options_database():
     StationarySolver(table2(4), MPI.COMM_SELF).solve()
     DynamicsSolver.from_stationary(scene.load("nominal_operation", elements=4), MPI.COMM_SELF,
                                    options={"ts_type": "cn"})
-    modal = ModalSolver(table2(4), MPI.COMM_SELF)
-    modal.linearise()
-    modal.solve(nev=6)
+    ModalSolver.from_stationary(table2(4), MPI.COMM_SELF).solve(nev=6)
     assert PETSc.Options().getAll() == before

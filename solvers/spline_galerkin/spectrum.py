@@ -8,9 +8,11 @@ with no step-size trade-off.
 Families come from the kinetic-energy fractions of the eigenvector's position
 part q (for lambda != 0 the velocity part is lambda q, with the same fractions):
 
-* centre line, with the consistent mass P0 (Eq. 50): displacement along the
-  chord (``longitudinal``), normal to it in the x-z plane (``lateral_in_plane``),
-  along y (``lateral_out_of_plane``);
+* centre line: the kinetic energy int |u.e|^2 ds (the Gauss rule of the
+  consistent mass P0, Eq. 50) of the displacement u(s) along the local tangent
+  t(s) of the stationary centre line (``longitudinal``), along n = j_E x t
+  (in the x-z plane, ``lateral_in_plane``) and along j_E
+  (``lateral_out_of_plane``): the frame of the FE scheme (solvers.linearise);
 * twist, (beta/delta) alpha^H Q0 alpha (Eq. 53): ``torsional``.  beta/delta is
   the rotational inertia per unit length 2 rho I / (rho A L0^2) of Eq. (27).
 
@@ -26,13 +28,11 @@ import numpy as np
 
 from .system import SplineGalerkin
 
-FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional", "rigid")
-
 
 @dataclass
 class Mode:
     eigenvalue: complex  # normalised; one of each conjugate pair (Im >= 0)
-    family: str
+    family: str  # one of rawehelix.families.FAMILIES
     fractions: dict  # energy fraction per family (without "rigid")
     dominant: list  # names of the state components with |v_k| >= 0.5 max |v|
 
@@ -43,23 +43,26 @@ def jacobian(system: SplineGalerkin, x: np.ndarray, t: float = 0.0) -> np.ndarra
 
 
 def energy_fractions(system: SplineGalerkin, x: np.ndarray, v: np.ndarray) -> dict:
-    """Kinetic-energy fractions of the position part of eigenvector v."""
-    nd, mat = system.nd, system.mat
-    top = system.nodes(system.split(x)[0], 0.0)[-1].real
-    e_c = top / np.linalg.norm(top)  # chord
+    """Kinetic-energy fractions of the position part of eigenvector v, at the
+    Gauss points (exact for P0 where the frame is constant)."""
+    nd, mat, B = system.nd, system.mat, system.basis
+    R = system.nodes(system.split(x)[0], 0.0).real
+    t = B.D[1] @ R
+    t /= np.linalg.norm(t, axis=1)[:, None]  # local tangent of the stationary state
     j_E = np.array([0.0, 1.0, 0.0])
-    n_c = np.cross(j_E, e_c)  # in-plane normal to the chord
-    d = v[:system.n_r].reshape(-1, 3)
+    n = np.cross(j_E, t)
+    n /= np.linalg.norm(n, axis=1)[:, None]  # in-plane normal
+    u = B.D[0][:, 1:system.N] @ v[:system.n_r].reshape(-1, 3)  # displacement at the Gauss points
     alpha = v[system.n_r:system.n_q]
 
-    def quad(P, a):
-        return float(np.real(np.conj(a) @ P @ a))
+    def quad(a):
+        return float(B.w @ np.abs(a)**2)
 
     E = {
-        "longitudinal": quad(mat.P0, d @ e_c),
-        "lateral_in_plane": quad(mat.P0, d @ n_c),
-        "lateral_out_of_plane": quad(mat.P0, d @ j_E),
-        "torsional": nd.beta / nd.delta * quad(mat.Q0, alpha),
+        "longitudinal": quad(np.sum(u * t, axis=1)),
+        "lateral_in_plane": quad(np.sum(u * n, axis=1)),
+        "lateral_out_of_plane": quad(u @ j_E),
+        "torsional": nd.beta / nd.delta * float(np.real(np.conj(alpha) @ mat.Q0 @ alpha)),
     }
     total = sum(E.values()) or 1.0
     return {k: e / total for k, e in E.items()}

@@ -17,6 +17,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
+from rawehelix.families import VIBRATIONS
 from rawehelix.solvers.spline_galerkin import spectrum
 from rawehelix.studies import metrics
 
@@ -91,15 +92,11 @@ def _shooting_tension_s0(params: Parameters):
     return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
 
 
-#: the mode families of Table 3 (without the rigid rotation)
-FAMILIES = tuple(f for f in spectrum.FAMILIES if f != "rigid")
-
-
 def _fe_modes(p: Parameters) -> list:
     """The FE modes (:class:`rawehelix.solvers.modal.Mode`) of the linearised
     stationary state: the one modal call of the studies."""
     from rawehelix.solvers.modal import ModalSolver
-    solver = ModalSolver(p, MPI.COMM_SELF)
+    solver = ModalSolver.from_stationary(p, MPI.COMM_SELF)
     return solver.solve(keep_vectors=False, require_families=False)
 
 
@@ -117,9 +114,9 @@ def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
     lowest = {}
     for m in modes:
         lam = abs(complex(m.eigenvalue)) / q.t_scale  # Eq. (25)
-        if m.family in FAMILIES and lam > 1e-9:
+        if m.family in VIBRATIONS and lam > 1e-9:
             lowest[m.family] = min(lowest.get(m.family, math.inf), lam)
-    return np.array([lowest.get(f, math.nan) for f in FAMILIES])
+    return np.array([lowest.get(f, math.nan) for f in VIBRATIONS])
 
 
 # -- dynamics (Sec. 5.2) -------------------------------------------------------------
@@ -238,7 +235,7 @@ def quantities() -> dict:
         "eigenvalues": Quantity("eigenvalues", "1/s",
                                 [Method(f"FE p={p}", "fe", p, (2, 4, 8, 16, 32)) for p in (2, 3, 4)]
                                 + [Method("spline", "spline", None, (2, 4, 8, 16))],
-                                "FE p=4", eigenvalues, list(FAMILIES)),
+                                "FE p=4", eigenvalues, list(VIBRATIONS)),
         **{name: Quantity(name, unit, _dynamic_methods(ladder_fe, ladder_spline, dts, N), "FE p=4",
                           fn, [label], time_reference=f"FE N={N} p=3 alpha2 (dt)",
                           **(SPIN_SCALE if name == "spin_overshoot" else {}))

@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix.solvers import analytic
+
 HERE = Path(__file__).parent
 
 
@@ -46,17 +48,10 @@ def _lowest(modes, family):
 
 def _modal(params, torque=None, nev=None):
     from rawehelix.solvers.modal import ModalSolver
-    solver = ModalSolver(params, MPI.COMM_SELF)
-    if torque is not None:  # equal end torques, Eqs. (38)-(39): steady twist tau = m
-        solver.rod.c.m0.value = solver.rod.c.mN.value = torque
-    solver.linearise()
+    # equal end torques, Eqs. (38)-(39): steady twist tau = m
+    solver = ModalSolver.from_stationary(params, MPI.COMM_SELF,
+                                         end_torques=None if torque is None else (torque, torque))
     return solver, solver.solve(nev=nev, require_families=False)
-
-
-def _beam_string(q, T, n=1):
-    """Pinned beam under tension: omega^2 = (n pi)^2 T + mu (n pi)^4 (normalised)."""
-    k = n * math.pi
-    return math.sqrt(k**2 * T + q.mu * k**4)
 
 
 def _shooting_check(params):
@@ -81,7 +76,7 @@ def axial_x100():
     fine = StationarySolver(params.replace(discretisation={"elements": 64}), MPI.COMM_SELF).solve()
     dT = float(abs(coarse.tension[0] / fine.tension[0] - 1))
     _, modes = _modal(params.replace(model={"gravity": False, "drag": False}))
-    bar = math.pi * math.sqrt(q.sigma * (1 + 2 * q.eps0) + q.mu * math.pi**2)  # axial, n = 1
+    bar = float(analytic.bar(q, 1, q.sigma * q.eps0))  # axial, n = 1
     lon = _lowest(modes, "longitudinal")
     return Outcome("axial_x100", "converged",
                    f"T(0) = {q.tension_N(coarse.tension[0]):.2f} N at N = 16 differs from N = 64 by "
@@ -98,7 +93,7 @@ def near_zero_tension():
     fe = StationarySolver(params, MPI.COMM_SELF).solve()
     T = q.sigma * q.eps0
     _, modes = _modal(params)
-    lat, beam = _lowest(modes, "lateral_in_plane"), _beam_string(q, T)
+    lat, beam = _lowest(modes, "lateral_in_plane"), float(analytic.beam(q, 1, T))
     err = abs(lat / beam - 1)
     return Outcome("near_zero_tension", "converged",
                    f"T = {q.tension_N(fe.tension[0]) * 1e3:.2f} mN (EA eps0); the lateral modes "
@@ -131,13 +126,13 @@ def string_limit():
     T = q.sigma * q.eps0
     _, modes = _modal(params)
     lat = _lowest(modes, "lateral_in_plane")
-    string = math.pi * math.sqrt(T)
+    string, beam = float(analytic.string(1, T)), float(analytic.beam(q, 1, T))
     return Outcome("string_limit", "converged",
                    f"mu = {q.mu:.1e}: the first lateral mode {lat:.4f} approaches the string's "
                    f"{string:.4f} (rel. {abs(lat / string - 1):.1e}; beam-string "
-                   f"{abs(lat / _beam_string(q, T) - 1):.1e})",
+                   f"{abs(lat / beam - 1):.1e})",
                    {"string_rel_diff": abs(lat / string - 1),
-                    "beam_string_rel_err": abs(lat / _beam_string(q, T) - 1)})
+                    "beam_string_rel_err": abs(lat / beam - 1)})
 
 
 def bending_x100():
@@ -147,7 +142,7 @@ def bending_x100():
     # delta = beta sigma / (2 mu) (Eq. 27) falls 100-fold with EI, so the lowest
     # lateral mode sits above ~150 torsional ones: ask for 180 modes
     _, modes = _modal(params.replace(model={"gravity": False, "drag": False}), nev=180)
-    lat, beam = _lowest(modes, "lateral_in_plane"), _beam_string(q, q.sigma * q.eps0)
+    lat, beam = _lowest(modes, "lateral_in_plane"), float(analytic.beam(q, 1, q.sigma * q.eps0))
     tor = _lowest(modes, "torsional")
     return Outcome("bending_x100", "converged",
                    f"T(0) agrees with shooting to {dT:.1e}; the first lateral mode is the "
@@ -176,7 +171,7 @@ def torsional_buckling(fractions=(0.9, 0.99, 1.02)):
     if unstable and min(unstable) > 1.0 and all(rows[f][0] < 1e-3 for f in fractions if f < 1):
         return Outcome("torsional_buckling", "detected",
                        f"stable up to {max(f for f in fractions if f < 1)} M_cr (lowest lateral "
-                       f"|lambda| falls from {_beam_string(q, T):.1f} to {rows[max(f for f in fractions if f < 1)][1]:.2f}); "
+                       f"|lambda| falls from {float(analytic.beam(q, 1, T)):.1f} to {rows[max(f for f in fractions if f < 1)][1]:.2f}); "
                        f"at {min(unstable)} M_cr a mode grows (Re lambda = {rows[min(unstable)][0]:.2f}): "
                        f"torsional buckling at M_cr = {m_cr * q.torque_scale:.0f} Nm", numbers)
     return Outcome("torsional_buckling", "converged", "no instability found", numbers)

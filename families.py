@@ -1,0 +1,20 @@
+"""The mode families of the spectrum (Table 3), shared by the FE scheme and the references.
+
+numpy-free on purpose: the spline and shooting references import it too.
+"""
+
+#: every family, in the order of the tables and summaries; ``rigid`` is the
+#: free rotation alpha = const (the zero eigenvalue of torque-free ends)
+FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional", "rigid")
+
+#: the families of vibrations, with a classical model each (solvers.analytic)
+VIBRATIONS = FAMILIES[:-1]
+
+#: the labels of Table 3
+FAMILY_LABELS = {
+    "longitudinal": "Longitudinal",
+    "lateral_in_plane": "Lateral (x-z)",
+    "lateral_out_of_plane": "Lateral (y)",
+    "torsional": "Torsional",
+    "rigid": "Rigid rotation",
+}

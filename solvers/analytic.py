@@ -1,0 +1,80 @@
+"""Analytic spectra of the classical continuous models, normalised (Eqs. 25-29).
+
+Unit mass per unit length, s in [0, 1]; k = n pi.  With the tension T, the
+bending mu (Eq. 26, off when model.bending is) and the torsional stiffness delta:
+
+* longitudinal, fixed-fixed bar (Rao, *Vibration of Continuous Systems*, 2019,
+  Sec. 9.3): about a straight state r' = (1 + eps) e the tension law (29) gives
+  the axial stiffness sigma (1 + 2 eps) = sigma + 2 T, and the bending term of
+  Eq. (33) acts on the axial component too:
+  omega_n^2 = (sigma + 2 T) k^2 + mu k^4  (T = 0, mu = 0: n pi sqrt(sigma));
+* lateral, pinned beam under tension (Rao, Sec. 11.5):
+  omega_n^2 = T k^2 + mu k^4  (mu = 0: the taut string, n pi sqrt(T));
+* torsional, free-free shaft (Rao, Sec. 8.3): omega_n = n pi sqrt(delta).
+
+The FE scheme uses them to place the SLEPc target and size the Krylov space
+(:func:`frequencies`, :func:`count_below`); the tests and the extremes study
+check spectra against them.  numpy only.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _mu(q) -> float:
+    return q.bending * q.mu
+
+
+def bar(q, n, tension: float = 0.0):
+    """Fixed-fixed bar: omega_n^2 = (sigma + 2 T) (n pi)^2 + mu (n pi)^4."""
+    k = np.asarray(n) * math.pi
+    return np.sqrt((q.sigma + 2 * tension) * k**2 + _mu(q) * k**4)
+
+
+def beam(q, n, tension: float):
+    """Pinned beam under tension: omega_n^2 = T (n pi)^2 + mu (n pi)^4."""
+    k = np.asarray(n) * math.pi
+    return np.sqrt(tension * k**2 + _mu(q) * k**4)
+
+
+def string(n, tension: float):
+    """Taut string, the beam without bending: omega_n = n pi sqrt(T)."""
+    return np.asarray(n) * math.pi * math.sqrt(tension)
+
+
+def shaft(q, n):
+    """Free-free shaft: omega_n = n pi sqrt(delta)."""
+    return np.asarray(n) * math.pi * math.sqrt(q.delta)
+
+
+def frequencies(q, tension: float, count: int, twist: bool = True) -> dict:
+    """omega_n, n = 1..count, per family (no torsional ones without the twist field)."""
+    n = np.arange(1, count + 1)
+    lateral = beam(q, n, tension)
+    return {
+        "longitudinal": bar(q, n, tension),
+        "lateral_in_plane": lateral,
+        "lateral_out_of_plane": lateral,
+        **({"torsional": shaft(q, n)} if twist else {}),
+    }
+
+
+def _below(stiffness: float, mu: float, omega: float) -> int:
+    """How many k = n pi solve mu k^4 + stiffness k^2 <= omega^2."""
+    if mu <= 0:
+        k2 = omega**2 / stiffness
+    else:
+        k2 = (-stiffness + math.sqrt(stiffness**2 + 4 * mu * omega**2)) / (2 * mu)
+    return int(math.sqrt(max(k2, 0.0)) / math.pi)
+
+
+def count_below(q, tension: float, omega: float, twist: bool = True) -> int:
+    """How many modes of all families have omega_n <= omega (lateral twice)."""
+    mu = _mu(q)
+    total = _below(q.sigma + 2 * tension, mu, omega) + 2 * _below(max(tension, 1e-300), mu, omega)
+    if twist:
+        total += int(omega / (math.pi * math.sqrt(q.delta)))
+    return total

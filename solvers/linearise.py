@@ -1,0 +1,120 @@
+"""K, C, M of the linearised Eqs. (30)-(31) about a stationary state.
+
+About a state w0, a small motion w = w0 + x e^{lambda t} obeys
+
+    (lambda^2 M + lambda C + K) x = 0,                                 (*)
+
+with the three Jacobians of the full residual F(w, w_t, w_tt; v) of
+Eqs. (30)-(31) (:func:`rawehelix.forms.rod.residual`):
+
+    K = dF/dw     at (w0, 0, 0)   elastic + geometric stiffness (32)-(34),
+    C = dF/dw_t   at (w0, 0, 0)   the linearised drag of Eq. (28),
+    M = dF/dw_tt                  the mass, int r_tt.v + alpha_tt psi.
+
+Boundary conditions: the displacement vanishes at s = 0 and s = 1
+(Eqs. 35-36); the twist is *not* pinned, so with torque-free ends (38)-(39)
+the rigid rotation alpha = const is a true mode.  The bc rows are assembled
+with 1 on the diagonal of K and 0 on those of C and M: a bc dof then satisfies
+x_i = 0 exactly and contributes only *infinite* eigenvalues, which
+shift-and-invert maps to 0 and never returns (no spurious finite eigenvalue).
+
+The kinetic-energy matrices classify the modes (:mod:`.classify`): the
+displacement u along the local tangent t of the stationary centre line
+(``longitudinal``), along n = j_E x t (in the x-z plane, ``lateral_in_plane``)
+and along j_E (``lateral_out_of_plane``); the twist with the rotational
+inertia beta/delta = 2 rho I / (rho A L0^2) of Eq. (27) (``torsional``); and
+per component x, y, z, alpha.  The spline reference uses the same frame.
+"""
+
+from __future__ import annotations
+
+import ufl
+from mpi4py import MPI
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+
+from rawehelix.forms import rod as rod_forms
+from rawehelix.forms.kinematics import d
+from rawehelix.solvers.state import RodState
+
+COMPONENTS = ("x", "y", "z", "alpha")
+
+
+def _assemble(a, bcs, diagonal):
+    A = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs, diagonal=diagonal)
+    A.assemble()
+    return A
+
+
+class Linearisation:
+    """The forms of (*) and of the kinetic energies on one rod; :meth:`assemble`
+    evaluates them about a state."""
+
+    def __init__(self, rod):
+        self.rod = rod
+        # separate fields for w, w_t, w_tt: the three Jacobians of F at (w0, 0, 0)
+        self.w_t = dolfinx.fem.Function(rod.W, name="velocity")
+        self.w_tt = dolfinx.fem.Function(rod.W, name="acceleration")
+        F = rod_forms.residual(rod.w, self.w_t, self.w_tt, rod.test, rod.c, rod.degree,
+                               rod.penalty, rod.measures)  # (30)-(31)
+        du = rod.trial
+        self.a_K = dolfinx.fem.form(ufl.derivative(F, rod.w, du))
+        self.a_C = dolfinx.fem.form(ufl.derivative(F, self.w_t, du))
+        self.a_M = dolfinx.fem.form(ufl.derivative(F, self.w_tt, du))
+        self.bcs = self._fixed_ends()
+        self.a_energy = {kind: {k: dolfinx.fem.form(a) for k, a in forms.items()}
+                         for kind, forms in self._energy_forms().items()}
+        self.a_tension = dolfinx.fem.form(rod_forms.tension_of(rod.w, rod.c) * rod.measures[0])
+        self.K = self.C = self.M = self.energy = None
+        self.mean_tension = None
+
+    def _fixed_ends(self):
+        """Homogeneous Dirichlet conditions on the displacement at both ends
+        (35)-(36); none on the twist (the rigid rotation stays free), unless
+        model.twist = false holds alpha = 0."""
+        rod = self.rod
+        zero = dolfinx.fem.Function(rod.V_r)
+        return [dolfinx.fem.dirichletbc(zero, dofs, rod.W.sub(0))
+                for dofs in rod.end_dofs.values()] + rod.twist_bcs
+
+    def _energy_forms(self) -> dict:
+        rod = self.rod
+        dx = rod.measures[0]
+        r0 = ufl.split(rod.w)[0]
+        u, a = ufl.split(rod.trial)
+        v, b = ufl.split(rod.test)
+        t = d(r0) / ufl.sqrt(ufl.dot(d(r0), d(r0)))  # local tangent of the state
+        j = ufl.as_vector((0.0, 1.0, 0.0))
+        n = ufl.cross(j, t)
+        n = n / ufl.sqrt(ufl.dot(n, n) + 1e-300)
+        rot = rod.c.beta / rod.c.delta  # (27)
+        family = {
+            "longitudinal": ufl.dot(u, t) * ufl.dot(v, t) * dx,
+            "lateral_in_plane": ufl.dot(u, n) * ufl.dot(v, n) * dx,
+            "lateral_out_of_plane": u[1] * v[1] * dx,
+            "torsional": rot * a * b * dx,
+        }
+        comps = {"x": u[0] * v[0] * dx, "y": u[1] * v[1] * dx, "z": u[2] * v[2] * dx,
+                 "alpha": rot * a * b * dx}
+        return {"family": family, "component": comps}
+
+    def assemble(self, state: RodState):
+        """K, C, M and the energy matrices about ``state`` (its velocity is
+        ignored: the linearisation is about (w0, 0, 0)).  Returns (K, C, M)."""
+        self.rod.set_state(state)
+        self.w_t.x.array[:] = 0.0
+        self.w_tt.x.array[:] = 0.0
+        self.K = _assemble(self.a_K, self.bcs, 1.0)
+        self.C = _assemble(self.a_C, self.bcs, 0.0)
+        self.M = _assemble(self.a_M, self.bcs, 0.0)
+        self.energy = {kind: {k: _assemble(a, [], 0.0) for k, a in forms.items()}
+                       for kind, forms in self.a_energy.items()}
+        local = dolfinx.fem.assemble_scalar(self.a_tension)
+        self.mean_tension = self.rod.comm.allreduce(local, op=MPI.SUM)  # int_0^1 T ds, (29)
+        return self.K, self.C, self.M
+
+    def finite_eigenvalue_count(self) -> int:
+        """2 (n - n_bc): the number of finite eigenvalues of (*)."""
+        n_bc = self.rod.comm.allreduce(sum(bc.dof_indices()[1] for bc in self.bcs), op=MPI.SUM)
+        return 2 * (self.rod.dof_count() - n_bc)
