@@ -181,3 +181,43 @@ def test_images_in_lists_pictures(tmp_path):
     _picture(tmp_path / "a.png")
     (tmp_path / "summary.json").write_text("{}")
     assert [p.name for p in demo.images_in(tmp_path)] == ["a.png", "b.gif"]
+
+
+def test_demo_main_runs_the_five_studies(tmp_path, monkeypatch):
+    """main() against stand-ins for the public API (rh.load_scene, rh.stationary,
+    rh.modes, rh.simulate, rh.sweep): the calls, the folders and the page."""
+    import rawehelix as rh
+    outdir, summaries, _ = _synthetic_demo(tmp_path)
+    calls = []
+
+    class Result:
+        def __init__(self, name, picture):
+            self.name, self.picture, self.summary = name, picture, summaries[name]
+
+        def write(self, folder):
+            calls.append(("write", Path(folder).name))
+            _picture(Path(folder) / self.picture)
+
+    def load_scene(name, **overrides):
+        calls.append(("load", name, tuple(sorted(overrides.items()))))
+        return {"name": name, **overrides}
+
+    def modes(scene):
+        spline = scene.get("scheme") == "spline"
+        return Result("modes_spline" if spline else "modes", "modes.png")
+
+    def sweep(scene, f1_Hz):
+        calls.append(("sweep", tuple(f1_Hz)))
+        return Result("sweep", "sweep.png")
+
+    for name, fn in {"load_scene": load_scene, "modes": modes, "sweep": sweep,
+                     "stationary": lambda scene: Result("stationary", "stationary.png"),
+                     "simulate": lambda scene, until_s: Result("spin_up", "dynamics.png")
+                     }.items():
+        monkeypatch.setattr(rh, name, fn, raising=False)
+    out = tmp_path / "demo"
+    path = demo.main(out, log=lambda *a: None)
+    assert ("load", "stationary_table2", (("elements", 2), ("scheme", "spline"))) in calls
+    assert ("sweep", demo.SWEEP_F1_HZ) in calls
+    assert [c[1] for c in calls if c[0] == "write"] == list(demo.STEPS)
+    _assert_images_exist(path, len(demo.STEPS))
