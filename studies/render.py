@@ -200,11 +200,12 @@ class View:
         X = self.chord(x_m)
         return X + (self.k - 1.0) * self._offset(X)
 
-    def caption(self, what=None) -> str:
+    def caption(self, what=None, relative_twist=False) -> str:
         what = what or f"{self.label} drawn x{self.k:g}"
         side = "-y_E" if self.axes[2][1] < 0 else "+y_E"
+        turn = "alpha - alpha(0)" if relative_twist else "the twist alpha"
         return (f"{what};  ring radius {self.radius_m:.2f} m drawn x{self.kr:g}\n"
-                f"rings turned by the twist alpha (red spoke), {TETHERS} tethers (blue); "
+                f"rings turned by {turn} (red spoke), {TETHERS} tethers (blue); "
                 f"chord horizontal, seen from {side}")
 
 
@@ -257,7 +258,7 @@ class _Drawing:
         p.add_mesh(self.meshes["spokes"], color="#d62728", line_width=lw + 1)
         p.add_mesh(self.meshes["markers"], color="#d62728", point_size=5 * lw + 2,
                    render_points_as_spheres=True)
-        bar = dict(title=self.scalar_title, vertical=True, position_x=0.9 if self.big else 0.86,
+        bar = dict(title=self.scalar_title, vertical=True, position_x=0.9 if self.big else 0.88,
                    position_y=0.2,
                    height=0.6, width=0.03, n_labels=5, fmt="%.4g", color="black",
                    title_font_size=int(20 * self.font), label_font_size=int(18 * self.font),
@@ -276,7 +277,8 @@ class _Drawing:
         bounds = [0.0, L, -r, r, -r, r]
         a, b = (math.radians(v) for v in VIEW_DEG)
         d = np.array([-math.sin(a) * math.cos(b), math.sin(b), math.cos(a) * math.cos(b)])
-        focal = np.array([0.5 * L, 0.0, 0.0])
+        wide = 1.24 if self.big else 1.36  # visible width / L: the helix left of the colour bar
+        focal = np.array([(0.5 + 0.25 * (wide - 1.0)) * L, 0.0, 0.0])
         p.camera.focal_point = focal
         p.camera.position = focal + 4.0 * L * d
         up = np.cross(d, [1.0, 0.0, 0.0])  # the chord horizontal on the screen
@@ -291,7 +293,7 @@ class _Drawing:
                     label_size_factor=0.9 if self.big else 1.6, tick_length=8, label_color="black",
                     tick_color="black")
         p.reset_camera(bounds=bounds)
-        p.camera.parallel_scale = 0.6 * L * self.size[1] / self.size[0]  # width 1.2 L
+        p.camera.parallel_scale = 0.5 * wide * L * self.size[1] / self.size[0]
 
     def show(self, x_m, alpha, scalars, title: str, caption: str):
         """Draw one state; returns the RGB image (h, w, 3).  One render per call."""
@@ -332,6 +334,11 @@ def _clim(values) -> list:
 
 def _title(title: str, time_s) -> str:
     return title if time_s is None else f"{title}    t = {time_s:.2f} s"
+
+
+def _twist(alpha, relative: bool) -> np.ndarray:
+    alpha = np.asarray(alpha, dtype=float)
+    return alpha - alpha[0] if relative else alpha
 
 
 def _save_png(path, image) -> Path:
@@ -400,14 +407,15 @@ def _in_clean_process(func):
 @_in_clean_process
 def helix_png(path, x_m, alpha_rad, tension_N, radius_m: float, title: str, time_s=None,
               reference_m=None, magnification=None, radius_magnification=None,
-              reference_label="the reference", size=PNG_SIZE):
+              reference_label="the reference", relative_twist=False, size=PNG_SIZE):
     """One picture of the helix: rings, tethers, centre line coloured by tension.
 
     x_m (n, 3) node positions [m], alpha_rad (n,) twist, tension_N (n,) or None
     (plain centre line).  The displacement from ``reference_m`` (n, 3), or the
     deflection from the chord when None, is drawn x ``magnification``
-    (automatic when None); both factors are written in the picture.
-    Returns the path, or None without pyvista."""
+    (automatic when None); both factors are written in the picture.  With
+    ``relative_twist`` the rings turn by alpha - alpha(0): the twist without
+    the rigid spin.  Returns the path, or None without pyvista."""
     if pyvista is None:
         return None
     x_m = np.asarray(x_m, dtype=float)
@@ -417,7 +425,8 @@ def helix_png(path, x_m, alpha_rad, tension_N, radius_m: float, title: str, time
     drawing = _Drawing(view, _clim(scalars), size,
                        "tension T (N)" if tension_N is not None else None)
     try:
-        image = drawing.show(x_m, alpha_rad, scalars, _title(title, time_s), view.caption())
+        image = drawing.show(x_m, _twist(alpha_rad, relative_twist), scalars,
+                             _title(title, time_s), view.caption(None, relative_twist))
     finally:
         drawing.close()
     return _save_png(path, image)
@@ -433,11 +442,13 @@ def _pick(frames, count):
 @_in_clean_process
 def helix_gif(path, frames, radius_m: float, title: str = "", reference_m=None,
               magnification=None, radius_magnification=None, reference_label="the reference",
-              size=GIF_SIZE, max_frames: int = GIF_FRAMES, fps: int = 8):
+              relative_twist=True, size=GIF_SIZE, max_frames: int = GIF_FRAMES, fps: int = 8):
     """An animation from frames [(time_s, x_m, alpha_rad, tension_N), ...].
 
     At most ``max_frames`` frames (evenly picked), one plotter reused, one
-    magnification and colour range for all frames.  Returns the path or None."""
+    magnification and colour range for all frames.  ``relative_twist`` (the
+    default) turns the rings by alpha - alpha(0): at 120 rpm and a few frames a
+    second the rigid spin would only alias.  Returns the path or None."""
     if pyvista is None or not frames:
         return None
     frames = _pick(list(frames), max_frames)
@@ -448,8 +459,9 @@ def helix_gif(path, frames, radius_m: float, title: str = "", reference_m=None,
     clim = _clim(np.concatenate([np.ravel(f[3]) for f in frames])) if has_T else [0.0, 1.0]
     drawing = _Drawing(view, clim, size, "tension T (N)" if has_T else None)
     try:
-        images = [drawing.show(x, f[2], f[3] if has_T else np.zeros(len(x)),
-                               _title(title, f[0]), view.caption())
+        images = [drawing.show(x, _twist(f[2], relative_twist),
+                               f[3] if has_T else np.zeros(len(x)), _title(title, f[0]),
+                               view.caption(None, relative_twist))
                   for f, x in zip(frames, states)]
     finally:
         drawing.close()

@@ -13,6 +13,7 @@ from rawehelix.solvers.spline_galerkin import dynamics, spectrum, stationary
 from rawehelix.solvers.spline_galerkin.basis import SplineBasis
 from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
 from rawehelix.studies import modes as modes_study
+from rawehelix.studies import paper
 from rawehelix.studies import scene
 
 
@@ -94,13 +95,7 @@ def test_newton_converges_for_any_N(nd, N):
 
 
 # -- Table 3 ---------------------------------------------------------------------
-TABLE3 = [  # (Re, Im, family), normalised
-    (-2.23, 271.4, "longitudinal"),
-    (-2.23, 37.0, "lateral_in_plane"),
-    (-1.48, 37.0, "lateral_out_of_plane"),
-    (0.0, 40.0, "torsional"),
-    (0.0, 20.0, "torsional"),
-]
+TABLE3 = [(r.eigenvalue.real, r.eigenvalue.imag, r.family) for r in paper.TABLE3]  # normalised
 
 
 @pytest.fixture(scope="module")
