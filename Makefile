@@ -1,5 +1,5 @@
 # rawehelix: two commands on a fresh Debian 12 machine (root or sudo):
-#   make demo   installs what is missing, then runs the Sec. 5.1 scene into results/
+#   make demo   installs what is missing, then runs Secs. 5.1-5.3 and writes results/report.html
 #   make test   installs what is missing, then runs the tests serially and under mpirun -n 2
 
 VENV    := .venv
@@ -18,9 +18,7 @@ install:
 	@bash scripts/install.sh
 
 demo: install
-	$(RAWE) stationary studies/scenes/stationary_table2.toml -o results/stationary_table2/stationary
-	$(RAWE) modes studies/scenes/stationary_table2.toml -o results/stationary_table2/modes
-	$(RAWE) modes studies/scenes/stationary_table2.toml --scheme spline --elements 2 -o results/stationary_table2/modes_spline_N2
+	$(PY) -m rawehelix.studies.demo results
 
 test: install
 	$(PY) -m pytest -q $(PYTEST_ARGS)

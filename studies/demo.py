@@ -194,7 +194,11 @@ def cli(argv=None):
     parser = argparse.ArgumentParser(prog="python -m rawehelix.studies.demo",
                                      description=__doc__.split("\n")[0])
     parser.add_argument("outdir", nargs="?", default="results")
-    main(parser.parse_args(argv).outdir)
+    parser.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
+    args = parser.parse_args(argv)
+    from rawehelix.studies import logs
+    logs.configure(args.verbose)  # no JIT-compiler chatter on a cold cache
+    main(args.outdir)
 
 
 if __name__ == "__main__":

@@ -132,11 +132,13 @@ class TimeSeries:
         reference = self.frames[0].x_m
         for frame in (self.frames[0], self.frames[-1]):
             render.helix_png(outdir / f"helix_{frame.t_s:.2f}s.png", frame.x_m, frame.alpha_rad,
-                             frame.tension_N, R, title, time_s=frame.t_s, reference_m=reference)
+                             frame.tension_N, R, title, time_s=frame.t_s, reference_m=reference,
+                             reference_label="the stationary state")
         if gif:
             render.helix_gif(outdir / "helix.gif",
                              [(f.t_s, f.x_m, f.alpha_rad, f.tension_N) for f in self.frames], R,
-                             title=title, reference_m=reference)
+                             title=title, reference_m=reference,
+                             reference_label="the stationary state")
 
 
 class _Recorder:

@@ -39,6 +39,7 @@ def write_json(path: Path, data: dict) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    os.chmod(tmp, 0o644)  # mkstemp makes it private; a results file is for everyone to read
     with os.fdopen(fd, "w") as f:
         json.dump(_jsonable(data), f, indent=2)
         f.write("\n")
