@@ -125,6 +125,7 @@ def test_chunks_are_contiguous_and_balanced(k):
         assert max(map(cost, parts)) < 0.9 * max(map(cost, even))
 
 
+@pytest.mark.slow  # 79 s
 def test_resonance_of_the_paper_at_n2(tmp_path):
     """Fig. 8 at N = 2: flat up to ~8 Hz, a rise above about 9 Hz, peak (> 900 N)
     near 13 Hz, collapse above."""
@@ -143,6 +144,7 @@ def test_resonance_of_the_paper_at_n2(tmp_path):
 
 
 @pytest.mark.mpi
+@pytest.mark.slow  # 88 s
 def test_two_ranks_match_one(tmp_path_factory):
     """Chunks on 2 ranks give the points of 1 rank to the periodicity tolerance
     (the second chunk starts from the stationary state with a lead-in instead of
