@@ -44,20 +44,22 @@ def create_mesh_1d(comm, cells: np.ndarray, x: np.ndarray):
                                     ghost_mode=dolfinx.mesh.GhostMode.shared_facet)
 
 
-def _mixed(cell, degree: int, copies: int):
-    """``copies`` x (vector P_p with 3 components, scalar P_p) as one mixed element."""
+def _mixed(cell, degree: int, copies: int, curvature: bool = False):
+    """``copies`` x (vector P_p with 3 components, scalar P_p) as one mixed element,
+    with a third vector P_p (the curvature) after the first pair if ``curvature``."""
     if NEW:
         vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
         sca = basix.ufl.element("Lagrange", "interval", degree)
-        return basix.ufl.mixed_element([vec, sca] * copies)
+        return basix.ufl.mixed_element([vec, sca] + [vec] * curvature + [vec, sca] * (copies - 1))
     vec = ufl.VectorElement("Lagrange", cell, degree, dim=3)
     sca = ufl.FiniteElement("Lagrange", cell, degree)
-    return ufl.MixedElement([vec, sca] * copies)
+    return ufl.MixedElement([vec, sca] + [vec] * curvature + [vec, sca] * (copies - 1))
 
 
-def rod_element(cell, degree: int):
-    """The mixed (r, alpha) element: vector P_p with 3 components and scalar P_p."""
-    return _mixed(cell, degree, 1)
+def rod_element(cell, degree: int, curvature: bool = False):
+    """The mixed (r, alpha) element: vector P_p with 3 components and scalar P_p;
+    (r, alpha, kappa) with a second vector P_p if ``curvature`` (forms/mixed.py)."""
+    return _mixed(cell, degree, 1, curvature)
 
 
 def function_space(mesh, element):

@@ -179,6 +179,7 @@ class Model:
 
 SCHEMES = ("fe", "spline")
 MESHES = ("uniform", "graded")
+BENDINGS = ("ip", "mixed")  # the FE bending operator: forms/rod.py, forms/mixed.py
 
 
 @dataclass(frozen=True)
@@ -189,10 +190,15 @@ class Discretisation:
     mesh: str = "uniform"  # "uniform" or "graded" (gmsh, refined toward the ends)
     grading: float = 4.0  # graded mesh: ratio of the largest to the smallest element
     penalty: float = 8.0  # interior-penalty factor eta: penalty = eta p^2 mu / h
+    # "ip": C0 interior penalty on r'' (fourth order); "mixed": the curvature
+    # kappa = r'' as its own field (Ciarlet-Raviart, second order, docs/large_n.md)
+    bending: str = "ip"
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
             raise ParameterError("discretisation.scheme", self.scheme, f"must be one of {SCHEMES}")
+        if self.bending not in BENDINGS:
+            raise ParameterError("discretisation.bending", self.bending, f"must be one of {BENDINGS}")
         if self.mesh not in MESHES:
             raise ParameterError("discretisation.mesh", self.mesh, f"must be one of {MESHES}")
         if self.elements < 1:
@@ -207,6 +213,15 @@ class Discretisation:
         if not self.grading >= 1:
             raise ParameterError("discretisation.grading", self.grading, "must be >= 1")
         _positive("discretisation", self, "penalty")
+
+    def ip_limit(self) -> int:
+        """The largest N at which the IP bending form is trusted: 512 (3/p)^(4/3).
+
+        Its Jacobian entries grow like mu p^4 N^3, and the round-off of the
+        lowest lateral eigenvalue with them: measured at p = 3 (docs/large_n.md)
+        7.7e-4 at N = 512, 1.9e-2 at N = 1000.  The mixed form has no such limit
+        up to N = 10^4."""
+        return int(512 * (3 / self.degree) ** (4 / 3))
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,9 @@ gravity +k_E has the potential -k_E . r.  What is *not* the variation of E:
   be beta tau d(gamma)/dr; with gamma off (tau = alpha') it is a one-way coupling;
 - drag (Eq. 28) and the end torques, which do work.
 
+With the mixed bending form (:mod:`rawehelix.forms.mixed`) mu/2 B(r, r) is
+mu/2 int |kappa|^2, and every r'' is the curvature field ``kappa``.
+
 All normalised: energies in units of M g L0.
 """
 
@@ -28,6 +31,7 @@ from __future__ import annotations
 import ufl
 
 from rawehelix.forms.kinematics import d, internal_force, stretch, tension, twist
+from rawehelix.forms import mixed
 from rawehelix.forms.rod import K_E, Coefficients, bending
 
 
@@ -36,20 +40,24 @@ def kinetic(r_t, alpha_t, c: Coefficients, dx):
     return (0.5 * ufl.inner(r_t, r_t) + 0.5 * c.beta / c.delta * alpha_t**2) * dx
 
 
-def potential(r, alpha, c: Coefficients, degree: int, penalty, measures):
-    """U = int sigma (l^3/3 - l^2/2) + mu/2 B(r, r) + beta/2 int tau^2 - int k_E.r, l = |r'|."""
+def potential(r, alpha, c: Coefficients, degree: int, penalty, measures, kappa=None):
+    """U = int sigma (l^3/3 - l^2/2) + mu/2 B(r, r) + beta/2 int tau^2 - int k_E.r, l = |r'|;
+    B(r, r) = int |kappa|^2 with the curvature field ``kappa``."""
     dx, dS, _ = measures
     lam = stretch(r)
-    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
+    bend = (0.5 * bending(r, r, degree, penalty, dx, dS) if kappa is None
+            else mixed.energy(kappa, dx))
     return ((c.sigma * (lam**3 / 3 - lam**2 / 2) + 0.5 * c.beta * tau**2
              - c.gravity * ufl.dot(K_E, r)) * dx
-            + 0.5 * c.bending * c.mu * bending(r, r, degree, penalty, dx, dS))
+            + c.bending * c.mu * bend)
 
 
-def non_variational_power(r, alpha, r_t, c: Coefficients, dx):
+def non_variational_power(r, alpha, r_t, c: Coefficients, dx, kappa=None):
     """Power of the parts of F_NL that are not the variation of E (see above):
     P = int (T r' - F_NL) . r_t' = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t',
     with F_NL of Eq. (32) and its variational part T r'."""
-    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
-    f = tension(r, c.sigma) * d(r) - internal_force(r, tau, c.sigma, c.mu, c.beta)  # (29), (32)
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
+    f = (tension(r, c.sigma) * d(r)
+         - internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa))  # (29), (32)
     return ufl.inner(f, d(r_t)) * dx

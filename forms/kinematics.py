@@ -5,6 +5,10 @@ Every function takes UFL expressions of the normalised centre line ``r`` (a
 Derivatives along s are cellwise (broken): with C0 Lagrange elements r'' and
 r''' are discontinuous across element boundaries, and the bending form in
 :mod:`rawehelix.forms.rod` makes up for it with interior-penalty terms.
+
+The functions that use r'' take an optional curvature field ``k``: the mixed
+bending form (:mod:`rawehelix.forms.mixed`) passes its own continuous field
+kappa (= r'' weakly), and r''' is then kappa'.  ``k = None`` means r''.
 """
 
 from __future__ import annotations
@@ -29,12 +33,18 @@ def tension(r, sigma):
     return sigma * (stretch(r) - 1)
 
 
-def curvature_squared(r):
+def curvature(r, k=None):
+    """r'' (cellwise), or the curvature field ``k`` when given."""
+    return d(r, 2) if k is None else k
+
+
+def curvature_squared(r, k=None):
     """kappa^2 = r''.r'', Eq. (34)."""
-    return ufl.dot(d(r, 2), d(r, 2))
+    kappa = curvature(r, k)
+    return ufl.dot(kappa, kappa)
 
 
-def frenet_torsion(r, eps):
+def frenet_torsion(r, eps, k=None):
     """Frenet torsion gamma = r'.(r'' x r''') / |r''|^2, Eq. (34), regularised.
 
     gamma is singular where the curvature vanishes: on a straight centre line,
@@ -51,18 +61,21 @@ def frenet_torsion(r, eps):
 
     ``eps`` is a normalised curvature (1/L0 units): ``model.gamma_eps`` in a
     scene; ``model.gamma = "off"`` drops gamma like the paper's code.  With
-    degree 2 elements r''' vanishes cellwise and so does gamma.
+    degree 2 elements r''' vanishes cellwise and so does gamma; with the
+    curvature field ``k`` (any degree) r'' = k and r''' = k'.
     """
-    r1, r2, r3 = d(r), d(r, 2), d(r, 3)
+    r1 = d(r)
+    r2 = curvature(r, k)
+    r3 = d(r, 3) if k is None else d(k)
     return ufl.dot(r1, ufl.cross(r2, r3)) / (ufl.dot(r2, r2) + eps**2)
 
 
-def twist(r, alpha, eps, coupling=1.0):
+def twist(r, alpha, eps, coupling=1.0, k=None):
     """Total twist tau = gamma + alpha', Eqs. (8) and (34); ``coupling`` = 0 drops gamma."""
-    return coupling * frenet_torsion(r, eps) + d(alpha)
+    return coupling * frenet_torsion(r, eps, k) + d(alpha)
 
 
-def internal_force(r, tau, sigma, mu, beta):
+def internal_force(r, tau, sigma, mu, beta, k=None):
     """F_NL = (T - mu kappa^2) r' + beta tau (r' x r''), Eq. (32)."""
-    return (tension(r, sigma) - mu * curvature_squared(r)) * d(r) \
-        + beta * tau * ufl.cross(d(r), d(r, 2))
+    return (tension(r, sigma) - mu * curvature_squared(r, k)) * d(r) \
+        + beta * tau * ufl.cross(d(r), curvature(r, k))

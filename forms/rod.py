@@ -12,6 +12,11 @@ tau(1) = mN (38)-(39) as natural boundary terms, and B the C0
 interior-penalty form of int r''.v'' (the -F_L' = -mu r'''' term, Eq. 33).
 The zero-curvature ends r'' = 0 (37) are natural: B has no boundary terms.
 
+With ``discretisation.bending = "mixed"`` the state has a third field, the
+curvature kappa, and B is replaced by the mixed form of
+:mod:`rawehelix.forms.mixed` (second order, kappa = 0 at the ends
+essential); the functions below see it as ``kappa`` (and its test ``eta``).
+
 No solver code here: functions take UFL objects and numbers (or constants)
 and return UFL.
 """
@@ -23,6 +28,7 @@ from typing import Any
 
 import ufl
 
+from rawehelix.forms import mixed
 from rawehelix.forms.kinematics import d, internal_force, tension, twist
 
 K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
@@ -105,13 +111,20 @@ def body_force(r_t, c: Coefficients):
     return c.gravity * K_E + c.drag * aerodynamic_force(r_t, c)
 
 
-def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx, dS, ds):
-    """Internal forces and end torques of Eqs. (30)-(31): everything but inertia and loads."""
+def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx, dS, ds,
+                     kappa=None, eta=None):
+    """Internal forces and end torques of Eqs. (30)-(31): everything but inertia and loads.
+
+    ``kappa``, ``eta``: the curvature field and its test (mixed bending form)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
-    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
-    F_NL = internal_force(r, tau, c.sigma, c.mu, c.beta)  # (32)
-    F = (ufl.inner(F_NL, d(v)) * dx
-         + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS))  # (33)
+    tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
+    F_NL = internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa)  # (32)
+    F = ufl.inner(F_NL, d(v)) * dx
+    if kappa is None:
+        F += c.bending * c.mu * bending(r, v, degree, penalty, dx, dS)  # (33)
+    else:  # (33) and kappa = r'' with kappa = 0 at the ends (37), forms/mixed.py
+        F += (c.bending * c.mu * mixed.bending_force(kappa, v, dx)
+              - c.mu * mixed.curvature_equation(r, kappa, eta, dx))
     if psi is None:  # the planar model: no twist equation
         return F
     return (F + c.delta * tau * d(psi) * dx  # (31)
@@ -124,29 +137,34 @@ def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures
 
     ``w``, ``w_t``, ``w_tt``: mixed (r, alpha) fields or their time
     derivatives; ``w_tt = None`` gives the stationary residual (and ``w_t =
-    None`` zero velocity).  ``measures`` = (dx, dS, ds)."""
-    r, alpha = ufl.split(w)
+    None`` zero velocity).  ``measures`` = (dx, dS, ds).  On the space
+    (r, alpha, kappa) of the mixed bending form the third field is kappa
+    (which has no rate: the rates' kappa parts are unused)."""
+    r, alpha, *kappa = ufl.split(w)
     r_t = ufl.split(w_t)[0] if w_t is not None else None
-    r_tt, alpha_tt = ufl.split(w_tt) if w_tt is not None else (None, None)
+    r_tt, alpha_tt = ufl.split(w_tt)[:2] if w_tt is not None else (None, None)
     return residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, test_fields(test), c, degree,
-                              penalty, measures)
+                              penalty, measures, kappa=kappa[0] if kappa else None)
 
 
 def test_fields(test):
-    """(v, psi) of a mixed (r, alpha) test function."""
+    """(v, psi) of a mixed (r, alpha) test function; (v, psi, eta) on (r, alpha, kappa)."""
     return ufl.split(test)
 
 
 def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, degree: int,
-                       penalty, measures):
+                       penalty, measures, kappa=None):
     """:func:`residual` on fields given one by one, so that (r, alpha) and
     their rates may live in a larger mixed space (the first-order form of the
-    dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero)."""
+    dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
+    the curvature field of the mixed bending form, with the test
+    ``tests[2]``."""
     dx, dS, ds = measures
-    v, psi = tests
+    v, psi, *eta = tests
     if r_t is None:
         r_t = ufl.as_vector((0.0, 0.0, 0.0))
-    F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds)
+    F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds,
+                          kappa=kappa, eta=eta[0] if eta else None)
          - ufl.inner(body_force(r_t, c), v) * dx)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx

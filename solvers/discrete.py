@@ -2,6 +2,10 @@
 
 Shared by the stationary, dynamic and modal solvers.  Built from validated
 :class:`~rawehelix.parameters.Parameters`; reads no files.
+
+With ``discretisation.bending = "mixed"`` the space is (r, alpha, kappa),
+kappa the curvature field of :mod:`rawehelix.forms.mixed` with kappa = 0 at
+both ends (Eq. 37) as Dirichlet conditions (``curvature_bcs``, also in ``bcs``).
 """
 
 from __future__ import annotations
@@ -34,8 +38,10 @@ class RodDiscretisation:
         self.comm = comm
         self.degree = disc.degree
         self.penalty = disc.penalty
+        self.mixed = disc.bending == "mixed"  # the curvature field kappa, forms/mixed.py
         self.mesh = interval.mesh_from_parameters(comm, params)
-        self.W = compat.function_space(self.mesh, compat.rod_element(self.mesh.ufl_cell(), self.degree))
+        self.W = compat.function_space(self.mesh, compat.rod_element(
+            self.mesh.ufl_cell(), self.degree, curvature=self.mixed))
         self.w = dolfinx.fem.Function(self.W, name="state")
         self.test = ufl.TestFunction(self.W)
         self.trial = ufl.TrialFunction(self.W)
@@ -69,6 +75,15 @@ class RodDiscretisation:
             dofs_a = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, bottom)
             self.bcs.append(dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, self.W.sub(1)))
         self.bcs += self.twist_bcs
+        self.curvature_bcs = []
+        if self.mixed:  # kappa(0) = kappa(1) = 0, Eq. (37), essential
+            self.V_k, self._kappa_dofs = compat.collapse(self.W.sub(2))
+            self.kappa_zero = dolfinx.fem.Function(self.V_k)
+            ends = np.concatenate([bottom, top]).astype(np.int32)
+            dofs_k = dolfinx.fem.locate_dofs_topological((self.W.sub(2), self.V_k), 0, ends)
+            self.curvature_bcs = [dolfinx.fem.dirichletbc(self.kappa_zero, dofs_k, self.W.sub(2))]
+            self._curvature_problem = None
+        self.bcs += self.curvature_bcs
 
     def all_dofs(self, W_sub, V_collapsed):
         """Every dof of a sub-space (for a field held at zero)."""
@@ -100,6 +115,7 @@ class RodDiscretisation:
         w.sub(0).interpolate(lambda x: np.outer(top, x[0]))
         w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
         w.x.scatter_forward()
+        self.update_curvature(w)
 
     def set_centre_line(self, centre_line, w=None):
         """w <- (r(s) from a callable s -> (n, 3), alpha = 0)."""
@@ -107,10 +123,26 @@ class RodDiscretisation:
         w.sub(0).interpolate(lambda x: np.asarray(centre_line(x[0])).T)
         w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
         w.x.scatter_forward()
+        self.update_curvature(w)
+
+    def update_curvature(self, w=None):
+        """Mixed bending form: kappa of ``w`` (default ``self.w``) <- kappa(r),
+        the kappa equation with kappa = 0 at the ends (:mod:`.curvature`), so
+        that a state set from a centre line is consistent.  Nothing for IP."""
+        if not self.mixed:
+            return
+        if self._curvature_problem is None:
+            from rawehelix.solvers.curvature import CurvatureProjection
+            self._curvature_problem = CurvatureProjection(self)
+        self._curvature_problem.apply(w or self.w)
 
     def centre_line(self):
         """r as UFL (the first field of the state)."""
         return ufl.split(self.w)[0]
+
+    def curvature(self):
+        """kappa as UFL (mixed bending form), or None: r'' is then cellwise."""
+        return ufl.split(self.w)[2] if self.mixed else None
 
     def gather_centre_line(self):
         """(s, r (n, 3)) at the Lagrange nodes on rank 0 ((None, None) elsewhere)."""

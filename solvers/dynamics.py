@@ -105,7 +105,7 @@ class DynamicsSolver:
         self.rod.q = self.q = self._q_scene
         self.rod.c.m0.value = 0.0  # the ground torque is the controller's, in the form
         # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free (unless model.twist = false)
-        bcs = self.rod.bcs[:2] + self.rod.twist_bcs
+        bcs = self.rod.bcs[:2] + self.rod.twist_bcs + self.rod.curvature_bcs  # (37): mixed form
         ts_defaults = dict(TS_DEFAULTS)
         if self.q.r1 > 0 and self.q.omega1 > 0:
             # a moving end (Eq. 70) starts with the end's velocity and acceleration
@@ -147,6 +147,8 @@ class DynamicsSolver:
         1e-14 (sigma + mu eta p^4 N^3) sqrt(dofs)."""
         q, d = self.q, self.params.discretisation
         scale = q.sigma + q.mu * d.penalty * d.degree**4 * d.elements**3
+        if d.bending == "mixed":  # second order: entries ~ (sigma + mu) p^2 N, forms/mixed.py
+            scale = (q.sigma + q.mu) * d.degree**2 * d.elements
         return 1e-14 * scale * math.sqrt(self.rod.dof_count())
 
     def _create_ts(self, ts_type: str):

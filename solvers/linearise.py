@@ -24,6 +24,13 @@ displacement u along the local tangent t of the stationary centre line
 and along j_E (``lateral_out_of_plane``); the twist with the rotational
 inertia beta/delta = 2 rho I / (rho A L0^2) of Eq. (27) (``torsional``); and
 per component x, y, z, alpha.  The spline reference uses the same frame.
+
+Mixed bending form (:mod:`rawehelix.forms.mixed`): the curvature kappa has
+no inertia and no damping, so M and C are zero on its rows and columns;
+its interior dofs then add only infinite eigenvalues (the kappa equation is
+a constraint, K's kappa block -mu M_kappa is regular), which shift-and-invert
+never returns, and the finite count is 2 (n_r + n_alpha - n_bc).  Its end
+conditions kappa = 0 (37) are in the bcs like the displacement's.
 """
 
 from __future__ import annotations
@@ -76,14 +83,14 @@ class Linearisation:
         rod = self.rod
         zero = dolfinx.fem.Function(rod.V_r)
         return [dolfinx.fem.dirichletbc(zero, dofs, rod.W.sub(0))
-                for dofs in rod.end_dofs.values()] + rod.twist_bcs
+                for dofs in rod.end_dofs.values()] + rod.twist_bcs + rod.curvature_bcs
 
     def _energy_forms(self) -> dict:
         rod = self.rod
         dx = rod.measures[0]
         r0 = ufl.split(rod.w)[0]
-        u, a = ufl.split(rod.trial)
-        v, b = ufl.split(rod.test)
+        u, a = ufl.split(rod.trial)[:2]
+        v, b = ufl.split(rod.test)[:2]
         t = d(r0) / ufl.sqrt(ufl.dot(d(r0), d(r0)))  # local tangent of the state
         j = ufl.as_vector((0.0, 1.0, 0.0))
         n = ufl.cross(j, t)
@@ -115,6 +122,13 @@ class Linearisation:
         return self.K, self.C, self.M
 
     def finite_eigenvalue_count(self) -> int:
-        """2 (n - n_bc): the number of finite eigenvalues of (*)."""
-        n_bc = self.rod.comm.allreduce(sum(bc.dof_indices()[1] for bc in self.bcs), op=MPI.SUM)
-        return 2 * (self.rod.dof_count() - n_bc)
+        """2 (n - n_bc): the number of finite eigenvalues of (*); the kappa dofs
+        of the mixed form (all of them, massless) are not counted."""
+        rod = self.rod
+        bcs = [bc for bc in self.bcs if all(bc is not k for k in rod.curvature_bcs)]
+        n_bc = rod.comm.allreduce(sum(bc.dof_indices()[1] for bc in bcs), op=MPI.SUM)
+        n_kappa = 0
+        if rod.mixed:
+            im = rod.V_k.dofmap.index_map
+            n_kappa = im.size_global * rod.V_k.dofmap.index_map_bs
+        return 2 * (rod.dof_count() - n_bc - n_kappa)

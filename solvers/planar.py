@@ -26,8 +26,10 @@ from rawehelix.meshes import interval
 
 
 def planar_allowed(params: Parameters) -> bool:
-    """The stationary scene is planar: its upper end lies in the x-z plane."""
-    return params.ends.circle_radius_m == 0
+    """The stationary scene is planar: its upper end lies in the x-z plane (and
+    the bending form is the IP one: the mixed form's kappa field is not reduced
+    here; it runs on the full rod)."""
+    return params.ends.circle_radius_m == 0 and params.discretisation.bending == "ip"
 
 
 def embed(u):
@@ -38,7 +40,8 @@ def embed(u):
 class PlanarRod:
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD):
         if not planar_allowed(params):
-            raise ValueError("the planar model needs the upper end in the x-z plane")
+            raise ValueError("the planar model needs the upper end in the x-z plane and "
+                             "discretisation.bending = 'ip'")
         disc = params.discretisation
         self.params, self.q, self.comm = params, params.normalised(), comm
         self.degree, self.penalty = disc.degree, disc.penalty

@@ -61,7 +61,8 @@ class Probes:
             "r_t": (compat.expression(f.r_t, V_r), dolfinx.fem.Function(V_r)),
             "tension": (compat.expression(T, V_s), dolfinx.fem.Function(V_s)),
             "twist": (compat.expression(
-                kinematics.twist(f.r, f.alpha, c.gamma_eps, c.gamma_coupling), V_s),
+                kinematics.twist(f.r, f.alpha, c.gamma_eps, c.gamma_coupling,
+                                 k=getattr(f, "kappa", None)), V_s),
                 dolfinx.fem.Function(V_s)),
         }
 

@@ -93,6 +93,7 @@ class FloorConvergence:
         R = PETSc.SNES.ConvergedReason
         if it == 0:
             self.f0 = self.fmin = fnorm
+            self.on_floor = False  # True: the last solve was accepted by the floor test
             return R.CONVERGED_ITERATING
         if fnorm != fnorm:
             return R.DIVERGED_FNORM_NAN
@@ -104,6 +105,7 @@ class FloorConvergence:
             return R.CONVERGED_SNORM_RELATIVE
         floor = it >= 3 and ynorm <= self.floor_step * (1.0 + xnorm) and fnorm > 0.5 * self.fmin
         self.fmin = min(self.fmin, fnorm)
+        self.on_floor = floor
         return R.CONVERGED_SNORM_RELATIVE if floor else R.CONVERGED_ITERATING
 
 
@@ -121,7 +123,8 @@ class NewtonSolver:
         comm = u.function_space.mesh.comm
         self.snes = PETSc.SNES().create(comm)
         self.snes.setOptionsPrefix(prefix)
-        self.snes.setConvergenceTest(FloorConvergence())
+        self.convergence = FloorConvergence()
+        self.snes.setConvergenceTest(self.convergence)
         self.snes.setFunction(self._residual, self.b)
         self.snes.setJacobian(self._jacobian, self.A)
         with default_options(prefix, {**SNES_DEFAULTS, **lu_options(comm), **(options or {})}):

@@ -19,6 +19,17 @@ expression of the state at s = 0 (Eq. 40 integrated once in time):
 with C fixed by the initial state, so the Jacobian contains dm0/dU and
 dm0/dV.  The alpha and alpha_t in the boundary term -delta m0 psi ds are
 evaluated on the end point s = 0 (the term is weighted by 1 - s).
+
+Mixed bending form (``discretisation.bending = "mixed"``, U = (r, alpha,
+kappa)): kappa has no inertia or damping, so its rows of dF/dV and dF/dA
+are zero and TSALPHA2 integrates an index-1 DAE.  alpha2 enforces the kappa
+equation at U_{n+alpha_f} = (1 - alpha_f) U_n + alpha_f U_{n+1}; since it is
+linear in (r, kappa), a consistent U_n (the stationary state, or any state
+after :meth:`RodDiscretisation.update_curvature`) gives a consistent
+U_{n+1}, and an inconsistency g_n is mapped to g_{n+1} = -(1 - alpha_f) /
+alpha_f g_n = -rho_inf g_n (alpha_f = 1 / (1 + rho_inf)): it decays, with
+alternating sign.  The V and A that alpha2 carries for kappa are never read.
+The first-order form is refused with the mixed form.
 """
 
 from __future__ import annotations
@@ -38,10 +49,12 @@ from rawehelix.solvers.discrete import RodDiscretisation
 
 
 class Fields:
-    """UFL views (r, alpha, r_t, alpha_t) of a formulation's state."""
+    """UFL views (r, alpha, r_t, alpha_t) of a formulation's state, and the
+    curvature field ``kappa`` of the mixed bending form (None: r'')."""
 
-    def __init__(self, r, alpha, r_t, alpha_t):
+    def __init__(self, r, alpha, r_t, alpha_t, kappa=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
+        self.kappa = kappa
 
 
 def controller_torque(c: rod.Coefficients, q, fields: Fields, time, offset):
@@ -76,9 +89,9 @@ class _Formulation:
         self.kinetic = dolfinx.fem.form(energy.kinetic(fields.r_t, fields.alpha_t, self.rod.c, dx))
         self.potential = dolfinx.fem.form(energy.potential(
             fields.r, fields.alpha, self.rod.c, self.rod.degree, self.rod.penalty,
-            self.rod.measures))
+            self.rod.measures, kappa=fields.kappa))
         self.power_nv = dolfinx.fem.form(energy.non_variational_power(
-            fields.r, fields.alpha, fields.r_t, self.rod.c, dx))
+            fields.r, fields.alpha, fields.r_t, self.rod.c, dx, kappa=fields.kappa))
         self.b = compat.create_vector(self.F)
         self.A = compat.create_matrix(self.J)
 
@@ -124,9 +137,9 @@ class SecondOrder(_Formulation):
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.shift_v = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
         self.shift_a = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
-        r, alpha = ufl.split(self.u)
-        r_t, alpha_t = ufl.split(self.v)
-        fields = Fields(r, alpha, r_t, alpha_t)
+        r, alpha, *kappa = ufl.split(self.u)  # kappa: the mixed bending form
+        r_t, alpha_t = ufl.split(self.v)[:2]
+        fields = Fields(r, alpha, r_t, alpha_t, kappa[0] if kappa else None)
         c_dyn = self._coefficients(fields)
         F = rod.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree, rod_.penalty,
                          rod_.measures)
@@ -178,6 +191,11 @@ class FirstOrder(_Formulation):
     second_order = False
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
+        if rod_.mixed:
+            raise ValueError(
+                "discretisation.bending = 'mixed' runs with the second-order integrator "
+                "only (-rawehelix_ts_type alpha2, the default): the first-order TS types "
+                "are not set up for its algebraic curvature field")
         mesh = rod_.mesh
         self.W2 = compat.function_space(mesh, compat.rod_pair_element(mesh.ufl_cell(), rod_.degree))
         self.x = dolfinx.fem.Function(self.W2, name="state")
