@@ -79,18 +79,6 @@ def _fail(message: str) -> int:
     return 2
 
 
-def _refuse_past_ip_limit(params):
-    """No silent wrong answer: the IP bending form refuses N past its round-off limit."""
-    disc = params.discretisation
-    if disc.scheme == "fe" and disc.bending == "ip" and disc.elements > disc.ip_limit():
-        raise SceneError(params.name, "discretisation.elements",
-                         f"{disc.elements} is past the limit N <= {disc.ip_limit()} of "
-                         f"discretisation.bending = 'ip' at degree {disc.degree} (the round-off of "
-                         f"its fourth-order operator, entries ~ mu p^4 N^3, spoils the lateral "
-                         f"eigenvalues by more than 1e-3; docs/large_n.md): use "
-                         f"--set discretisation.bending=mixed, or fewer elements")
-
-
 def _overrides(args) -> dict:
     """--set KEY=VALUE (values in TOML syntax: 9000, 1e-3, true, "graded") and
     --f1 START:STOP:STEP, as dotted scene keys: validated by the scene loader."""
@@ -135,7 +123,6 @@ def main(argv: list[str] | None = None) -> int:
             return _extremes(args)
         params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                scheme=args.scheme, overrides=_overrides(args))
-        _refuse_past_ip_limit(params)
         outdir = args.output or Path("results") / params.name / args.command
         return COMMAND[args.command](rh, params, args, outdir, comm)
     except SceneError as err:

@@ -260,6 +260,8 @@ def compute(params: Parameters, count: int | None = None, comm=None,
     Raises SceneError for a bad count, SolverError if a solve fails.
     """
     check_count(count)
+    from rawehelix.studies import limits
+    limits.check_bending_resolution(params, "modes")
     scheme = params.discretisation.scheme
     if scheme == "fe":
         result = fe_modes(params, count, comm, scene or params.name)

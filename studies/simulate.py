@@ -33,7 +33,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import metrics, writers
+from rawehelix.studies import limits, metrics, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -209,6 +209,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                          "(the spline reference is solvers.spline_galerkin.dynamics)")
     if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
         raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
+    limits.check_bending_resolution(params, "simulate")
     q = params.normalised()
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s

@@ -41,7 +41,7 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import writers
+from rawehelix.studies import limits, writers
 from rawehelix.studies.scene import SceneError
 
 RESULTS = "sweep.json"
@@ -319,6 +319,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     call resumes a stopped sweep (see the module docstring); without it the
     sweep writes nothing.  Returns the :class:`SweepResult` (summary on every rank)."""
     start = time.perf_counter()
+    limits.check_bending_resolution(params, "sweep")
     frequencies = validate_frequencies(params.sweep.frequencies() if f1_Hz is None else f1_Hz)
     disc = params.discretisation
     header = {"scene": params.name, "fingerprint": fingerprint(params), "scheme": disc.scheme,

@@ -185,3 +185,13 @@ def test_cli_refuses_ip_past_its_limit(tmp_path, capsys):
     assert "N <= 512" in err and "discretisation.bending=mixed" in err
     assert not out.exists()
     assert math.isfinite(table2(1000, 3, "ip").discretisation.ip_limit())
+
+
+@pytest.mark.parametrize("command", ["modes", "simulate", "sweep"])
+def test_library_refuses_ip_past_its_limit(command):
+    """The refusal lives in the library: Python callers get it too (the
+    stationary state is not refused: it reports its distance to shooting)."""
+    import rawehelix as rh
+    scene_ = rh.load_scene("mobile_end", elements=1000)
+    with pytest.raises(rh.SceneError, match="N <= 512"):
+        getattr(rh, command)(scene_)
