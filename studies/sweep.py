@@ -28,9 +28,7 @@ inset T(t) near 10 Hz).
 
 from __future__ import annotations
 
-import json
 import logging
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,25 +40,9 @@ from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import limits, writers
+from rawehelix.studies.sweep_store import (RESULTS, DirectoryStore, MemoryStore, SweepError,  # noqa: F401
+                                           _key, check_directory, fingerprint, merge_results)
 from rawehelix.studies.scene import SceneError
-
-RESULTS = "sweep.json"
-
-
-class SweepError(ValueError):
-    """The output directory belongs to another sweep."""
-
-
-def fingerprint(params: Parameters) -> str:
-    """A hash of everything that changes the points: not f1 itself, the f1
-    list, the end time nor the output sampling (the time step does count)."""
-    data = params.as_dict()
-    data["ends"].pop("circle_frequency_Hz")
-    data["time"] = {"dt_s": data["time"]["dt_s"]}
-    for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
-        data["sweep"].pop(key)
-    return writers.digest(data)
-
 
 def make_backend(params: Parameters, comm):
     """The integrator for the scene's scheme."""
@@ -71,10 +53,6 @@ def make_backend(params: Parameters, comm):
         return SplineBackend(q, disc.elements)
     from rawehelix.solvers.forced import FEBackend
     return FEBackend(params, comm)
-
-
-def _key(f1: float) -> str:
-    return f"f1_{f1:010.5f}"
 
 
 def validate_frequencies(f1_Hz) -> list[float]:
@@ -89,113 +67,6 @@ def validate_frequencies(f1_Hz) -> list[float]:
     if bad:
         raise SceneError("sweep", "f1_Hz", f"{bad[0]!r}: every f1 must be a finite number > 0 [Hz]")
     return sorted({round(f, 10) for f in values})
-
-
-class MemoryStore:
-    """Finished points kept in memory (a sweep without a checkpoint directory)."""
-
-    def __init__(self):
-        self.records, self.states = {}, {}
-
-    def finished(self, f1: float) -> dict | None:
-        return self.records.get(_key(f1))
-
-    def state(self, f1: float):
-        return self.states.get(_key(f1))
-
-    def save(self, f1: float, record: dict, state_arrays: dict | None, note: str = ""):
-        self.records[_key(f1)] = record
-        if state_arrays is not None:
-            self.states[_key(f1)] = state_arrays
-
-    def all_records(self, comm) -> list[dict]:
-        gathered = comm.gather(list(self.records.values()), root=0)
-        return None if gathered is None else [r for part in gathered for r in part]
-
-
-class DirectoryStore:
-    """Finished points in a checkpoint directory: resumable (see the module docstring)."""
-
-    def __init__(self, outdir: Path, header: dict):
-        self.outdir, self.header = Path(outdir), header
-
-    def open(self, comm):
-        """Refuse a directory of another sweep, then create it (collective)."""
-        error = None
-        if comm.rank == 0:
-            try:
-                check_directory(self.outdir, self.header)
-            except SweepError as err:
-                error = str(err)
-        error = comm.bcast(error, root=0)
-        if error:
-            raise SweepError(error)
-        if comm.rank == 0:
-            (self.outdir / "points").mkdir(parents=True, exist_ok=True)
-            merge_results(self.outdir, self.header)
-        comm.Barrier()
-
-    def finished(self, f1: float) -> dict | None:
-        path = self.outdir / "points" / f"{_key(f1)}.json"
-        return json.loads(path.read_text()) if path.exists() else None
-
-    def state(self, f1: float):
-        path = self.outdir / "points" / f"{_key(f1)}.npz"
-        if not path.exists():
-            return None
-        with np.load(path) as data:
-            return {k: data[k] for k in data.files}
-
-    def save(self, f1: float, record: dict, state_arrays: dict | None, note: str = ""):
-        points = self.outdir / "points"
-        if state_arrays is not None:
-            writers.write_npz(points / f"{_key(f1)}.npz", state_arrays)
-        writers.write_json(points / f"{_key(f1)}.json", record)
-        with open(self.outdir / "computed.log", "a") as f:
-            f.write(f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}{note}\n")
-        merge_results(self.outdir, self.header)
-
-    def all_records(self, comm) -> list[dict] | None:
-        comm.Barrier()
-        if comm.rank != 0:
-            return None
-        records = []
-        for path in sorted((self.outdir / "points").glob("f1_*.json")):
-            try:
-                records.append(json.loads(path.read_text()))
-            except json.JSONDecodeError:
-                continue
-        merge_results(self.outdir, self.header)
-        return records
-
-
-def merge_results(outdir: Path, header: dict) -> dict:
-    """Rewrite sweep.json from the finished points (atomic; any rank may call it)."""
-    points = []
-    for path in sorted((outdir / "points").glob("f1_*.json")):
-        try:
-            points.append(json.loads(path.read_text())["entry"])
-        except (json.JSONDecodeError, KeyError):
-            continue
-    data = {**header, "points": sorted(points, key=lambda p: p["f1_Hz"])}
-    writers.write_json(outdir / RESULTS, data)
-    return data
-
-
-def check_directory(outdir: Path, header: dict):
-    """Refuse an output directory that holds another sweep."""
-    path = outdir / RESULTS
-    if not path.exists():
-        return
-    try:
-        old = json.loads(path.read_text())
-    except json.JSONDecodeError:
-        return  # cannot happen with atomic writes; treat as empty
-    if old.get("fingerprint") != header["fingerprint"]:
-        raise SweepError(
-            f"{path}: holds a sweep of another scene or discretisation (scene "
-            f"{old.get('scene')!r}, scheme {old.get('scheme')!r}, N = {old.get('elements')}, "
-            f"p = {old.get('degree')}); use another -o directory or delete it")
 
 
 def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=None) -> int:
