@@ -39,6 +39,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters, Sweep
+from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import writers
@@ -320,6 +321,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     sweep writes nothing.  Returns the :class:`SweepResult` (summary on every rank)."""
     start = time.perf_counter()
     frequencies = validate_frequencies(params.sweep.frequencies() if f1_Hz is None else f1_Hz)
+    stepsize.check(params, frequencies)  # FE: fixed steps resolve the forcing and omega_L
     disc = params.discretisation
     header = {"scene": params.name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
               "elements": disc.elements, "degree": disc.degree if disc.scheme == "fe" else None}
