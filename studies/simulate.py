@@ -32,6 +32,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
+from rawehelix.solvers import stepsize
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import limits, metrics, writers
 from rawehelix.studies.scene import SceneError
@@ -209,7 +210,13 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                          "(the spline reference is solvers.spline_galerkin.dynamics)")
     if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
         raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
+<<<<<<< HEAD
     limits.check_bending_resolution(params, "simulate")
+=======
+    # a fixed step must resolve the forcing and the modes a moving end excites
+    adapt = (options or {}).get("ts_adapt_type")
+    stepsize.check(params, fixed_steps=None if adapt is None else adapt == "none")
+>>>>>>> dtstab
     q = params.normalised()
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s

@@ -37,6 +37,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters, Sweep
+from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import limits, writers
@@ -192,6 +193,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     start = time.perf_counter()
     limits.check_bending_resolution(params, "sweep")
     frequencies = validate_frequencies(params.sweep.frequencies() if f1_Hz is None else f1_Hz)
+    stepsize.check(params, frequencies)  # FE: fixed steps resolve the forcing and omega_L
     disc = params.discretisation
     header = {"scene": params.name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
               "elements": disc.elements, "degree": disc.degree if disc.scheme == "fe" else None}

@@ -21,6 +21,7 @@ EXPECTED = {
     "f1_40Hz": ("converged", lambda n: 700 < n["tension_min_N"] <= n["tension_max_N"] < 750
                 and n["rel_diff_N8_N16"] < 0.01 and n["spline_N2_tension_max_N"] < 200),
     "dt_x10": ("converged", lambda n: n["spin_diff_rpm"] < 0.05),
+    "dt_sweep_10ms": ("error", lambda n: 2.3e-3 < n["dt_max_s"] < 2.4e-3),
     "n_1e4": ("converged", lambda n: n["centre_line_err_m"] < 1e-10 and n["tension_rel_err"] < 1e-8),
 }
 
