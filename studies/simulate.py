@@ -210,13 +210,10 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                          "(the spline reference is solvers.spline_galerkin.dynamics)")
     if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
         raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
-<<<<<<< HEAD
     limits.check_bending_resolution(params, "simulate")
-=======
     # a fixed step must resolve the forcing and the modes a moving end excites
     adapt = (options or {}).get("ts_adapt_type")
     stepsize.check(params, fixed_steps=None if adapt is None else adapt == "none")
->>>>>>> dtstab
     q = params.normalised()
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s

@@ -279,12 +279,8 @@ DESCRIPTIONS = {
     "torsional_buckling": "end torque 0.9, 0.99 and 1.02 x the Greenhill torque",
     "f1_40Hz": "upper end driven at f1 = 40 Hz",
     "dt_x10": "time step x 10 (0.01 s, fixed) for Sec. 5.2",
-<<<<<<< HEAD
-    "n_1e4": "N = 10^4 elements (p = 3, mixed bending form)",
-=======
     "dt_sweep_10ms": "Sec. 5.3 sweep at 7.5 Hz with fixed steps of 10 ms",
-    "n_1e4": "N = 10^4 elements (p = 3)",
->>>>>>> dtstab
+    "n_1e4": "N = 10^4 elements (p = 3, mixed bending form)",
 }
 
 
