@@ -22,6 +22,7 @@ the IP bending term is far too stiff).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numpy as np
 from mpi4py import MPI
@@ -131,11 +132,14 @@ class DynamicsSolver:
     @classmethod
     def from_stationary(cls, params: Parameters, comm=MPI.COMM_WORLD, options: dict | None = None,
                         scene: str = "scene") -> "DynamicsSolver":
-        """A solver started from the stationary state of Sec. 5.1 (at rest, t = 0)."""
+        """A solver started from the stationary state of Sec. 5.1 at t = 0: at
+        rest, but for a moving upper end, whose velocity is the circle's (70)."""
         stationary = StationarySolver(params, comm, scene=scene)
         result = stationary.solve()
         solver = cls(params, comm, options, rod=stationary.rod)
         solver.set_state(result.state)
+        if solver.form.moving_top:  # the end starts with the circle's velocity, Eq. (70)
+            solver.set_end_motion(params.ends.circle_frequency_Hz, 0.0)
         return solver
 
     def residual_floor(self) -> float:
@@ -229,6 +233,19 @@ class DynamicsSolver:
             self.ts.setSolution2(compat.petsc_vec(form.u).copy(), compat.petsc_vec(form.v).copy())
         else:
             self.ts.setSolution(compat.petsc_vec(form.x).copy())
+
+    def set_top_torque(self, top_Nm: float, rise_time_s: float | None = None):
+        """The rotor torque at the upper end, Eq. (69): M_N0 = ``top_Nm`` [Nm],
+        reached with the rise time ``rise_time_s`` [s] (default: the scene's).
+        The ground torque is the controller's, Eq. (40)."""
+        q = self._q_scene
+        t0 = q.t0 if rise_time_s is None else rise_time_s / q.t_scale
+        if not (t0 > 0 and math.isfinite(top_Nm)):
+            raise ValueError(f"set_top_torque: top_Nm = {top_Nm!r} must be finite and "
+                             f"rise_time_s = {rise_time_s!r} > 0")
+        self._q_scene = dataclasses.replace(q, mN0=top_Nm / q.torque_scale, t0=t0)
+        self.q = self.rod.q = dataclasses.replace(self.q, mN0=self._q_scene.mN0, t0=t0)
+        self.form.set_time(self.t)
 
     def set_end_motion(self, f1_Hz: float, t_start: float = 0.0):
         """The upper end on the circle of radius ``ends.circle_radius_m`` at f1 [Hz],

@@ -280,3 +280,20 @@ def test_same_numbers_on_one_and_two_ranks():
     if comm.rank == 0:
         serial = series(DynamicsSolver.from_stationary(p, MPI.COMM_SELF), 2.0, 0.1)
         assert np.allclose(parallel, serial, rtol=1e-8, atol=1e-8 * 120)
+
+
+def test_public_end_conditions_equal_the_scene_ones():
+    """set_top_torque and set_end_motion do what the scene's own torque and
+    circle do (nothing outside the solver reaches into its internals)."""
+    p = nominal(4)
+    scene_torque = series(DynamicsSolver.from_stationary(p), 0.5, 0.25)
+    solver = DynamicsSolver.from_stationary(p.replace(torque={"top_Nm": 0.0}))
+    solver.set_top_torque(p.torque.top_Nm)
+    assert np.allclose(series(solver, 0.5, 0.25), scene_torque, rtol=1e-9, atol=1e-9)
+
+    m = scene.load("mobile_end", elements=4)
+    circle = series(DynamicsSolver.from_stationary(m, options={"ts_adapt_type": "none"}), 0.2, 0.1)
+    still = m.replace(ends={"circle_frequency_Hz": 0.0})
+    solver = DynamicsSolver.from_stationary(still, options={"ts_adapt_type": "none"})
+    solver.set_end_motion(m.ends.circle_frequency_Hz, 0.0)
+    assert np.allclose(series(solver, 0.2, 0.1), circle, rtol=1e-9, atol=1e-9)
