@@ -189,6 +189,7 @@ class Discretisation:
     mesh: str = "uniform"  # "uniform" or "graded" (gmsh, refined toward the ends)
     grading: float = 4.0  # graded mesh: ratio of the largest to the smallest element
     penalty: float = 8.0  # interior-penalty factor eta: penalty = eta p^2 mu / h
+    quadrature_degree: int = 0  # cell quadrature: 0 the rule 3p, -1 UFL's estimate, > 0 that degree
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
@@ -207,6 +208,9 @@ class Discretisation:
         if not self.grading >= 1:
             raise ParameterError("discretisation.grading", self.grading, "must be >= 1")
         _positive("discretisation", self, "penalty")
+        if self.quadrature_degree < -1:
+            raise ParameterError("discretisation.quadrature_degree", self.quadrature_degree,
+                                 "must be 0 (the rule 3p), -1 (UFL's estimate) or a degree >= 1")
 
 
 @dataclass(frozen=True)
