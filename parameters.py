@@ -193,6 +193,7 @@ class Discretisation:
     # "ip": C0 interior penalty on r'' (fourth order); "mixed": the curvature
     # kappa = r'' as its own field (Ciarlet-Raviart, second order, docs/large_n.md)
     bending: str = "ip"
+    quadrature_degree: int = 0  # cell quadrature: 0 the rule 3p, -1 UFL's estimate, > 0 that degree
 
     def __post_init__(self):
         if self.scheme not in SCHEMES:
@@ -213,6 +214,9 @@ class Discretisation:
         if not self.grading >= 1:
             raise ParameterError("discretisation.grading", self.grading, "must be >= 1")
         _positive("discretisation", self, "penalty")
+        if self.quadrature_degree < -1:
+            raise ParameterError("discretisation.quadrature_degree", self.quadrature_degree,
+                                 "must be 0 (the rule 3p), -1 (UFL's estimate) or a degree >= 1")
 
     def ip_limit(self) -> int:
         """The largest N at which the IP bending form is trusted: 512 (3/p)^(4/3).

@@ -14,6 +14,10 @@ sections and keeps the others' last results.
 3. The same FE sweep on 2 MPI ranks against 1 (mpirun, same command).
 4. The modal solve (20 eigenpairs) at N = 2000, p = 3.
 5. Real-time factor of the Sec. 5.2 and 5.3 scenes at converged resolution.
+6. ``levers``: the cheaper step lever by lever (docs/speed.md), back to back:
+   real-time factor at 10 Hz and the verified numbers (T(0), Table 3, T max).
+7. ``sweep_few``: the FE sweep over the spline N = 2 one on a few points
+   (SWEEP_FEW_F1), each the whole command: the issue-12 ratio target.
 """
 
 from __future__ import annotations
@@ -33,6 +37,8 @@ HERE = Path(__file__).parent
 ROOT = HERE.parent
 FE_SWEEP = {"elements": 8, "degree": 3}  # converged within 1 % (README, Sec. 5.3)
 SWEEP_F1 = [0.5 * k for k in range(1, 31)]  # Fig. 8: 30 points, 0.5-15 Hz
+SWEEP_FEW_F1 = [9.0, 9.5, 10.0]  # a few Fig. 8 points near the resonance
+TENSION_MAX_REF_N = 244.4777456315  # T max at 10 Hz, FE p = 4, N = 16 (docs/converge/tension_max)
 
 
 def stats(values):
@@ -184,13 +190,106 @@ def bench_rtf(repeats: int):
     return out
 
 
+def bench_sweep_few(f1: list[float], repeats: int):
+    """FE N = 8 over spline N = 2 on a few points, whole commands in turn."""
+    cases = {"fe_1_rank": ("fe", FE_SWEEP["elements"]), "spline_N2": ("spline", 2)}
+    walls = {k: [] for k in cases}
+    for _ in range(repeats):
+        for key, (scheme, elements) in cases.items():
+            walls[key].append(_sweep_command(1, scheme, elements, f1, HERE / "sweeps" / f"few_{key}"))
+    for key in cases:
+        shutil.rmtree(HERE / "sweeps" / f"few_{key}", ignore_errors=True)
+    out = {"points": len(f1), "f1": f"{f1[0]}:{f1[-1]}:{f1[1] - f1[0]}",
+           **{k: {"wall_s": stats(v)} for k, v in walls.items()}}
+    out["ratio_fe_over_spline"] = (out["fe_1_rank"]["wall_s"]["median"]
+                                   / out["spline_N2"]["wall_s"]["median"])
+    return out
+
+
+#: the levers of docs/speed.md, cumulative: (discretisation.quadrature_degree,
+#: FEBackend options); the lifting skip and the one set_time per time are in
+#: every row (code, not options: see bench_residual_crossings)
+LEVERS = {
+    "0. before: UFL's quadrature, full Newton (rtol 1e-8)":
+        (-1, {"ts_jacobian_reuse": 0.0, "ts_snes_rtol": 1e-8}),
+    "1. + quadrature 3p": (0, {"ts_jacobian_reuse": 0.0, "ts_snes_rtol": 1e-8}),
+    "2. + reused Jacobian and LU (rate 0.1, rtol 1e-6; opt-in: FEBackend.REUSE)":
+        (0, {"ts_jacobian_reuse": 0.1, "ts_snes_rtol": 1e-6}),
+}
+
+
+def _verified(quadrature: int) -> dict:
+    """T(0) of Sec. 5.1 [N] and the Table 3 eigenvalues (FE N = 16) [1/s]."""
+    from mpi4py import MPI
+    from rawehelix.families import VIBRATIONS
+    from rawehelix.solvers.modal import ModalSolver
+    from rawehelix.solvers.stationary import StationarySolver
+    from rawehelix.studies import scene
+    p = scene.load("stationary_table2").replace(discretisation={"quadrature_degree": quadrature})
+    q = p.normalised()
+    T0 = float(q.tension_N(StationarySolver(p, MPI.COMM_SELF).solve().tension[0]))
+    p16 = p.replace(discretisation={"elements": 16})
+    lowest = {}
+    for m in ModalSolver.from_stationary(p16, MPI.COMM_SELF).solve(keep_vectors=False,
+                                                                   require_families=False):
+        if m.family in VIBRATIONS:
+            lam = abs(complex(m.eigenvalue)) / q.t_scale
+            lowest[m.family] = min(lowest.get(m.family, np.inf), lam)
+    return {"T0_N": T0, "eigenvalues_per_s": {f: float(lowest[f]) for f in VIBRATIONS if f in lowest}}
+
+
+def bench_levers(repeats: int, sim_s: float = 1.0):
+    """Each lever: real-time factor at 10 Hz (N = 8, p = 3, dt = 0.5 ms, ``sim_s``
+    simulated, the levers taken in turn ``repeats`` times), T max at 10 Hz
+    (periodic_response as docs/converge, at the scene's dt) and its error
+    against TENSION_MAX_REF_N, T(0) and the Table 3 eigenvalues."""
+    from mpi4py import MPI
+    from rawehelix.solvers.forced import FEBackend
+    from rawehelix.solvers.periodic import periodic_response
+    from rawehelix.studies import scene
+
+    def params(quadrature, **sections):
+        return scene.load("mobile_end", elements=8, degree=3).replace(
+            discretisation={"quadrature_degree": quadrature}, **sections)
+    backends = {k: FEBackend(params(qd), MPI.COMM_SELF, options=o) for k, (qd, o) in LEVERS.items()}
+    rtf, counts = {k: [] for k in LEVERS}, {}
+    for _ in range(repeats):
+        for key, backend in backends.items():
+            solver = backend.solver
+            n0, s0 = solver.newton_iterations, solver.steps
+            t_end = sim_s / backend.params.normalised().t_scale
+            t0 = time.perf_counter()
+            backend.set_frequency(10.0, 0.0)
+            backend.advance(backend.stationary(), 0.0, t_end, np.linspace(t_end / 200, t_end, 200))
+            rtf[key].append(sim_s / (time.perf_counter() - t0))
+            counts[key] = {"steps": solver.steps - s0, "newton": solver.newton_iterations - n0}
+    out, verified = {}, {}
+    for key, (qd, options) in LEVERS.items():
+        p = params(qd, sweep={"lead_in_s": 3.0, "periodic_tolerance": 1e-5})
+        backend = FEBackend(p, MPI.COMM_SELF, options=options)
+        result, _, _ = periodic_response(backend, p.normalised(), 10.0, backend.stationary(), 0.0,
+                                         p.sweep, lead_in=True)
+        if qd not in verified:
+            verified[qd] = _verified(qd)
+        out[key] = {"rtf": stats(rtf[key]), **counts[key],
+                    "jacobians": getattr(backend.solver.convergence, "rebuilds", None),
+                    "tension_max_N": result.tension_max_N,
+                    "tension_max_rel_error": result.tension_max_N / TENSION_MAX_REF_N - 1,
+                    **verified[qd]}
+    base = out[next(iter(LEVERS))]["rtf"]["median"]
+    for v in out.values():
+        v["speedup"] = v["rtf"]["median"] / base
+    return out
+
+
 TARGETS = {
     "sweep": "FE at converged N: as fast as or faster than the paper's N = 2 reference (ratio <= 1)",
     "step_cost": "linear in N (exponent 1)",
     "mpi": "2 ranks: speed-up near 2 (2 cores)",
     "modal": "seconds (the paper: N = 2 only)",
     "rtf": {"sec5.2": "real-time factor >= 5 (Sec. 5.2)",
-            "sec5.3": "none set; the paper: about a minute per forcing frequency at N = 2"},
+            "sec5.3": "real-time factor >= 5 on one core with T max error <= 1e-3 (issue 12)"},
+    "sweep_few": "FE N = 8 over spline N = 2 on the same points <= 0.5 (issue 12)",
 }
 
 
@@ -201,8 +300,11 @@ def _spread(v: dict, fmt: str = ".0f", unit: str = " s") -> str:
 
 def markdown(r: dict) -> str:
     s, st, md, rt = (r.get(k) for k in ("sweep", "step_cost", "modal", "rtf"))
-    lines = [f"Measured {r['date']} on {r['machine']['cores']} cores; each figure is the median "
-             f"with the min-max spread of the runs.", "",
+    dates = r.get("dates", {})
+    when = "; ".join(f"{name} {date}" for name, date in sorted(dates.items()))
+    lines = [f"Measured on {r['machine']['cores']} cores; each figure is the median with the "
+             f"min-max spread of the runs.  Each section keeps the date of its last run: {when}.",
+             "",
              "| benchmark | measured | target |", "| --- | --- | --- |"]
     if s:
         lines.append(
@@ -226,13 +328,26 @@ def markdown(r: dict) -> str:
     for key, v in (rt or {}).items():
         lines.append(f"| 5. real-time factor, {key} | {_spread(v, '.1f', '')} | "
                      f"{TARGETS['rtf'][key.split('_')[0]]} |")
+    for key, v in (r.get("levers") or {}).items():
+        lines.append(f"| 6. lever {key} | real-time factor {_spread(v['rtf'], '.2f', '')} "
+                     f"(x{v['speedup']:.2f}), T max error {v['tension_max_rel_error']:+.2e} | "
+                     f"{TARGETS['rtf']['sec5.3']} |")
+    few = r.get("sweep_few")
+    if few:
+        lines.append(f"| 7. sweep f1 = {few['f1']} Hz ({few['points']} points), whole command | FE "
+                     f"{_spread(few['fe_1_rank']['wall_s'])}, spline N = 2 "
+                     f"{_spread(few['spline_N2']['wall_s'])}: ratio {few['ratio_fe_over_spline']:.2f} "
+                     f"| {TARGETS['sweep_few']} |")
     return "\n".join(lines) + "\n"
+
+
+SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few")
 
 
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="fewer points and repeats")
-    parser.add_argument("--only", default="step_cost,modal,rtf,sweep",
+    parser.add_argument("--only", default=",".join(SECTIONS),
                         help="comma-separated sections to run")
     parser.add_argument("--sweep-repeats", type=int, default=3)
     args = parser.parse_args()
@@ -241,18 +356,24 @@ def main():
     f1 = SWEEP_F1[16::3] if args.quick else SWEEP_F1
     results = {"machine": {"cores": os.cpu_count()}, "date": time.strftime("%Y-%m-%d %H:%M")}
     previous = HERE / "results.json"
-    if previous.exists():  # a section not run now keeps its last measurement
-        results = {**json.loads(previous.read_text()), **results}
+    if previous.exists():  # a section not run now keeps its last measurement (and date)
+        old = json.loads(previous.read_text())
+        dates = old.get("dates") or {k: old["date"] for k in SECTIONS if k in old}
+        results = {**old, **results, "dates": dates}
+    results.setdefault("dates", {})
     only = set(args.only.split(","))
     steps = (10, 30, 100, 300, 1000, 3000, 10000)
     for name, fn in (("step_cost", lambda: bench_step_cost(repeats, steps)),
                      ("modal", lambda: bench_modal(repeats)),
                      ("rtf", lambda: bench_rtf(repeats)),
-                     ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats))):
+                     ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats)),
+                     ("levers", lambda: bench_levers(repeats)),
+                     ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()
         results[name] = fn()
+        results["dates"][name] = time.strftime("%Y-%m-%d %H:%M")
         print(f"{name}: done in {time.perf_counter() - t0:.0f} s", flush=True)
         (HERE / "results.json").write_text(json.dumps(results, indent=2) + "\n")
     (HERE / "results.md").write_text(markdown(results))

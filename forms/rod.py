@@ -70,6 +70,33 @@ class Coefficients:
         )
 
 
+def quadrature_degree(degree: int, chosen: int = 0) -> int | None:
+    """The quadrature degree of every cell integral (residual and Jacobian alike).
+
+    ``chosen`` = 0: the rule 3p.  The polynomial parts of the integrands of
+    (30)-(31) at degree p are of degree 2p (inertia r_tt.v), 2p - 4 (bending
+    r''.v''), 4p - 6 (mu kappa^2 r'.v') and 3p (drag |r_t| r_t.v, if |r_t|
+    were a polynomial); the tension (|r'| - 1) r'.v' is a polynomial of degree
+    2p - 2 times 1/|r'| = 1 + O(strain), so the part that no rule integrates
+    exactly is of the order of the strain (2e-3) times a smooth function.
+    3p integrates every polynomial part exactly for p <= 6 and the rest to
+    well below the discretisation error (docs/speed.md).  UFL's own estimate
+    (``chosen`` = -1) adds the degrees of every factor, 14 for the residual
+    and 20 for the Jacobian at p = 3, so the Jacobian is not even the exact
+    derivative of the residual; ``chosen`` > 0: that degree."""
+    if chosen == -1:
+        return None
+    return chosen if chosen > 0 else 3 * degree
+
+
+def measures(mesh, degree: int, chosen: int = 0):
+    """(dx, dS, ds) with the quadrature of :func:`quadrature_degree` on the cells
+    (the facet measures are point evaluations in 1D)."""
+    q = quadrature_degree(degree, chosen)
+    metadata = {} if q is None else {"quadrature_degree": q}
+    return (ufl.dx(domain=mesh, metadata=metadata), ufl.dS(domain=mesh), ufl.ds(domain=mesh))
+
+
 def jump_d(f, n):
     """[[f']] = f'(+) n(+) + f'(-) n(-): the jump of the normal derivative at a node."""
     return d(f)("+") * n("+")[0] + d(f)("-") * n("-")[0]

@@ -47,7 +47,7 @@ class RodDiscretisation:
         self.trial = ufl.TrialFunction(self.W)
         self.c = rod.Coefficients.from_normalised(
             self.q, params.model, make=lambda v: dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(v)))
-        self.measures = (ufl.dx(domain=self.mesh), ufl.dS(domain=self.mesh), ufl.ds(domain=self.mesh))
+        self.measures = rod.measures(self.mesh, disc.degree, disc.quadrature_degree)
         self._set_up_end_conditions(pin_twist)
 
     # -- end conditions, Eqs. (35), (36), (66), (70) ------------------------------

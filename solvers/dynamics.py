@@ -12,7 +12,10 @@ period loses less than 1e-4 of its amplitude per period.  Options (prefix
     -rawehelix_ts_adapt_type basic|none
     -rawehelix_ts_rtol, -rawehelix_ts_atol   local error tolerances (normalised)
     -rawehelix_ts_max_snes_failures 8  retries of a failed step (dt x 0.25 each)
-    -rawehelix_ts_snes_lag_jacobian 2, -rawehelix_ts_snes_monitor, ...
+    -rawehelix_ts_jacobian_reuse 0.1   modified Newton: keep the Jacobian and its LU
+                                       across iterations and steps until an iteration
+                                       contracts |F| by less than this (0: full Newton)
+    -rawehelix_ts_snes_monitor, ...
 
 TSALPHA2 solves the second-order form; every other type gets the first-order
 form on (U, V) (implicit types: theta, cn, beuler, bdf, alpha, arkimex with
@@ -36,8 +39,8 @@ from rawehelix.parameters import Parameters
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.probes import Probes
-from rawehelix.solvers.snes import (FloorConvergence, SolverError, default_options, lu_options,
-                                   reason_name, temporary_options)
+from rawehelix.solvers.snes import (FloorConvergence, ReusedJacobian, SolverError, default_options,
+                                   lu_options, reason_name, temporary_options)
 from rawehelix.solvers.state import RodState
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
@@ -53,6 +56,7 @@ TS_DEFAULTS = {
     "ts_max_reject": 20,
     "ts_max_steps": 10_000_000,
     "ts_error_if_step_fails": "false",  # we raise SolverError with the reason
+    "ts_jacobian_reuse": 0.0,  # full Newton; see ReusedJacobian
 }
 SNES_DEFAULTS = {  # under the prefix rawehelix_ts_
     "snes_type": "newtonls",
@@ -173,7 +177,11 @@ class DynamicsSolver:
         snes = ts.getSNES()
         snes.setOptionsPrefix(PREFIX + "ts_")
         snes.setFromOptions()
-        snes.setConvergenceTest(FloorConvergence())
+        rate = PETSc.Options().getReal(PREFIX + "ts_jacobian_reuse", 0.0)
+        self.convergence = ReusedJacobian(rate) if rate > 0 else FloorConvergence()
+        self.convergence.stale = True
+        self.form.reuse = self.convergence if rate > 0 else None
+        snes.setConvergenceTest(self.convergence)
         snes.getKSP().setFromOptions()
         snes.getKSP().getPC().setFromOptions()
         return ts
@@ -197,6 +205,7 @@ class DynamicsSolver:
             f.x.scatter_forward()
         self.ts.setTime(state.t)
         form.set_time(state.t)
+        self.convergence.stale = True  # a new start: a fresh Jacobian (if reused)
         self._push()
         if state.offset is None:
             form.offset.value = 0.0

@@ -52,7 +52,7 @@ class PlanarRod:
         self.test = ufl.TestFunction(self.W)
         self.c = rod.Coefficients.from_normalised(
             self.q, params.model, make=lambda v: dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(v)))
-        self.measures = (ufl.dx(domain=self.mesh), ufl.dS(domain=self.mesh), ufl.ds(domain=self.mesh))
+        self.measures = rod.measures(self.mesh, disc.degree, disc.quadrature_degree)
         top = self.q.top_position(0.0)
         self.top_xz = np.array([top[0], top[2]])
         bottom_v = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 0.0))

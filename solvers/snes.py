@@ -109,6 +109,43 @@ class FloorConvergence:
         return R.CONVERGED_SNORM_RELATIVE if floor else R.CONVERGED_ITERATING
 
 
+class ReusedJacobian(FloorConvergence):
+    """Modified Newton for a time integrator: the Jacobian and its LU stay from
+    one iteration and one step to the next until an iteration contracts |F|
+    by less than ``rate``, or the shifts of the Jacobian (the 1/dt and 1/dt^2
+    factors: a new step size) change; then the next Jacobian call rebuilds
+    them.  A fixed step keeps the shifts fixed and the state moves little per
+    step, so one LU serves many steps.  Convergence is judged as by
+    :class:`FloorConvergence`, on the true residual: only the rate changes.
+
+    The Jacobian callback asks :meth:`rebuild_for`; when it skips the assembly
+    the matrix keeps its PETSc state and PCSetUp keeps the LU factors."""
+
+    def __init__(self, rate: float = 0.1, floor_step: float = 1.0e-6):
+        super().__init__(floor_step)
+        self.rate = rate
+        self.stale = True
+        self.shifts = None
+        self.rebuilds = 0
+
+    def rebuild_for(self, shifts) -> bool:
+        """True (and the Jacobian counts as fresh) if it must be rebuilt for these shifts."""
+        if self.stale or shifts != self.shifts:
+            self.stale, self.shifts = False, shifts
+            self.rebuilds += 1
+            return True
+        return False
+
+    def __call__(self, snes, it, norms):
+        reason = super().__call__(snes, it, norms)
+        fnorm = norms[2]
+        if it > 0 and reason == PETSc.SNES.ConvergedReason.CONVERGED_ITERATING \
+                and not fnorm <= self.rate * self.fprev:
+            self.stale = True  # slow (or growing): a fresh Jacobian for the next iteration
+        self.fprev = fnorm
+        return reason
+
+
 class NewtonSolver:
     """SNES on F(u; v) = 0 with bcs; the Jacobian is the UFL derivative of F."""
 

@@ -188,7 +188,8 @@ def test_fe_sweep_resumes(tmp_path):
     the uninterrupted run (the backend restarts the integrator at every f1, so
     continuing in memory and from the file take the same steps, to round-off:
     measured 1.4e-12 relative in T max, as the fresh solver's first Newton
-    iterations differ from the warm one's; asserted to 1e-9)."""
+    iterations differ from the warm one's; the sweep's modified Newton (rtol 1e-6, a
+    Jacobian rebuilt when convergence slows) turns that into ~1e-9; asserted to 1e-7)."""
     params = scene.load("mobile_end", scheme="fe", elements=2, degree=2).replace(
         sweep=FE_TINY, time={"dt_s": 2e-3})
     whole = tmp_path / "whole"
@@ -214,12 +215,12 @@ def test_fe_sweep_resumes(tmp_path):
     assert computed_f1(resumed) == FE_F1[1:] and last["computed_now"] == 1
     for a, b in zip(first["points"], last["points"]):
         assert {k: a[k] for k in EXACT} == {k: b[k] for k in EXACT}
-        assert [b[k] for k in CLOSE] == pytest.approx([a[k] for k in CLOSE], rel=1e-9)
+        assert [b[k] for k in CLOSE] == pytest.approx([a[k] for k in CLOSE], rel=1e-7)
     name = f"f1_{FE_F1[1]:010.5f}"
     a, b = (json.loads((d / "points" / f"{name}.json").read_text()) for d in (whole, resumed))
-    assert b["series_tension_N"] == pytest.approx(a["series_tension_N"], rel=1e-9)
+    assert b["series_tension_N"] == pytest.approx(a["series_tension_N"], rel=1e-7)
     with np.load(whole / "points" / f"{name}.npz") as x, \
             np.load(resumed / "points" / f"{name}.npz") as y:
         assert set(x) == set(y)
         for k in x:
-            assert np.allclose(y[k], x[k], rtol=1e-9, atol=1e-9 * np.abs(x[k]).max()), k
+            assert np.allclose(y[k], x[k], rtol=1e-7, atol=1e-7 * np.abs(x[k]).max()), k
