@@ -18,12 +18,13 @@ import logging
 import ufl
 from mpi4py import MPI
 from dolfinx import fem, mesh
+from rawehelix import compat
 log = logging.getLogger("rawehelix.test")
 log.info("an info message")
 log.debug("a debug message")
 log.warning("a warning")
 domain = mesh.create_unit_interval(MPI.COMM_SELF, 2)
-V = fem.FunctionSpace(domain, ("Lagrange", 1))
+V = compat.scalar_space(domain, "Lagrange", 1)
 u = fem.Function(V)
 fem.form(u * u * ufl.dx)
 """

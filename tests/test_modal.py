@@ -155,9 +155,12 @@ def test_damping_table2(family):
 
 def test_no_damping_without_wind():
     """Second helix: no wind, so the linearised drag vanishes and every mode is
-    undamped (Re lambda = 0 to rounding)."""
+    undamped (Re lambda = 0 to rounding).  The rigid rotation is a Jordan pair
+    at zero, which round-off splits by O(sqrt(eps)) (measured 2.4e-6 with the
+    3p quadrature, 1e-9 with UFL's): test_rigid_rotation bounds it."""
     _, modes = spectrum("second")
-    assert all(abs(m.eigenvalue.real) < 1e-8 * max(abs(m.eigenvalue), 1.0) for m in modes)
+    vibrations = [m for m in modes if m.family != "rigid"]
+    assert all(abs(m.eigenvalue.real) < 1e-8 * max(abs(m.eigenvalue), 1.0) for m in vibrations)
 
 
 @pytest.mark.parametrize("name", SCENES)
