@@ -52,7 +52,9 @@ def test_vv_shows_the_compiler(tmp_path):
     assert err[:3] == ["rawehelix: an info message", "rawehelix: a debug message",
                        "rawehelix: a warning"]
     assert all(line.startswith("rawehelix: ") for line in err)
-    assert any("gcc" in line for line in err)  # the C compiler's command lines
+    from rawehelix import compat
+    if not compat.NEW:  # DOLFINx 0.5's FFCx logs the C compiler's command lines (0.9's does not)
+        assert any("gcc" in line for line in err)
 
 
 def test_stationary_on_a_cold_cache_prints_nothing_on_stderr(tmp_path):
