@@ -43,6 +43,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.errors import SceneError
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import energy, rod
 from rawehelix.solvers.discrete import RodDiscretisation
@@ -230,8 +231,9 @@ class FirstOrder(_Formulation):
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
         if rod_.mixed:
-            raise ValueError(
-                "discretisation.bending = 'mixed' runs with the second-order integrator "
+            raise SceneError(
+                rod_.params.name, "discretisation.bending",
+                "'mixed' runs with the second-order integrator "
                 "only (-rawehelix_ts_type alpha2, the default): the first-order TS types "
                 "are not set up for its algebraic curvature field")
         mesh = rod_.mesh
