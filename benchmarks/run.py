@@ -54,13 +54,15 @@ def quiet():
     logging.getLogger().setLevel(logging.WARNING)
 
 
-def _sweep_command(ranks: int, scheme: str, elements: int, f1: list[float], outdir: Path) -> float:
+def _sweep_command(ranks: int, scheme: str, elements: int, f1: list[float], outdir: Path,
+                   petsc: tuple = ()) -> float:
     """Wall time of the whole ``rawehelix sweep`` command (start-up included)."""
     env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
     exe = str(Path(sys.executable).with_name("rawehelix"))
     spec = f"{f1[0]}:{f1[-1]}:{f1[1] - f1[0]}"
     cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", exe, "sweep", "mobile_end",
-           "--scheme", scheme, "--elements", str(elements), "--f1", spec, "-o", str(outdir)]
+           "--scheme", scheme, "--elements", str(elements), "--f1", spec, "-o", str(outdir),
+           *petsc]
     if shutil.which("mpirun") is None:
         if ranks > 1:
             raise RuntimeError("mpirun not found: make install puts Open MPI in place")
@@ -192,17 +194,23 @@ def bench_rtf(repeats: int):
 
 def bench_sweep_few(f1: list[float], repeats: int):
     """FE N = 8 over spline N = 2 on a few points, whole commands in turn."""
-    cases = {"fe_1_rank": ("fe", FE_SWEEP["elements"]), "spline_N2": ("spline", 2)}
+    reuse = ("-rawehelix_ts_jacobian_reuse", "0.1", "-rawehelix_ts_snes_rtol", "1e-6")
+    cases = {"fe_1_rank": ("fe", FE_SWEEP["elements"], ()),
+             "fe_1_rank_reuse": ("fe", FE_SWEEP["elements"], reuse),
+             "spline_N2": ("spline", 2, ())}
     walls = {k: [] for k in cases}
     for _ in range(repeats):
-        for key, (scheme, elements) in cases.items():
-            walls[key].append(_sweep_command(1, scheme, elements, f1, HERE / "sweeps" / f"few_{key}"))
+        for key, (scheme, elements, petsc) in cases.items():
+            walls[key].append(_sweep_command(1, scheme, elements, f1, HERE / "sweeps" / f"few_{key}",
+                                             petsc))
     for key in cases:
         shutil.rmtree(HERE / "sweeps" / f"few_{key}", ignore_errors=True)
     out = {"points": len(f1), "f1": f"{f1[0]}:{f1[-1]}:{f1[1] - f1[0]}",
            **{k: {"wall_s": stats(v)} for k, v in walls.items()}}
     out["ratio_fe_over_spline"] = (out["fe_1_rank"]["wall_s"]["median"]
                                    / out["spline_N2"]["wall_s"]["median"])
+    out["ratio_fe_reuse_over_spline"] = (out["fe_1_rank_reuse"]["wall_s"]["median"]
+                                         / out["spline_N2"]["wall_s"]["median"])
     return out
 
 
@@ -336,8 +344,10 @@ def markdown(r: dict) -> str:
     if few:
         lines.append(f"| 7. sweep f1 = {few['f1']} Hz ({few['points']} points), whole command | FE "
                      f"{_spread(few['fe_1_rank']['wall_s'])}, spline N = 2 "
-                     f"{_spread(few['spline_N2']['wall_s'])}: ratio {few['ratio_fe_over_spline']:.2f} "
-                     f"| {TARGETS['sweep_few']} |")
+                     f"{_spread(few['spline_N2']['wall_s'])}: ratio {few['ratio_fe_over_spline']:.2f}"
+                     + (f"; FE with the reused Jacobian {_spread(few['fe_1_rank_reuse']['wall_s'])}: "
+                        f"ratio {few['ratio_fe_reuse_over_spline']:.2f}" if "fe_1_rank_reuse" in few
+                        else "") + f" | {TARGETS['sweep_few']} |")
     return "\n".join(lines) + "\n"
 
 
