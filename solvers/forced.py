@@ -27,14 +27,14 @@ class FEBackend:
     #: the end dofs jump at every new f1, and alpha2's adaptive error estimate
     #: cannot get below its tolerance however small the step; a Newton failure
     #: still cuts the step (by 4), with no limit on their count over a sweep;
-    OPTIONS = {"ts_adapt_type": "none", "ts_max_snes_failures": -1, "ts_snes_max_it": 25}
-    #: modified Newton: one LU for many fixed steps (snes.ReusedJacobian); its
-    #: linear rate needs a Newton tolerance matched to the step's own error:
-    #: 1e-6 moves T max at 10 Hz by 2e-5 relative and halves the cost
-    #: (docs/speed.md).  Opt-in (``options=FEBackend.REUSE``, or on the command
-    #: line -rawehelix_ts_jacobian_reuse 0.1 -rawehelix_ts_snes_rtol 1e-6) until
-    #: the README's sweep figures are re-measured with it.
-    REUSE = {"ts_jacobian_reuse": 0.1, "ts_snes_rtol": 1.0e-6}
+    #: and modified Newton: one LU for many fixed steps (snes.ReusedJacobian),
+    #: rebuilt when an iteration contracts |F| by less than 10x; its linear rate
+    #: needs a Newton tolerance matched to the step's own error: 1e-6 moves T
+    #: max at 10 Hz by 2e-5 relative and halves the cost (docs/speed.md).
+    #: ``FULL_NEWTON`` switches it off (the converge study's reference runs).
+    OPTIONS = {"ts_adapt_type": "none", "ts_max_snes_failures": -1, "ts_snes_max_it": 25,
+               "ts_jacobian_reuse": 0.1, "ts_snes_rtol": 1.0e-6}
+    FULL_NEWTON = {"ts_jacobian_reuse": 0.0, "ts_snes_rtol": 1.0e-8}
 
     def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None):
         self.params = params

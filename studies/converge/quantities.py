@@ -198,8 +198,9 @@ def tension_max(params: Parameters, method: Method, value) -> np.ndarray:
         backend = SplineBackend(q, p.discretisation.elements, rtol=1e-9, atol=1e-11)
     else:
         from rawehelix.solvers.forced import FEBackend
-        backend = FEBackend(p, MPI.COMM_SELF,
-                            options={"ts_type": method.ts_type} if method.ts_type else None)
+        # full Newton: the study measures discretisation errors down to 1e-6
+        backend = FEBackend(p, MPI.COMM_SELF, options={
+            **FEBackend.FULL_NEWTON, **({"ts_type": method.ts_type} if method.ts_type else {})})
     result, _, _ = periodic_response(backend, q, TENSION_MAX_F1_HZ, backend.stationary(), 0.0,
                                      p.sweep, lead_in=True)
     return np.array([result.tension_max_N])
