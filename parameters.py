@@ -415,6 +415,11 @@ class Normalised:
         omega1 = 2 * math.pi * f1_Hz * self.t_scale
         return dataclasses.replace(self, omega1=omega1, phase0=-omega1 * t_start)
 
+    @property
+    def moving_end(self) -> bool:
+        """Does the upper end move on its circle (Eq. 70: R1 > 0 and f1 > 0)?"""
+        return self.r1 > 0 and self.omega1 > 0
+
     def top_velocity(self, t: float = 0.0) -> np.ndarray:
         """d r~(1, t~)/dt~ of Eq. (70)."""
         c, s, w, r1 = math.cos(self.Gamma0), math.sin(self.Gamma0), self.omega1, self.r1

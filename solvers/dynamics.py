@@ -112,7 +112,7 @@ class DynamicsSolver:
         # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free (unless model.twist = false)
         bcs = self.rod.bcs[:2] + self.rod.twist_bcs + self.rod.curvature_bcs  # (37): mixed form
         ts_defaults = dict(TS_DEFAULTS)
-        if self.q.r1 > 0 and self.q.omega1 > 0:
+        if self.q.moving_end:
             # a moving end (Eq. 70) starts with the end's velocity and acceleration
             # jumping, which alpha2's error estimate never accepts: fixed steps
             ts_defaults["ts_adapt_type"] = "none"
@@ -212,7 +212,7 @@ class DynamicsSolver:
             form.offset.value = -self.probes.value("m0")  # m0 = 0 in this state
         else:
             form.offset.value = state.offset
-        self._good = (state.t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
+        self._remember(state.t)
         self._fresh = self._has_state = True
 
     def state(self) -> RodState:
@@ -263,14 +263,14 @@ class DynamicsSolver:
         its position: the circle restarts where the last one ended)."""
         q = self._q_scene.at_frequency(f1_Hz, t_start)
         self.q = self.rod.q = q
-        self.form.moving_top = q.r1 > 0 and q.omega1 > 0
+        self.form.moving_top = q.moving_end
         if self._has_state and self.form.second_order:
             t = self.t
             set_constant(self._v_top, q.top_velocity(t))
             dolfinx.fem.petsc.set_bc(compat.petsc_vec(self.form.v), [self._bc_v])
             self.form.v.x.scatter_forward()
             self._push()
-            self._good = (t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
+            self._remember(t)
 
     # -- stepping ---------------------------------------------------------------
     @property
@@ -359,13 +359,17 @@ class DynamicsSolver:
         if not finite:
             self._callback_error = NonFiniteState()
             raise self._callback_error
-        self._good = (t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
+        self._remember(t)
         if self._on_step is not None and not first:
             self._on_step(self)
         eps = 1e-9 * max(1.0, t)
         if self._on_output is not None and (first or (self._pending and abs(t - self._pending[0]) <= eps)):
             self.form.set_time(t)
             self._on_output(self)
+
+    def _remember(self, t: float):
+        """The current state is the last good one (restored after a failure)."""
+        self._good = (t, [compat.petsc_vec(f).copy() for f in self._state_functions()])
 
     def _state_functions(self):
         return (self.form.u, self.form.v) if self.form.second_order else (self.form.x,)

@@ -29,10 +29,6 @@ class RodState:
         return RodState(self.w.copy(), None if self.w_t is None else self.w_t.copy(),
                         self.t, self.dofs, self.offset)
 
-    def at_rest(self) -> "RodState":
-        """The same configuration with zero velocity."""
-        return RodState(self.w.copy(), None, self.t, self.dofs)
-
     def arrays(self) -> dict:
         """Plain arrays (for a file of the caller's): see :meth:`from_arrays`."""
         out = {"w": self.w, "t": np.float64(self.t), "dofs": np.int64(self.dofs)}

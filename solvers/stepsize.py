@@ -54,11 +54,6 @@ class StepLimit:
         return dt_s <= self.dt_max_s * (1 + 1e-12)
 
 
-def moving_end(params) -> bool:
-    """Does the upper end move (Eq. 70: R1 > 0 and f1 > 0)?"""
-    return params.ends.circle_radius_m > 0 and params.ends.circle_frequency_Hz > 0
-
-
 def limit(params, f1_Hz: float | None = None) -> StepLimit:
     """The step limit of the criterion for the scene at the forcing f1 [Hz]
     (default: the scene's ``ends.circle_frequency_Hz``)."""
@@ -80,7 +75,7 @@ def check(params, f1_Hz=None, fixed_steps: bool | None = None):
     Only FE runs whose upper end moves are checked, and only with fixed steps
     (``fixed_steps``, default True: the dynamics' default with a moving end).
     Raises :class:`SceneError`; returns the StepLimit (None: not checked)."""
-    moving = params.ends.circle_radius_m > 0 if f1_Hz is not None else moving_end(params)
+    moving = params.ends.circle_radius_m > 0 if f1_Hz is not None else params.normalised().moving_end
     if fixed_steps is None:
         fixed_steps = moving
     if params.discretisation.scheme != "fe" or not (fixed_steps and moving):

@@ -74,7 +74,7 @@ class _Formulation:
         mesh = rod_.mesh
         self.time = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))  # t~
         self.offset = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))  # C of Eq. (40)
-        self.moving_top = rod_.q.r1 > 0 and rod_.q.omega1 > 0  # Eq. (70)
+        self.moving_top = rod_.q.moving_end  # Eq. (70)
         self.bcs = bcs
         self._t_set = None  # (t, scene, moving end) of the data last set
         self.reuse = None  # a snes.ReusedJacobian: the Jacobian callbacks skip a fresh one
@@ -110,10 +110,12 @@ class _Formulation:
     def set_time(self, t: float):
         """Time-dependent data: torque ramp (69), end motion (36)/(70)."""
         q = self.rod.q
-        key = (t, id(q), self.moving_top)
-        if key == self._t_set:  # every residual of a Newton solve is at one time
+        last = self._t_set
+        # every residual of a Newton solve is at one time; the key holds q itself
+        # (compared by identity): an id() of a freed q could be reused by a new one
+        if last is not None and last[0] == t and last[1] is q and last[2] == self.moving_top:
             return
-        self._t_set = key
+        self._t_set = (t, q, self.moving_top)
         self._bc_values = None
         self.time.value = t
         self.rod.c.mN.value = q.top_torque(t)  # (69)

@@ -180,9 +180,10 @@ def _simulate(rh, params, args, outdir, comm) -> int:
 
 def _sweep(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import sweep
+    from rawehelix.studies.sweep_store import SweepError
     try:
         result = rh.sweep(params, comm=comm, checkpoint=outdir)
-    except sweep.SweepError as err:
+    except SweepError as err:
         raise SceneError("-o", str(outdir), str(err)) from None
     result.write(outdir, series=args.series)
     _say(comm, sweep.report(result) + f"\n  wrote {outdir}/")

@@ -154,12 +154,11 @@ class ModesResult(list):
                                     f"scaled to 1)"),
             writers.centre_line_xdmf(outdir / "modes.xdmf", x0, point_data)]
         from rawehelix.studies import render
-        animate = getattr(render, "mode_animation", None)
-        available = getattr(render, "available", None)
-        if animate is not None and available is not None and available():
+        if render.available():
             for f, m in firsts.items():
-                path = animate(outdir / f"mode_{f}.gif", m.s_m, x0, m.displacement, m.alpha_rad,
-                               self.radius_m, f"{FAMILY_LABELS[f]}, {m.frequency_Hz:.2f} Hz")
+                path = render.mode_animation(
+                    outdir / f"mode_{f}.gif", m.s_m, x0, m.displacement, m.alpha_rad,
+                    self.radius_m, f"{FAMILY_LABELS[f]}, {m.frequency_Hz:.2f} Hz")
                 if path is not None:
                     paths.append(pathlib.Path(path))
         return paths

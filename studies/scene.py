@@ -137,9 +137,3 @@ def load(path, elements: int | None = None, degree: int | None = None,
             (("elements", elements), ("degree", degree), ("scheme", scheme)) if v is not None}
     data = apply_overrides(data, {**(overrides or {}), **disc}, p)
     return parameters_from_dict(data, p, name=p.stem)
-
-
-def title(path) -> str:
-    p = resolve(path)
-    data = tomllib.loads(p.read_text())
-    return data.get("title", p.stem)

@@ -147,7 +147,6 @@ class _Recorder:
 
     def __init__(self, solver, fields_every: int):
         self.q = solver.q
-        self.rank0 = solver.comm.rank == 0
         self.rows: list[tuple] = []
         self.frames: list[Frame] = []
         self.fields_every = max(1, fields_every)

@@ -41,8 +41,7 @@ from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import limits, writers
-from rawehelix.studies.sweep_store import (RESULTS, DirectoryStore, MemoryStore, SweepError,  # noqa: F401
-                                           _key, check_directory, fingerprint, merge_results)
+from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
 from rawehelix.studies.scene import SceneError
 
 def make_backend(params: Parameters, comm):

@@ -107,25 +107,29 @@ class DirectoryStore:
         comm.Barrier()
         if comm.rank != 0:
             return None
-        records = []
-        for path in sorted((self.outdir / "points").glob("f1_*.json")):
-            try:
-                records.append(json.loads(path.read_text()))
-            except json.JSONDecodeError:
-                continue
-        merge_results(self.outdir, self.header)
+        records = read_records(self.outdir)
+        merge_results(self.outdir, self.header, records)
         return records
 
 
-def merge_results(outdir: Path, header: dict) -> dict:
-    """Rewrite sweep.json from the finished points (atomic; any rank may call it)."""
-    points = []
+def read_records(outdir: Path) -> list[dict]:
+    """The finished points' records of a checkpoint directory, by f1 (a file
+    without an entry, or not yet whole, is passed over)."""
+    records = []
     for path in sorted((outdir / "points").glob("f1_*.json")):
         try:
-            points.append(json.loads(path.read_text())["entry"])
-        except (json.JSONDecodeError, KeyError):
+            record = json.loads(path.read_text())
+        except json.JSONDecodeError:
             continue
-    data = {**header, "points": sorted(points, key=lambda p: p["f1_Hz"])}
+        if "entry" in record:
+            records.append(record)
+    return sorted(records, key=lambda r: r["entry"]["f1_Hz"])
+
+
+def merge_results(outdir: Path, header: dict, records: list[dict] | None = None) -> dict:
+    """Rewrite sweep.json from the finished points (atomic; any rank may call it)."""
+    records = read_records(outdir) if records is None else records
+    data = {**header, "points": [r["entry"] for r in records]}
     writers.write_json(outdir / RESULTS, data)
     return data
 

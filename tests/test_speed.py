@@ -3,7 +3,6 @@ reused Jacobian leave the verified numbers where they were."""
 
 import math
 
-import numpy as np
 import pytest
 from mpi4py import MPI
 
