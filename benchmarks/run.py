@@ -108,11 +108,10 @@ def bench_sweep(f1: list[float], repeats: int):
 def newton_iteration_cost(N: int, repeats: int) -> float:
     """One Newton iteration of a time step (residual, Jacobian, LU solve with the
     solvers' own choice, ``lu_options``) at the chord state; a step costs ~1-2 of these."""
-    from petsc4py import PETSc
     from mpi4py import MPI
     from rawehelix import compat
     from rawehelix.solvers.discrete import RodDiscretisation
-    from rawehelix.solvers.snes import lu_options
+    from rawehelix.solvers.snes import direct_solver
     from rawehelix.solvers.ts_forms import SecondOrder
     from rawehelix.studies import scene
     params = scene.load("nominal_operation", elements=N, degree=3)
@@ -121,13 +120,7 @@ def newton_iteration_cost(N: int, repeats: int) -> float:
     form = SecondOrder(rod, rod.bcs[:2])
     x = compat.petsc_vec(form.u).copy()
     b, A = form.b, form.A
-    ksp = PETSc.KSP().create(MPI.COMM_SELF)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    lu = lu_options(MPI.COMM_SELF)
-    ksp.getPC().setFactorSolverType(lu["pc_factor_mat_solver_type"])
-    if "pc_factor_mat_ordering_type" in lu:
-        ksp.getPC().setFactorOrdering(lu["pc_factor_mat_ordering_type"])
+    ksp = direct_solver(MPI.COMM_SELF)
     y = x.duplicate()
     times = []
     for _ in range(repeats):

@@ -22,7 +22,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat
 from rawehelix.forms.kinematics import d
-from rawehelix.solvers.snes import lu_options
+from rawehelix.solvers.snes import SolverError, direct_solver
 
 
 class CurvatureProjection:
@@ -43,15 +43,7 @@ class CurvatureProjection:
         self.A = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ufl.inner(k, eta) * dx),
                                                    bcs=self.bcs)
         self.A.assemble()
-        self.ksp = PETSc.KSP().create(rod.comm)
-        self.ksp.setOperators(self.A)
-        self.ksp.setType("preonly")
-        pc = self.ksp.getPC()
-        pc.setType("lu")
-        options = lu_options(rod.comm)
-        pc.setFactorSolverType(options["pc_factor_mat_solver_type"])
-        if "pc_factor_mat_ordering_type" in options:
-            pc.setFactorOrdering(options["pc_factor_mat_ordering_type"])
+        self.ksp = direct_solver(rod.comm, self.A)
         self.kappa = dolfinx.fem.Function(self.V_k)
         self.b = compat.create_vector(self.L)
 
@@ -64,6 +56,9 @@ class CurvatureProjection:
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs)  # homogeneous: no lifting needed
         self.ksp.solve(self.b, compat.petsc_vec(self.kappa))
+        if self.ksp.getConvergedReason() < 0:  # a zero pivot of the mass matrix, say
+            raise SolverError(f"curvature projection: the LU solve failed (KSP reason "
+                              f"{self.ksp.getConvergedReason()})")
         self.kappa.x.scatter_forward()
         w.x.array[self.parent] = self.kappa.x.array
         w.x.scatter_forward()

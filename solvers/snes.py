@@ -38,6 +38,21 @@ def lu_options(comm) -> dict:
     return {"pc_factor_mat_solver_type": "mumps"}
 
 
+def direct_solver(comm, A=None):
+    """A KSP that is one LU solve with :func:`lu_options` (operators ``A`` if given)."""
+    ksp = PETSc.KSP().create(comm)
+    if A is not None:
+        ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("lu")
+    options = lu_options(comm)
+    pc.setFactorSolverType(options["pc_factor_mat_solver_type"])
+    if "pc_factor_mat_ordering_type" in options:
+        pc.setFactorOrdering(options["pc_factor_mat_ordering_type"])
+    return ksp
+
+
 class temporary_options:
     """Put options into the PETSc database for one set-up; take them out afterwards.
 
