@@ -21,8 +21,9 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from rawehelix.families import FAMILY_LABELS
 from rawehelix.studies import paper as paper_data
-from rawehelix.studies.modes import FAMILY_LABELS
+from rawehelix.studies import writers
 
 
 @dataclass
@@ -150,11 +151,7 @@ def write_report(path, sections, title: str = "rawehelix report", meta: str = ""
     path = Path(path)
     text = render_html(sections, title, path.parent.resolve() if path.parent.exists()
                        else path.parent.absolute(), meta)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    return path
+    return writers.write_text(path, text)
 
 
 # -- Table 3 --------------------------------------------------------------------------------

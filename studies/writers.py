@@ -34,17 +34,21 @@ def digest(data) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def write_json(path: Path, data: dict) -> Path:
-    """Write JSON atomically: a reader never sees half a file."""
+def write_text(path: Path, text: str) -> Path:
+    """Write a text file atomically: a reader never sees half a file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     os.chmod(tmp, 0o644)  # mkstemp makes it private; a results file is for everyone to read
-    with os.fdopen(fd, "w") as f:
-        json.dump(_jsonable(data), f, indent=2)
-        f.write("\n")
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        f.write(text)
     os.replace(tmp, path)
     return path
+
+
+def write_json(path: Path, data: dict) -> Path:
+    """Write JSON atomically (:func:`write_text`)."""
+    return write_text(path, json.dumps(_jsonable(data), indent=2) + "\n")
 
 
 def _finish(fig, path: Path, title: str, dpi: int = 110) -> Path:

@@ -150,8 +150,8 @@ def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: Quantity, n
     """summary.json, converge.csv, converge.md and work_precision.png in ``outdir``."""
     outdir.mkdir(parents=True, exist_ok=True)
     writers.write_json(outdir / "summary.json", summary)
-    (outdir / "converge.csv").write_text(report.csv_text(summary, qty.unit, qty.components))
-    (outdir / "converge.md").write_text(report.markdown(summary, qty, name))
+    writers.write_text(outdir / "converge.csv", report.csv_text(summary, qty.unit, qty.components))
+    writers.write_text(outdir / "converge.md", report.markdown(summary, qty, name))
     report.work_precision_png(outdir / "work_precision.png", by_method, qty, name)
 
 
