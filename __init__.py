@@ -23,7 +23,8 @@ Subpackages:
 __version__ = "0.2.0"
 
 from rawehelix.api import (Parameters, SceneError, SolverError, load_scene, modes,  # noqa: E402
-                           simulate, stationary, sweep)
+                           orbits, simulate, stationary, sweep)
 
-__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "SceneError", "SolverError",
+__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "orbits", "SceneError",
+           "SolverError",
            "Parameters", "__version__"]

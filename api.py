@@ -22,7 +22,8 @@ from __future__ import annotations
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
-__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "SceneError", "SolverError",
+__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "orbits", "SceneError",
+           "SolverError",
            "Parameters"]
 
 
@@ -91,3 +92,16 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
     call resumes a stopped sweep."""
     from rawehelix.studies import sweep as study
     return study.compute(scene, f1_Hz, comm=_world(comm), checkpoint=checkpoint)
+
+
+def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None):
+    """The branch of periodic orbits of Sec. 5.3 from f1_start towards f1_stop [Hz]:
+    shooting on the period map of the generalised-alpha integrator, Floquet
+    multipliers from its tangent, pseudo-arclength continuation through folds.
+    An :class:`~rawehelix.studies.orbits.OrbitsResult` with ``branch`` (``f1_Hz``,
+    ``tension_max_N``, ``tension_min_N``, ``stable``, ``max_multiplier``,
+    ``newton_iterations``), ``folds``, ``bifurcations`` and ``summary``.
+    ``progress(orbit)`` is called at every point.  One rank (dense monodromy)."""
+    from rawehelix.studies import orbits as study
+    return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress)
+

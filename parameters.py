@@ -433,16 +433,24 @@ class Normalised:
         return r1 * w**2 * np.array([s * sw, -cw, -c * sw])
 
     def top_torque(self, t: float) -> float:
-        """m_N(t~) = m_N0 [1 - exp(-t~/t~0)], Eq. (69)."""
+        """m_N(t~) = m_N0 [1 - exp(-t~/t~0)], Eq. (69); m_N0 at all times if t~0 = 0
+        (:meth:`steady_torque`)."""
+        if self.t0 == 0:
+            return self.mN0
         return self.mN0 * (1.0 - math.exp(-t / self.t0))
+
+    def steady_torque(self) -> "Normalised":
+        """The same scene with the torque ramp (69) at its final value m_N0 from t~ = 0
+        (periodic orbits: the forcing must be periodic)."""
+        return dataclasses.replace(self, t0=0.0)
 
     def top_torque_rate(self, t: float) -> float:
         """d m_N / dt~ of Eq. (69)."""
-        return self.mN0 / self.t0 * math.exp(-t / self.t0)
+        return 0.0 if self.t0 == 0 else self.mN0 / self.t0 * math.exp(-t / self.t0)
 
     def top_torque_accel(self, t: float) -> float:
         """d^2 m_N / dt~^2 of Eq. (69)."""
-        return -self.mN0 / self.t0**2 * math.exp(-t / self.t0)
+        return 0.0 if self.t0 == 0 else -self.mN0 / self.t0**2 * math.exp(-t / self.t0)
 
     def chord_tension(self) -> float:
         """sigma eps0: the tension of the straight chord, normalised (Eq. 29)."""

@@ -185,6 +185,7 @@ class SecondOrder(_Formulation):
         J = (ufl.derivative(F, self.u, rod_.trial)
              + self.shift_v * ufl.derivative(F, self.v, rod_.trial)
              + self.shift_a * ufl.derivative(F, self.a, rod_.trial))
+        self.residual_ufl = F  # F(t, U, V, A): the orbits' tangent takes its three derivatives
         self._compile(F, J, fields, c_dyn)
 
     def _set_top(self, t):

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from rawehelix.studies.scene import SceneError
 
-COMMANDS = ("stationary", "modes", "simulate", "sweep", "converge", "extremes")
+COMMANDS = ("stationary", "modes", "simulate", "sweep", "orbits", "converge", "extremes")
 log = logging.getLogger("rawehelix")
 
 
@@ -38,6 +38,7 @@ def _parser() -> argparse.ArgumentParser:
                             ("modes", "natural modes about the stationary state (Table 3)"),
                             ("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)"),
                             ("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)"),
+                            ("orbits", "periodic orbits over f1 with Floquet stability, through folds"),
                             ("converge", "refinement study and work-precision figure")):
         p = sub.add_parser(name, help=help_text)
         p.add_argument("scene", help="scene TOML file, or the name of a shipped scene")
@@ -61,6 +62,11 @@ def _parser() -> argparse.ArgumentParser:
         if name == "converge":
             p.add_argument("--quantity", required=True,
                            help="quantity of interest: tension_s0, eigenvalues, ...")
+        if name == "orbits":
+            p.add_argument("--f1", required=True, metavar="START:STOP",
+                           help="the f1 window in Hz, traced from START towards STOP")
+            p.add_argument("--sweep", type=Path, default=None, metavar="DIR",
+                           help="a sweep's output directory: its points on the diagram")
         if name == "sweep":
             p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
                            help="frequencies in Hz (default: the scene's [sweep] section)")
@@ -92,7 +98,7 @@ def _overrides(args) -> dict:
         except tomllib.TOMLDecodeError:
             value = text  # a bare word: a string
         over[key.strip()] = value
-    if getattr(args, "f1", None) is not None:
+    if args.command == "sweep" and args.f1 is not None:
         try:
             start, stop, step = (float(v) for v in args.f1.split(":"))
         except ValueError:
@@ -190,6 +196,21 @@ def _sweep(rh, params, args, outdir, comm) -> int:
     return 0
 
 
+def _orbits(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import orbits
+    try:
+        start, stop = (float(x) for x in args.f1.split(":"))
+    except ValueError:
+        raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
+    result = rh.orbits(params, start, stop, comm=comm,
+                       progress=lambda o: _say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
+                                               f"{o.tension_max_N:.2f} N, |multiplier| "
+                                               f"{o.max_multiplier:.5f}"))
+    result.write(outdir, sweep_dir=args.sweep)
+    _say(comm, orbits.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
 def _converge(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import converge
     if args.quantity not in converge.quantities():
@@ -211,7 +232,7 @@ def _extremes(args) -> int:
 
 
 COMMAND = {"stationary": _stationary, "modes": _modes, "simulate": _simulate, "sweep": _sweep,
-           "converge": _converge}
+           "orbits": _orbits, "converge": _converge}
 
 
 def _abort_other_ranks(comm, code: int):

@@ -1,0 +1,309 @@
+"""Periodic orbits of the forced rod (Sec. 5.3, Eq. 70) by shooting, with Floquet stability.
+
+The period map P advances the state X = (U, V, A) of the generalised-alpha
+integrator (Chung and Hulbert 1993, the scheme of TSALPHA2, same rho_inf)
+over one forcing period T1 = 1/f1 in M equal steps.  A periodic orbit is a
+fixed point of P modulo the twist's steady rotation:
+
+    G(X) = P(X) - X - Delta e_alpha = 0,                         (shooting)
+
+e_alpha: a uniform unit twist (U's alpha dofs).  With the controller's
+integral action (k1 > 0, Eq. 40) the rotation per period is fixed,
+Delta = alpha_dot* T1; without it, the rigid rotation is a symmetry, Delta
+is free and one phase condition (the mean twist of X) closes the system.
+The torque ramp (69) is taken at its final value (``Normalised.steady_torque``).
+
+One step solves R(z) = F(t_n + alpha_f h, z, V_a(z), A_a(z)) = 0 for the
+stage value z = U_{n+alpha_f} (the unknown of TSALPHA2 up to the factor
+alpha_f); U_{n+1}, V_{n+1}, A_{n+1}, V_a, A_a are linear in (z, X_n)
+(:meth:`AlphaMap.newmark`).  The monodromy dP/dX comes from tangent
+propagation through the steps: at a converged step
+
+    J dz = -(F_V dV_a + F_A dA_a)|_{z fixed},  J = F_U + s_V F_V + s_A F_A,
+
+with the step's own factored Jacobian J (NLvib does this for Newmark).
+Dirichlet rows (35)-(37) read z - g(t), so their rows of J are unit rows
+and they do not depend on X_n.  The Floquet multipliers are the
+eigenvalues of the monodromy at the orbit; the n spurious roots of the
+scheme (about -rho_inf per step) give multipliers near 0.
+
+Dense linear algebra on one rank: the state has 3 n entries (n dofs), the
+monodromy (3n)^2; refused past ``MAX_STATE`` (N = 8, p = 3: 3n = 300).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+import scipy.linalg
+import ufl
+from mpi4py import MPI
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+
+from rawehelix import compat
+from rawehelix.parameters import Parameters
+from rawehelix.solvers.dynamics import DynamicsSolver
+from rawehelix.solvers.snes import SolverError
+
+MAX_STATE = 3000  # dense monodromy: (3n)^2 doubles, an LU of n per step
+
+
+@dataclasses.dataclass
+class Orbit:
+    """A periodic orbit at one f1 (normalised state, SI outputs)."""
+
+    f1_Hz: float
+    X: np.ndarray  # (U, V, A) at the start of the period, phase 0
+    delta: float  # twist rotation per period (normalised)
+    tension_max_N: float
+    tension_min_N: float
+    multipliers: np.ndarray  # Floquet multipliers, by decreasing modulus (the
+    # free twist rotation's pair without a controller set aside: symmetry_multiplier)
+    newton_iterations: int
+    residual: float  # |G| / |X| at the orbit
+    steps: int  # steps per period
+    wall_s: float
+
+    @property
+    def max_multiplier(self) -> float:
+        return float(np.abs(self.multipliers[0]))
+
+    @property
+    def stable(self) -> bool:
+        return self.max_multiplier < 1.0
+
+    def entry(self) -> dict:
+        return {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
+                "tension_min_N": self.tension_min_N, "stable": self.stable,
+                "max_multiplier": self.max_multiplier,
+                "newton_iterations": self.newton_iterations, "residual": self.residual,
+                "steps_per_period": self.steps, "wall_s": self.wall_s}
+
+
+class AlphaMap:
+    """The generalised-alpha period map of the FE rod, with its tangent."""
+
+    def __init__(self, params: Parameters, rho_inf: float = 0.9, comm=MPI.COMM_SELF):
+        if comm.size > 1:
+            raise SolverError("orbits: the shooting solver runs on one rank (dense monodromy); "
+                              "run separate frequency windows on separate ranks")
+        self.params = params
+        self.solver = DynamicsSolver.from_stationary(params, comm)
+        self.form = form = self.solver.form
+        if not form.second_order:
+            raise SolverError("orbits: needs the second-order form (alpha2)")
+        self.q_base = params.normalised().steady_torque()
+        am, af = (2 - rho_inf) / (1 + rho_inf), 1 / (1 + rho_inf)  # Chung-Hulbert
+        self.alpha_m, self.alpha_f = am, af
+        self.gamma, self.beta = 0.5 + am - af, 0.25 * (1 + am - af) ** 2
+        F, trial = form.residual_ufl, self.solver.rod.trial
+        self._F = form.F
+        self._dF = [dolfinx.fem.form(ufl.derivative(F, f, trial)) for f in (form.u, form.v, form.a)]
+        self._mats = [compat.create_matrix(a) for a in self._dF]
+        self._b = compat.create_vector(self._F)
+        self.n = n = compat.petsc_vec(form.u).getLocalSize()
+        if 3 * n > MAX_STATE:
+            raise SolverError(f"orbits: the state has 3n = {3 * n} entries; the dense "
+                              f"monodromy is limited to {MAX_STATE} (fewer elements or a "
+                              f"lower degree)")
+        dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in form.bcs] or [[]]))
+        self.bc_dofs = dofs.astype(np.int32)
+        _, alpha_dofs = compat.collapse(self.solver.rod.W.sub(1))
+        self.e_alpha = np.zeros(3 * n)
+        self.e_alpha[np.asarray(alpha_dofs)] = 1.0  # a uniform twist of U
+        self.controller = self.q_base.k1 != 0.0
+        self.floor = self.solver.residual_floor()
+        self.newton_iterations = 0  # of the steps, since the last orbit() began
+        stationary = self.solver.state()
+        self.offset = stationary.offset
+        w_t = stationary.w_t if stationary.w_t is not None else np.zeros(n)
+        self.X_stationary = np.concatenate([stationary.w, w_t, np.zeros(n)])
+
+    # -- the scheme -----------------------------------------------------------------
+    def newmark(self, z, u, v, a, h):
+        """(U_{n+1}, V_{n+1}, A_{n+1}, V_a, A_a) from the stage value z and X_n:
+        U_a = z = U_n + alpha_f (U_{n+1} - U_n); Newmark's beta/gamma update."""
+        af, am, g, b = self.alpha_f, self.alpha_m, self.gamma, self.beta
+        u1 = (z - (1 - af) * u) / af
+        a1 = (u1 - u - h * v - h * h * (0.5 - b) * a) / (b * h * h)
+        v1 = v + h * ((1 - g) * a + g * a1)
+        return u1, v1, a1, v + af * (v1 - v), a + am * (a1 - a)
+
+    def set_frequency(self, f1_Hz: float):
+        q = self.q_base.at_frequency(f1_Hz, 0.0)
+        rod = self.solver.rod
+        rod.q = q
+        self.form.moving_top = q.moving_end
+        self.form.offset.value = self.offset
+        self.q = q
+
+    def _load(self, z, va, aa, t):
+        form = self.form
+        form.set_time(t)
+        for f, x in ((form.u, z), (form.v, va), (form.a, aa)):
+            compat.petsc_vec(f).setArray(x)
+
+    def _bc_values(self):
+        g = self._b
+        with g.localForm() as gl:
+            gl.set(0.0)
+        dolfinx.fem.petsc.set_bc(g, self.form.bcs)
+        return g.getArray(readonly=True)[self.bc_dofs].copy()
+
+    def _residual(self, z):
+        b = self._b
+        with b.localForm() as bl:
+            bl.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(b, self._F)
+        R = b.getArray(readonly=True).copy()
+        R[self.bc_dofs] = z[self.bc_dofs] - self._g
+        return R
+
+    def _matrices(self):
+        out = []
+        for A, a in zip(self._mats, self._dF):
+            A.zeroEntries()
+            dolfinx.fem.petsc.assemble_matrix(A, a)
+            A.assemble()
+            indptr, indices, data = A.getValuesCSR()
+            D = np.zeros((self.n, self.n))
+            rows = np.repeat(np.arange(self.n), np.diff(indptr))
+            D[rows, indices] = data
+            out.append(D)
+        return out
+
+    def _jacobian(self, Fu, Fv, Fa, h):
+        sv = self.gamma / (self.beta * h)  # dV_a/dz
+        sa = self.alpha_m / (self.alpha_f * self.beta * h * h)  # dA_a/dz
+        J = Fu + sv * Fv + sa * Fa
+        J[self.bc_dofs, :] = 0.0
+        J[self.bc_dofs, self.bc_dofs] = 1.0
+        return scipy.linalg.lu_factor(J)
+
+    def step(self, t, h, X, Phi=None):
+        """One step from X at t; with Phi (3n x k): the tangent d X_{n+1} = S Phi."""
+        n = self.n
+        u, v, a = X[:n], X[n:2 * n], X[2 * n:]
+        ta = t + self.alpha_f * h
+        z = u + self.alpha_f * (h * v + 0.5 * h * h * a)  # predictor: constant acceleration
+        self.form.set_time(ta)
+        self._g = self._bc_values()
+        lu = None
+        for it in range(20):
+            u1, v1, a1, va, aa = self.newmark(z, u, v, a, h)
+            self._load(z, va, aa, ta)
+            R = self._residual(z)
+            norm = np.linalg.norm(R)
+            if it > 0 and (norm <= self.floor or np.linalg.norm(dz) <= 1e-12 * (1 + np.linalg.norm(z))):
+                break
+            Fu, Fv, Fa = self._matrices()
+            lu = self._jacobian(Fu, Fv, Fa, h)
+            dz = scipy.linalg.lu_solve(lu, R)
+            z = z - dz
+        else:
+            raise SolverError(f"orbits: Newton did not converge in a step at t = {t:.6g} "
+                              f"(|R| = {norm:.3g}, floor {self.floor:.3g}); try a smaller step")
+        self.newton_iterations += it
+        X1 = np.concatenate([u1, v1, a1])
+        if Phi is None:
+            return X1, None
+        Fu, Fv, Fa = self._matrices()  # at the converged step
+        lu = self._jacobian(Fu, Fv, Fa, h)
+        Pu, Pv, Pa = Phi[:n], Phi[n:2 * n], Phi[2 * n:]
+        _, _, _, dva, daa = self.newmark(np.zeros_like(Pu), Pu, Pv, Pa, h)
+        rhs = Fv @ dva + Fa @ daa
+        rhs[self.bc_dofs] = 0.0
+        dz = -scipy.linalg.lu_solve(lu, rhs)
+        du1, dv1, da1, _, _ = self.newmark(dz, Pu, Pv, Pa, h)
+        return X1, np.vstack([du1, dv1, da1])
+
+    def steps_per_period(self, f1_Hz: float) -> int:
+        period = 1.0 / (f1_Hz * self.q_base.t_scale)  # normalised
+        return max(8, math.ceil(period / (self.params.time.dt_s / self.q_base.t_scale) - 1e-9))
+
+    def period(self, X, f1_Hz: float, tangent: bool = False, steps: int | None = None):
+        """P(X) over one period at f1 (phase 0 at t = 0), the tension at s = 0 at
+        every step (normalised) and, with ``tangent``, the monodromy dP/dX."""
+        self.set_frequency(f1_Hz)
+        M = steps or self.steps_per_period(f1_Hz)
+        T1 = 2 * math.pi / self.q.omega1
+        h = T1 / M
+        Phi = np.eye(3 * self.n) if tangent else None
+        tension = []
+        for k in range(M):
+            X, Phi = self.step(k * h, h, X, Phi)
+            if not np.all(np.isfinite(X)):
+                raise SolverError(f"orbits: the state became NaN or Inf at f1 = {f1_Hz} Hz")
+            compat.petsc_vec(self.form.u).setArray(X[:self.n])
+            tension.append(self.solver.probes.value("tension0"))
+        return X, np.array(tension), Phi
+
+    def rotation(self, f1_Hz: float) -> float:
+        """Delta: the twist's rotation per period fixed by the controller (k1 > 0)."""
+        return self.q_base.spin_target * 2 * math.pi / (2 * math.pi * f1_Hz * self.q_base.t_scale)
+
+    # -- shooting ----------------------------------------------------------------
+    def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
+              monodromy=None, steps: int | None = None) -> Orbit:
+        """Newton on G(X) = P(X) - X - Delta e_alpha = 0 (chord: the monodromy is
+        refreshed when an iteration contracts |G| by less than 10x)."""
+        start = time.perf_counter()
+        self.newton_iterations = 0
+        X = X0.copy()
+        for _ in range(lead_in):
+            X, _, _ = self.period(X, f1_Hz)
+        e = self.e_alpha
+        delta = self.rotation(f1_Hz) if self.controller else 0.0
+        mono, last, its = monodromy, np.inf, 0
+        for its in range(1, max_it + 1):
+            need = mono is None
+            PX, tension, Phi = self.period(X, f1_Hz, tangent=need, steps=steps)
+            if need:
+                mono = Phi
+            G = PX - X - delta * e
+            res = np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
+            if res <= tol:
+                break
+            A = mono - np.eye(3 * self.n)
+            if res > 0.1 * last and not need:
+                mono = None  # slow: a fresh monodromy at the next iteration
+            last = res
+            if self.controller:
+                X = X - np.linalg.solve(A, G)
+            else:  # unknowns (X, Delta); phase: e . (X - X_prev) = 0.  Without torque
+                # the spin is free too (a family of orbits): the least-squares step
+                K = np.block([[A, -e[:, None]], [e[None, :], np.zeros((1, 1))]])
+                step = np.linalg.lstsq(K, np.concatenate([G, [0.0]]), rcond=None)[0]
+                X, delta = X - step[:-1], delta - step[-1]
+        else:
+            raise SolverError(f"orbits: shooting did not converge at f1 = {f1_Hz} Hz in "
+                              f"{max_it} iterations (|G|/|X| = {res:.3g} > {tol:g})")
+        return self.finish(X, f1_Hz, delta, its, res, start, steps)
+
+    def finish(self, X, f1_Hz, delta, its, res, start, steps=None) -> Orbit:
+        """The orbit through X: one more period with the tangent gives the
+        Floquet multipliers at the orbit itself, and the tension over it."""
+        _, tension, Phi = self.period(X, f1_Hz, tangent=True, steps=steps)
+        mu = np.linalg.eigvals(Phi)
+        symmetry = None
+        if not self.controller:
+            # the free rotation alpha -> alpha + c and the uniform spin that drives it
+            # form a Jordan block of the multiplier 1; round-off eps splits it into
+            # 1 +- sqrt(eps): the pair is set aside, and reported by its mean
+            pair = np.argsort(np.abs(mu - 1.0))[:2]
+            symmetry = complex(np.mean(mu[pair]))
+            mu = np.delete(mu, pair)
+        mu = mu[np.argsort(-np.abs(mu))]
+        T = self.q.tension_N(tension)
+        orbit = Orbit(f1_Hz=f1_Hz, X=X, delta=delta, tension_max_N=float(T.max()),
+                      tension_min_N=float(T.min()), multipliers=mu, newton_iterations=its,
+                      residual=float(res), steps=steps or self.steps_per_period(f1_Hz),
+                      wall_s=time.perf_counter() - start)
+        orbit.monodromy = Phi
+        orbit.symmetry_multiplier = symmetry
+        return orbit
