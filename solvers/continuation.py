@@ -11,7 +11,7 @@ with the chord [[M_k - I, G_f1], [tau_k^T]]: M_k is the monodromy at Y_k,
 G_f1 central differences of G over f1 with the steps per period held
 (one M for the whole corrector, so that the map is smooth in f1).  The
 next tangent solves [[M - I, G_f1], [tau_k^T]] tau = (0, 1).  The step
-adapts: x1.5 after a corrector of <= 3 iterations, /2 after a failure.
+adapts: x1.5 after a corrector of <= 5 iterations, /1.5 after >= 7, /2 after a failure.
 
 Folds (limit points of cycles) are where df1/ds changes sign; they are
 located between the two points by the secant on tau_f1.  Period doubling
@@ -134,7 +134,10 @@ class Branch:
             self.points.append(orbit)
             if progress:
                 progress(orbit)
-            ds = min(self.ds_max, ds * 1.5) if its <= 3 else ds
+            if its <= 5:  # an easy corrector (a chord step and a refresh or two)
+                ds = min(self.ds_max, ds * 1.5)
+            elif its >= 7:
+                ds = max(self.ds_min, ds / 1.5)
             if not (lo <= f1 <= hi):
                 break
         return self.points
