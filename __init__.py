@@ -8,6 +8,7 @@ centre line r(s, t) and twist angle alpha(s, t).  The public API
     scene = rh.load_scene("stationary_table2", elements=16)
     st = rh.stationary(scene)      # SI arrays and .summary; st.write(outdir)
     table = rh.modes(scene)        # the modes of Table 3
+    fr = rh.response(rh.load_scene("mobile_end", elements=8))  # linear response to the circle
     ts = rh.simulate(rh.load_scene("nominal_operation"), until_s=10.0)
     sw = rh.sweep(rh.load_scene("mobile_end", elements=8), f1_Hz=[9.0, 10.0])
 
@@ -23,8 +24,7 @@ Subpackages:
 __version__ = "0.2.0"
 
 from rawehelix.api import (Parameters, SceneError, SolverError, load_scene, modes,  # noqa: E402
-                           orbits, simulate, stationary, sweep)
+                           orbits, response, simulate, stationary, sweep)
 
-__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "orbits", "SceneError",
-           "SolverError",
-           "Parameters", "__version__"]
+__all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
+           "SceneError", "SolverError", "Parameters", "__version__"]

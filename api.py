@@ -22,9 +22,8 @@ from __future__ import annotations
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
-__all__ = ["load_scene", "stationary", "modes", "simulate", "sweep", "orbits", "SceneError",
-           "SolverError",
-           "Parameters"]
+__all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
+           "SceneError", "SolverError", "Parameters"]
 
 
 def _world(comm):
@@ -67,6 +66,20 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
     (SLEPc) or the paper's spline scheme."""
     from rawehelix.studies import modes as study
     return study.compute(scene, count=count, comm=_world(comm))
+
+
+def response(scene: Parameters, f1_Hz=None, comm=None):
+    """The linear frequency response to the upper end's circle (Sec. 5.3, Eq. 70)
+    at each f1 [Hz] (default: the scene's [sweep] list), about the stationary
+    state with the end at the circle's centre: a
+    :class:`~rawehelix.studies.response.ResponseResult` with ``f1_Hz``,
+    ``lateral_mid_amplitude_m`` (semi-major axis of the midpoint's lateral
+    ellipse), ``tension_amplitude_N`` (at s = 0), ``peaks`` (``peaks_Hz``) with
+    the nearest natural mode, ``natural`` (the modes of the same
+    linearisation) and ``summary``.  One f1's complex response vector:
+    :class:`rawehelix.solvers.response.HarmonicResponse`."""
+    from rawehelix.studies import response as study
+    return study.compute(scene, f1_Hz, comm=_world(comm))
 
 
 def simulate(scene: Parameters, until_s: float | None = None, comm=None,

@@ -75,8 +75,7 @@ class NonFiniteState(ArithmeticError):
 
 
 def ts_reason_name(reason: int) -> str:
-    names = {v: k for k, v in vars(PETSc.TS.ConvergedReason).items() if isinstance(v, int)}
-    return f"{names.get(reason, '?')} ({reason})"
+    return reason_name(reason, PETSc.TS.ConvergedReason)
 
 
 class DynamicsSolver:

@@ -225,6 +225,8 @@ class NewtonSolver:
         return its
 
 
-def reason_name(reason: int) -> str:
-    names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if isinstance(v, int)}
+def reason_name(reason: int, kind=None) -> str:
+    """The name of a converged reason of ``kind`` (default PETSc.SNES.ConvergedReason)."""
+    kind = PETSc.SNES.ConvergedReason if kind is None else kind
+    names = {v: k for k, v in vars(kind).items() if isinstance(v, int)}
     return f"{names.get(reason, '?')} ({reason})"

@@ -4,6 +4,7 @@
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
     rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
+    rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
     rawehelix converge SCENE --quantity Q [-o DIR]
     rawehelix extremes [CASE ...] [-o DIR]
 
@@ -27,7 +28,8 @@ from pathlib import Path
 
 from rawehelix.studies.scene import SceneError
 
-COMMANDS = ("stationary", "modes", "simulate", "sweep", "orbits", "converge", "extremes")
+COMMANDS = ("stationary", "modes", "simulate", "sweep", "response", "orbits", "converge",
+            "extremes")
 log = logging.getLogger("rawehelix")
 
 
@@ -38,6 +40,7 @@ def _parser() -> argparse.ArgumentParser:
                             ("modes", "natural modes about the stationary state (Table 3)"),
                             ("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)"),
                             ("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)"),
+                            ("response", "linear frequency response to the upper end's circle"),
                             ("orbits", "periodic orbits over f1 with Floquet stability, through folds"),
                             ("converge", "refinement study and work-precision figure")):
         p = sub.add_parser(name, help=help_text)
@@ -67,9 +70,10 @@ def _parser() -> argparse.ArgumentParser:
                            help="the f1 window in Hz, traced from START towards STOP")
             p.add_argument("--sweep", type=Path, default=None, metavar="DIR",
                            help="a sweep's output directory: its points on the diagram")
-        if name == "sweep":
+        if name in ("sweep", "response"):
             p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
                            help="frequencies in Hz (default: the scene's [sweep] section)")
+        if name == "sweep":
             p.add_argument("--series", action="store_true",
                            help="also write each point's tension time series (CSV)")
     p = sub.add_parser("extremes", help="the scenes at the edges of the physics (studies/extremes)")
@@ -98,7 +102,7 @@ def _overrides(args) -> dict:
         except tomllib.TOMLDecodeError:
             value = text  # a bare word: a string
         over[key.strip()] = value
-    if args.command == "sweep" and args.f1 is not None:
+    if args.command in ("sweep", "response") and args.f1 is not None:
         try:
             start, stop, step = (float(v) for v in args.f1.split(":"))
         except ValueError:
@@ -211,6 +215,14 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     return 0
 
 
+def _response(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import response
+    result = rh.response(params, comm=comm)
+    result.write(outdir)
+    _say(comm, response.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
 def _converge(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import converge
     if args.quantity not in converge.quantities():
@@ -232,7 +244,7 @@ def _extremes(args) -> int:
 
 
 COMMAND = {"stationary": _stationary, "modes": _modes, "simulate": _simulate, "sweep": _sweep,
-           "orbits": _orbits, "converge": _converge}
+           "response": _response, "orbits": _orbits, "converge": _converge}
 
 
 def _abort_other_ranks(comm, code: int):
