@@ -58,17 +58,23 @@ class Branch:
         self.folds: list[dict] = []
         self.bifurcations: list[dict] = []
 
-    def _G(self, X, f1, steps):
-        PX, tension, _ = self.m.period(X, f1, steps=steps)
-        return PX - X - self.m.rotation(f1) * self.m.e_alpha, tension
+    def _G(self, X, f1, steps, tangent=False):
+        """(G, monodromy or None) at (X, f1), Delta fixed by the controller."""
+        G, _, Phi = self.m.shooting_residual(X, f1, self.m.rotation(f1), tangent=tangent,
+                                             steps=steps)
+        return G, Phi
 
     def _G_f1(self, X, f1, steps, eps=1e-5):
         return (self._G(X, f1 + eps, steps)[0] - self._G(X, f1 - eps, steps)[0]) / (2 * eps)
 
+    def _bordered(self, A, gf, tau):
+        """[[M - I, G_f1], [(w^2 tau)^T]]: the corrector's and the tangent's matrix."""
+        return np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
+
     def _tangent(self, orbit: Orbit, tau_prev, steps):
         A = orbit.monodromy - np.eye(orbit.X.size)
         gf = self._G_f1(orbit.X, orbit.f1_Hz, steps)
-        K = np.block([[A, gf[:, None]], [(self.w**2 * tau_prev)[None, :]]])
+        K = self._bordered(A, gf, tau_prev)
         rhs = np.zeros(K.shape[0])
         rhs[-1] = 1.0
         tau = np.linalg.solve(K, rhs)
@@ -96,21 +102,17 @@ class Branch:
             start = time.perf_counter()
             steps = self.m.steps_per_period(prev.f1_Hz)
             Y = Y0 + ds * tau
-            K = np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
+            K = self._bordered(A, gf, tau)
             ok, lu, res, last = False, None, np.inf, np.inf
             for its in range(1, self.max_it + 1):
                 X, f1 = Y[:n], float(Y[-1])
                 if not f1 > 0:
                     break
                 slow = lu is not None and res > 0.1 * last  # the chord is too far off
+                G, Phi = self._G(X, f1, steps, tangent=slow)
                 if slow:  # Newton: the monodromy and G_f1 here
-                    PX, _, Phi = self.m.period(X, f1, tangent=True, steps=steps)
-                    G = PX - X - self.m.rotation(f1) * self.m.e_alpha
                     A, gf = Phi - np.eye(n), self._G_f1(X, f1, steps)
-                    K = np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
-                    lu = None
-                else:
-                    G, _ = self._G(X, f1, steps)
+                    K, lu = self._bordered(A, gf, tau), None
                 last, res = res, np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
                 log.debug("corrector %d: f1 = %.6f Hz, |G|/|X| = %.3g, ds %.3g%s", its, f1, res,
                           ds, " (fresh monodromy)" if slow else "")

@@ -68,6 +68,8 @@ class Orbit:
     residual: float  # |G| / |X| at the orbit
     steps: int  # steps per period
     wall_s: float
+    monodromy: np.ndarray | None = dataclasses.field(default=None, repr=False)  # dP/dX at X
+    symmetry_multiplier: complex | None = None  # the free rotation's pair (no controller)
 
     @property
     def max_multiplier(self) -> float:
@@ -105,14 +107,14 @@ class AlphaMap:
         self._F = form.F
         self._dF = [dolfinx.fem.form(ufl.derivative(F, f, trial)) for f in (form.u, form.v, form.a)]
         self._mats = [compat.create_matrix(a) for a in self._dF]
+        self._rows = [None] * 3  # row index of each stored entry (fixed pattern)
         self._b = compat.create_vector(self._F)
         self.n = n = compat.petsc_vec(form.u).getLocalSize()
         if 3 * n > MAX_STATE:
             raise SolverError(f"orbits: the state has 3n = {3 * n} entries; the dense "
                               f"monodromy is limited to {MAX_STATE} (fewer elements or a "
                               f"lower degree)")
-        dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in form.bcs] or [[]]))
-        self.bc_dofs = dofs.astype(np.int32)
+        self.bc_dofs = form.bc_dofs  # one rank: every Dirichlet dof is owned
         _, alpha_dofs = compat.collapse(self.solver.rod.W.sub(1))
         self.e_alpha = np.zeros(3 * n)
         self.e_alpha[np.asarray(alpha_dofs)] = 1.0  # a uniform twist of U
@@ -148,13 +150,6 @@ class AlphaMap:
         for f, x in ((form.u, z), (form.v, va), (form.a, aa)):
             compat.petsc_vec(f).setArray(x)
 
-    def _bc_values(self):
-        g = self._b
-        with g.localForm() as gl:
-            gl.set(0.0)
-        dolfinx.fem.petsc.set_bc(g, self.form.bcs)
-        return g.getArray(readonly=True)[self.bc_dofs].copy()
-
     def _residual(self, z):
         b = self._b
         with b.localForm() as bl:
@@ -165,15 +160,17 @@ class AlphaMap:
         return R
 
     def _matrices(self):
+        """F_U, F_V, F_A as dense arrays, without Dirichlet rows."""
         out = []
-        for A, a in zip(self._mats, self._dF):
+        for k, (A, a) in enumerate(zip(self._mats, self._dF)):
             A.zeroEntries()
             dolfinx.fem.petsc.assemble_matrix(A, a)
             A.assemble()
             indptr, indices, data = A.getValuesCSR()
+            if self._rows[k] is None:
+                self._rows[k] = np.repeat(np.arange(self.n), np.diff(indptr))
             D = np.zeros((self.n, self.n))
-            rows = np.repeat(np.arange(self.n), np.diff(indptr))
-            D[rows, indices] = data
+            D[self._rows[k], indices] = data
             out.append(D)
         return out
 
@@ -192,7 +189,7 @@ class AlphaMap:
         ta = t + self.alpha_f * h
         z = u + self.alpha_f * (h * v + 0.5 * h * h * a)  # predictor: constant acceleration
         self.form.set_time(ta)
-        self._g = self._bc_values()
+        self._g = self.form.bc_values()
         lu = None
         for it in range(20):
             u1, v1, a1, va, aa = self.newmark(z, u, v, a, h)
@@ -244,12 +241,20 @@ class AlphaMap:
         return X, np.array(tension), Phi
 
     def rotation(self, f1_Hz: float) -> float:
-        """Delta: the twist's rotation per period fixed by the controller (k1 > 0)."""
-        return self.q_base.spin_target * 2 * math.pi / (2 * math.pi * f1_Hz * self.q_base.t_scale)
+        """Delta = alpha_dot* T1: the twist's rotation per period fixed by the
+        controller (k1 > 0, Eq. 40); T1 = 1 / (f1 t_scale), normalised."""
+        return self.q_base.spin_target / (f1_Hz * self.q_base.t_scale)
+
+    def shooting_residual(self, X, f1_Hz: float, delta: float, tangent: bool = False,
+                          steps: int | None = None):
+        """G(X) = P(X) - X - Delta e_alpha, the tension over the period and (with
+        ``tangent``) the monodromy."""
+        PX, tension, Phi = self.period(X, f1_Hz, tangent=tangent, steps=steps)
+        return PX - X - delta * self.e_alpha, tension, Phi
 
     # -- shooting ----------------------------------------------------------------
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
-              monodromy=None, steps: int | None = None) -> Orbit:
+              steps: int | None = None) -> Orbit:
         """Newton on G(X) = P(X) - X - Delta e_alpha = 0 (chord: the monodromy is
         refreshed when an iteration contracts |G| by less than 10x)."""
         start = time.perf_counter()
@@ -259,13 +264,12 @@ class AlphaMap:
             X, _, _ = self.period(X, f1_Hz)
         e = self.e_alpha
         delta = self.rotation(f1_Hz) if self.controller else 0.0
-        mono, last, its = monodromy, np.inf, 0
+        mono, last, its = None, np.inf, 0
         for its in range(1, max_it + 1):
             need = mono is None
-            PX, tension, Phi = self.period(X, f1_Hz, tangent=need, steps=steps)
+            G, _, Phi = self.shooting_residual(X, f1_Hz, delta, tangent=need, steps=steps)
             if need:
                 mono = Phi
-            G = PX - X - delta * e
             res = np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
             if res <= tol:
                 break
@@ -303,7 +307,6 @@ class AlphaMap:
         orbit = Orbit(f1_Hz=f1_Hz, X=X, delta=delta, tension_max_N=float(T.max()),
                       tension_min_N=float(T.min()), multipliers=mu, newton_iterations=its,
                       residual=float(res), steps=steps or self.steps_per_period(f1_Hz),
-                      wall_s=time.perf_counter() - start)
-        orbit.monodromy = Phi
-        orbit.symmetry_multiplier = symmetry
+                      wall_s=time.perf_counter() - start, monodromy=Phi,
+                      symmetry_multiplier=symmetry)
         return orbit

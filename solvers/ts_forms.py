@@ -103,8 +103,8 @@ class _Formulation:
         self._scratch = self.b.duplicate()
         owned = self.b.getLocalSize()
         dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in self.bcs] or [[]])).astype(np.int32)
-        self._bc_dofs = dofs[dofs < owned]
-        self._bc_values = None  # g at _bc_dofs, after each set_time
+        self.bc_dofs = dofs[dofs < owned]  # this rank's owned Dirichlet dofs
+        self._bc_values = None  # g at bc_dofs, after each set_time
         self.A = compat.create_matrix(self.J)
 
     def set_time(self, t: float):
@@ -138,17 +138,22 @@ class _Formulation:
             b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
             dolfinx.fem.petsc.set_bc(b, self.bcs, x, -1.0)
 
-    def _bc_mismatch(self, x) -> float:
-        """max |x - g| over this rank's owned Dirichlet dofs (g of the last set_time)."""
+    def bc_values(self) -> np.ndarray:
+        """g at :attr:`bc_dofs`, the Dirichlet data of the last set_time (cached)."""
         if self._bc_values is None:
             g = self._scratch
             with g.localForm() as g_local:
                 g_local.set(0.0)
             dolfinx.fem.petsc.set_bc(g, self.bcs)
-            self._bc_values = g.getArray(readonly=True)[self._bc_dofs].copy()
-        if not len(self._bc_dofs):
+            self._bc_values = g.getArray(readonly=True)[self.bc_dofs].copy()
+        return self._bc_values
+
+    def _bc_mismatch(self, x) -> float:
+        """max |x - g| over this rank's owned Dirichlet dofs (g of the last set_time)."""
+        g = self.bc_values()
+        if not len(self.bc_dofs):
             return 0.0
-        return float(np.max(np.abs(x.getArray(readonly=True)[self._bc_dofs] - self._bc_values)))
+        return float(np.max(np.abs(x.getArray(readonly=True)[self.bc_dofs] - g)))
 
     def assemble_jacobian(self, A):
         A.zeroEntries()

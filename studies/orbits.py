@@ -15,9 +15,8 @@ Neimark-Sacker points (flagged between two points).
 from __future__ import annotations
 
 import json
-import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -25,8 +24,6 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.studies import writers
-
-log = logging.getLogger(__name__)
 
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
 
@@ -49,7 +46,6 @@ class OrbitsResult:
     folds: list[dict]
     bifurcations: list[dict]
     wall_s: float
-    sweep_points: list[dict] = field(default_factory=list)
 
     @property
     def summary(self) -> dict:
@@ -62,7 +58,7 @@ class OrbitsResult:
         outdir = Path(outdir)
         outdir.mkdir(parents=True, exist_ok=True)
         writers.write_json(outdir / "summary.json", self.summary)
-        sweep = _sweep_points(sweep_dir) if sweep_dir else self.sweep_points
+        sweep = _sweep_points(sweep_dir) if sweep_dir else []
         diagram_png(outdir / "orbits.png", self.branch, self.folds, sweep,
                     f"{self.title}: periodic orbits, N = {self.elements}, p = {self.degree}")
         return outdir
