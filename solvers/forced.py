@@ -14,9 +14,10 @@ import math
 
 import numpy as np
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from rawehelix.parameters import Parameters
-from rawehelix.solvers.dynamics import DynamicsSolver
+from rawehelix.solvers.dynamics import PREFIX, TS_DEFAULTS, DynamicsSolver
 from rawehelix.solvers.state import RodState
 
 
@@ -83,3 +84,30 @@ class FEBackend:
     @staticmethod
     def unpack(data) -> RodState:
         return RodState.from_arrays(data)
+
+
+class ChordBackend(FEBackend):
+    """FEBackend's periods with :class:`~rawehelix.solvers.chord.ChordAlpha`'s
+    step loop instead of PETSc TS: the same scheme, start and uniform steps, so
+    the same numbers to the Newton tolerance; one rank, dense LU (small N)."""
+
+    def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None,
+                 **chord):
+        from rawehelix.solvers.chord import ChordAlpha
+        super().__init__(params, comm, options)
+        radius = PETSc.Options().getReal(PREFIX + "ts_alpha_radius", TS_DEFAULTS["ts_alpha_radius"])
+        self.stepper = ChordAlpha(params, radius, solver=self.solver, **chord)
+
+    def advance(self, state: RodState, t0: float, t1: float, t_out):
+        solver, form = self.solver, self.solver.form
+        solver.set_state(dataclasses.replace(state, t=t0))
+        solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
+        steps = math.ceil((t1 - t0) / self.dt - 1e-9)
+        h = (t1 - t0) / steps
+        u, v, tension = self.stepper.run(t0, h, steps, form.u.x.array.copy(), form.v.x.array.copy())
+        form.u.x.array[:] = u
+        form.v.x.array[:] = v
+        times = t0 + h * np.arange(steps + 1)
+        out = solver.rod.get_state(form.u, form.v, t1)
+        out.offset = float(form.offset.value)
+        return out, np.interp(np.asarray(t_out), times, tension)

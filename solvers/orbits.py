@@ -90,12 +90,14 @@ class Orbit:
 class AlphaMap:
     """The generalised-alpha period map of the FE rod, with its tangent."""
 
-    def __init__(self, params: Parameters, rho_inf: float = 0.9, comm=MPI.COMM_SELF):
+    def __init__(self, params: Parameters, rho_inf: float = 0.9, comm=MPI.COMM_SELF,
+                 solver: DynamicsSolver | None = None):
         if comm.size > 1:
             raise SolverError("orbits: the shooting solver runs on one rank (dense monodromy); "
                               "run separate frequency windows on separate ranks")
         self.params = params
-        self.solver = DynamicsSolver.from_stationary(params, comm)
+        # solver: a DynamicsSolver of params to share (the chord stepper's backend)
+        self.solver = solver or DynamicsSolver.from_stationary(params, comm)
         self.form = form = self.solver.form
         if not form.second_order:
             raise SolverError("orbits: needs the second-order form (alpha2)")
@@ -107,9 +109,9 @@ class AlphaMap:
         self._F = form.F
         self._dF = [dolfinx.fem.form(ufl.derivative(F, f, trial)) for f in (form.u, form.v, form.a)]
         self._mats = [compat.create_matrix(a) for a in self._dF]
-        self._rows = [None] * 3  # row index of each stored entry (fixed pattern)
-        self._b = compat.create_vector(self._F)
+        self._rows = {}  # matrix -> row index of each stored entry (fixed pattern)
         self.n = n = compat.petsc_vec(form.u).getLocalSize()
+        self._b = np.zeros(form.u.x.array.size)  # one rank: owned dofs only
         if 3 * n > MAX_STATE:
             raise SolverError(f"orbits: the state has 3n = {3 * n} entries; the dense "
                               f"monodromy is limited to {MAX_STATE} (fewer elements or a "
@@ -127,10 +129,16 @@ class AlphaMap:
         self.X_stationary = np.concatenate([stationary.w, w_t, np.zeros(n)])
 
     # -- the scheme -----------------------------------------------------------------
-    def newmark(self, z, u, v, a, h):
+    @property
+    def scheme(self) -> tuple:
+        """(alpha_m, alpha_f, gamma, beta) of the scheme."""
+        return self.alpha_m, self.alpha_f, self.gamma, self.beta
+
+    def newmark(self, z, u, v, a, h, scheme=None):
         """(U_{n+1}, V_{n+1}, A_{n+1}, V_a, A_a) from the stage value z and X_n:
-        U_a = z = U_n + alpha_f (U_{n+1} - U_n); Newmark's beta/gamma update."""
-        af, am, g, b = self.alpha_f, self.alpha_m, self.gamma, self.beta
+        U_a = z = U_n + alpha_f (U_{n+1} - U_n); Newmark's beta/gamma update
+        (``scheme``: other (alpha_m, alpha_f, gamma, beta), e.g. alpha2's start)."""
+        am, af, g, b = scheme or self.scheme
         u1 = (z - (1 - af) * u) / af
         a1 = (u1 - u - h * v - h * h * (0.5 - b) * a) / (b * h * h)
         v1 = v + h * ((1 - g) * a + g * a1)
@@ -151,13 +159,19 @@ class AlphaMap:
             compat.petsc_vec(f).setArray(x)
 
     def _residual(self, z):
-        b = self._b
-        with b.localForm() as bl:
-            bl.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(b, self._F)
-        R = b.getArray(readonly=True).copy()
+        R = compat.assemble_vector_array(self._b, self._F).copy()
         R[self.bc_dofs] = z[self.bc_dofs] - self._g
         return R
+
+    def _dense(self, A, key) -> np.ndarray:
+        """An assembled PETSc matrix as a dense array; ``key`` names its (fixed) pattern."""
+        indptr, indices, data = A.getValuesCSR()
+        rows = self._rows.get(key)
+        if rows is None:
+            rows = self._rows[key] = np.repeat(np.arange(self.n), np.diff(indptr))
+        D = np.zeros((self.n, self.n))
+        D[rows, indices] = data
+        return D
 
     def _matrices(self):
         """F_U, F_V, F_A as dense arrays, without Dirichlet rows."""
@@ -166,17 +180,16 @@ class AlphaMap:
             A.zeroEntries()
             dolfinx.fem.petsc.assemble_matrix(A, a)
             A.assemble()
-            indptr, indices, data = A.getValuesCSR()
-            if self._rows[k] is None:
-                self._rows[k] = np.repeat(np.arange(self.n), np.diff(indptr))
-            D = np.zeros((self.n, self.n))
-            D[self._rows[k], indices] = data
-            out.append(D)
+            out.append(self._dense(A, k))
         return out
 
-    def _jacobian(self, Fu, Fv, Fa, h):
-        sv = self.gamma / (self.beta * h)  # dV_a/dz
-        sa = self.alpha_m / (self.alpha_f * self.beta * h * h)  # dA_a/dz
+    def shifts(self, h, scheme=None) -> tuple[float, float]:
+        """(dV_a/dz, dA_a/dz) of :meth:`newmark`: the shifts of TSALPHA2's Jacobian."""
+        am, af, g, b = scheme or self.scheme
+        return g / (b * h), am / (af * b * h * h)
+
+    def _jacobian(self, Fu, Fv, Fa, h, scheme=None):
+        sv, sa = self.shifts(h, scheme)
         J = Fu + sv * Fv + sa * Fa
         J[self.bc_dofs, :] = 0.0
         J[self.bc_dofs, self.bc_dofs] = 1.0

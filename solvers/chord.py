@@ -1,0 +1,163 @@
+"""A step loop of TSALPHA2 without PETSc TS (issue 12): chord Newton on the stage value.
+
+The scheme is :class:`~rawehelix.solvers.orbits.AlphaMap`'s, the generalised-alpha
+method of TSALPHA2 (same rho_inf): one step solves R(z) = F(t_n + alpha_f h, z,
+V_a(z), A_a(z)) = 0 for z = U_{n+alpha_f}, with V_a, A_a linear in z
+(``AlphaMap.newmark``, slopes ``AlphaMap.shifts``).  What is new is how:
+
+- chord (modified) Newton: the dense LU of J = F_U + s_V F_V + s_A F_A is held
+  across iterations and steps (one per step size and scheme) and refreshed when
+  an iteration contracts dz by less than ``rate`` (theta > 0.1) or diverges;
+- the predictor extrapolates the last three stage values (quadratic in t), so
+  that one or two chord iterations suffice;
+- the stopping test is Hairer's (Hairer and Wanner, Solving ODEs II, IV.8):
+  eta |dz|_inf <= tol with eta = theta / (1 - theta) from the contraction theta
+  = |dz_k| / |dz_{k-1}| of this step, or at the first iteration of a step from
+  the last step's (eta_prev^0.8: it creeps towards 1, so a stale estimate forces
+  a second iteration that measures theta again);  eta |dz| bounds the distance to
+  the solution of R(z) = 0 if the contraction holds.  A step that does not meet
+  it in ``max_it`` iterations, or diverges with a fresh Jacobian, or leaves a
+  non-finite state, raises SolverError;
+- the Dirichlet rows (35)-(36) as in AlphaMap (z = g(t_n + alpha_f h); the
+  predictor puts z on g, so their rows of R are zero);
+- TSALPHA2's start (``TSAlpha_Restart``): two steps of the scheme (1, 1, 1, 1/2)
+  (backward Euler in V) of h/2 from (U_0, V_0, A = 0), then A_0 by backward
+  differences of V: so a run of ``advance`` equals PETSc's to the Newton tolerance.
+
+Dense linear algebra on one rank (AlphaMap's limit: 3 n <= ``orbits.MAX_STATE``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg
+
+import dolfinx.fem
+
+from rawehelix import compat
+from rawehelix.solvers.orbits import AlphaMap
+from rawehelix.solvers.snes import SolverError
+
+BACKWARD_EULER = (1.0, 1.0, 1.0, 0.5)  # (alpha_m, alpha_f, gamma, beta) of TSAlpha_Restart
+#: weights of the newest-first stage values in the extrapolation of order k
+EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0), 3: (4.0, -6.0, 4.0, -1.0)}
+
+
+class ChordAlpha(AlphaMap):
+    """TSALPHA2's steps by chord Newton with held LU factors (see the module docstring).
+
+    ``tol``: Hairer's test on the stage value (normalised, max norm); ``rate``:
+    the contraction above which the LU is refreshed; ``max_it``: per step."""
+
+    def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-10,
+                 rate: float = 0.1, max_it: int = 8, order: int = 2):
+        super().__init__(params, rho_inf, solver=solver)
+        self.tol, self.rate, self.max_it, self.order = tol, rate, max_it, order
+        self._lu = {}  # (scheme, h) -> LU factors of J
+        self.eta = 1.0  # Hairer's eta = theta / (1 - theta), carried from step to step
+        self.iterations = self.factorisations = self.steps = 0
+        self._tension = self.solver.probes.forms["tension0"]
+        self._J = compat.create_matrix(self.form.J)
+        self._getrs = scipy.linalg.get_lapack_funcs("getrs", (np.zeros(1),))
+
+    def _factor(self, key, h, scheme):
+        """LU of J = F_U + s_V F_V + s_A F_A at the loaded stage (the formulation's
+        TSALPHA2 Jacobian form, one assembly; Dirichlet rows and columns unit)."""
+        form = self.form
+        form.shift_v.value, form.shift_a.value = self.shifts(h, scheme)
+        form.assemble_jacobian(self._J)
+        self._lu[key] = lu = scipy.linalg.lu_factor(self._dense(self._J, "J"), check_finite=False)
+        self.factorisations += 1
+        return lu
+
+    def solve_stage(self, t, h, u, v, a, z, scheme=None):
+        """One step from (u, v, a) at t with the predictor z: (U, V, A)_{n+1} and z."""
+        scheme = scheme or self.scheme
+        sv, sa = self.shifts(h, scheme)
+        ta = t + scheme[1] * h
+        form = self.form
+        form.set_time(ta)
+        z = z.copy()
+        z[self.bc_dofs] = self._g = form.bc_values()  # so R's Dirichlet rows stay 0
+        _, _, _, va, aa = self.newmark(z, u, v, a, h, scheme)
+        key = (scheme, h)
+        lu = self._lu.get(key)
+        fresh, last, eta = False, None, max(self.eta, 1e-16) ** 0.8
+        x_u, x_v, x_a = form.u.x.array, form.v.x.array, form.a.x.array
+        for it in range(1, self.max_it + 1):
+            x_u[:] = z
+            x_v[:] = va
+            x_a[:] = aa
+            if lu is None:
+                lu, fresh, last = self._factor(key, h, scheme), True, None
+            R = compat.assemble_vector_array(self._b, self._F)
+            R[self.bc_dofs] = 0.0
+            dz, info = self._getrs(lu[0], lu[1], R)
+            size = abs(dz).max()
+            if not size < math.inf:  # NaN or Inf
+                raise SolverError(f"chord alpha2: the state became NaN or Inf at t = {t:.6g} "
+                                  f"(normalised)")
+            theta = None if last is None else size / last
+            if theta is not None and theta >= 1.0:  # diverging: back, and a fresh Jacobian
+                if fresh:
+                    raise SolverError(
+                        f"chord alpha2: Newton diverges with a fresh Jacobian at t = {t:.6g} "
+                        f"(normalised; contraction {theta:.2g}); try a smaller step (time.dt_s)")
+                lu = None
+                self._lu.pop(key, None)
+                continue
+            z -= dz
+            va -= sv * dz
+            aa -= sa * dz
+            self.iterations += 1
+            if theta is not None:
+                eta = self.eta = theta / (1.0 - theta)
+                if theta > self.rate:  # slow: a fresh LU at the next use
+                    self._lu.pop(key, None)
+                    lu = None if eta * size > self.tol else lu
+                    fresh = False
+            if eta * size <= self.tol:
+                break
+            last = size
+        else:
+            raise SolverError(
+                f"chord alpha2: no convergence in {self.max_it} iterations at t = {t:.6g} "
+                f"(normalised; last |dz| = {size:.3g}, tol {self.tol:g}); try a smaller step "
+                f"(time.dt_s)")
+        self.steps += 1
+        u1, v1, a1, _, _ = self.newmark(z, u, v, a, h, scheme)
+        return u1, v1, a1, z
+
+    def start(self, t, h, u, v):
+        """A_0 as TSALPHA2's restart: two half steps of the scheme (1, 1, 1, 1/2)."""
+        a0 = np.zeros_like(u)
+        u1, v1, _, _ = self.solve_stage(t, h / 2, u, v, a0, u + 0.5 * h * v, BACKWARD_EULER)
+        _, v2, _, _ = self.solve_stage(t + h / 2, h / 2, u1, v1, a0, u1 + 0.5 * h * v1,
+                                       BACKWARD_EULER)
+        return (-3.0 * v + 4.0 * v1 - v2) / (h / 2)
+
+    def tension0(self, u) -> float:
+        """T(0) (normalised) of the configuration u: the probe's point form (one rank)."""
+        self.form.u.x.array[:] = u
+        return dolfinx.fem.assemble_scalar(self._tension)
+
+    def run(self, t0, h, steps, u, v):
+        """``steps`` steps of h from (u, v) at t0, with alpha2's start: the final (u, v)
+        and the tension at s = 0 after every step (normalised, the start's first)."""
+        tension = np.empty(steps + 1)
+        tension[0] = self.tension0(u)
+        a = self.start(t0, h, u, v)
+        af = self.alpha_f
+        history = []  # the last stage values, newest first
+        for k in range(steps):
+            if len(history) < self.order + 1:  # constant acceleration (AlphaMap's)
+                z = u + af * (h * v + 0.5 * h * h * a)
+            else:  # the last order + 1 stage values, a polynomial in t
+                z = sum(c * zk for c, zk in zip(EXTRAPOLATION[self.order], history))
+            u, v, a, z = self.solve_stage(t0 + k * h, h, u, v, a, z)
+            history = [z] + history[:self.order]
+            tension[k + 1] = self.tension0(u)
+        return u, v, tension
+
