@@ -18,6 +18,10 @@ sections and keeps the others' last results.
    real-time factor at 10 Hz and the verified numbers (T(0), Table 3, T max).
 7. ``sweep_few``: the FE sweep over the spline N = 2 one on a few points
    (SWEEP_FEW_F1), each the whole command: the issue-12 ratio target.
+8. ``chord``: the step loop without PETSc TS (solvers/chord.py, chord Newton
+   with held dense LU) against the TS path in the same process, in CPU time:
+   real-time factor and T max error at 10 Hz, dt = 0.5 and 1 ms, and where a
+   chord step's CPU time goes.
 """
 
 from __future__ import annotations
@@ -283,6 +287,93 @@ def bench_levers(repeats: int, sim_s: float = 1.0):
     return out
 
 
+CHORD_DT_S = (5e-4, 1e-3)
+
+
+def _chord_params(dt_s, **sections):
+    from rawehelix.studies import scene
+    return scene.load("mobile_end", elements=8, degree=3).replace(time={"dt_s": dt_s}, **sections)
+
+
+def chord_profile(backend, sim_s: float = 1.0) -> dict:
+    """CPU time per step [us] of the parts of a chord step at 10 Hz (``sim_s``
+    simulated from the stationary state), by wrapping them with process_time
+    (its own cost, ~0.6 us a pair, is in each part); ``other`` is the rest:
+    numpy glue of the chord iteration and the step loop in Python."""
+    from rawehelix.solvers import chord
+    s = backend.stepper
+    form, acc, clock = s.form, {}, time.process_time
+    parts = {"set_time (constants, end position)": (form, "set_time"),
+             "bc_values (Dirichlet data)": (form, "bc_values"),
+             "residual assembly": (chord.compat, "assemble_vector_array"),
+             "LU solve (getrs)": (s, "_getrs"), "Jacobian assembly + LU factor": (s, "_factor"),
+             "newmark (stage vectors)": (s, "newmark"), "tension0": (s, "tension0")}
+    saved = {}
+    for label, (obj, name) in parts.items():
+        f = saved[label] = getattr(obj, name)
+
+        def wrapped(*a, _f=f, _label=label, **k):
+            t = clock()
+            out = _f(*a, **k)
+            acc[_label] = acc.get(_label, 0.0) + clock() - t
+            return out
+        setattr(obj, name, wrapped)
+    try:
+        steps0, its0, f0 = s.steps, s.iterations, s.factorisations
+        t_end = sim_s / backend.params.normalised().t_scale
+        backend.set_frequency(10.0, 0.0)
+        t0 = clock()
+        backend.advance(backend.stationary(), 0.0, t_end, np.array([t_end]))
+        total = clock() - t0
+    finally:
+        for label, (obj, name) in parts.items():
+            setattr(obj, name, saved[label])
+    steps = s.steps - steps0
+    out = {k: v / steps * 1e6 for k, v in acc.items()}
+    out["other"] = total / steps * 1e6 - sum(out.values())
+    return {"us_per_step": out, "total_us_per_step": total / steps * 1e6,
+            "iterations_per_step": (s.iterations - its0) / steps,
+            "factorisations": s.factorisations - f0, "steps": steps}
+
+
+def bench_chord(repeats: int, sim_s: float = 1.0):
+    """The chord step loop against PETSc TS (the sweep's default FEBackend), same
+    process, taken in turn ``repeats`` times: real-time factor in CPU time over
+    ``sim_s`` simulated at 10 Hz from the stationary state, T max at 10 Hz
+    (periodic_response as ``levers``) and its error against TENSION_MAX_REF_N."""
+    from mpi4py import MPI
+    from rawehelix.solvers.forced import ChordBackend, FEBackend
+    from rawehelix.solvers.periodic import periodic_response
+    kinds = {"ts": FEBackend, "chord": ChordBackend}
+    out = {}
+    for dt in CHORD_DT_S:
+        backends = {k: B(_chord_params(dt), MPI.COMM_SELF) for k, B in kinds.items()}
+        rtf = {k: [] for k in kinds}
+        for _ in range(repeats):
+            for key, backend in backends.items():
+                t_end = sim_s / backend.params.normalised().t_scale
+                backend.set_frequency(10.0, 0.0)
+                t0 = time.process_time()
+                backend.advance(backend.stationary(), 0.0, t_end, np.linspace(t_end / 200, t_end, 200))
+                rtf[key].append(sim_s / (time.process_time() - t0))
+        row = {}
+        for key, B in kinds.items():
+            p = _chord_params(dt, sweep={"lead_in_s": 3.0, "periodic_tolerance": 1e-5})
+            backend = B(p, MPI.COMM_SELF)
+            t0 = time.process_time()
+            result, _, _ = periodic_response(backend, p.normalised(), 10.0, backend.stationary(),
+                                             0.0, p.sweep, lead_in=True)
+            row[key] = {"rtf": stats(rtf[key]), "tension_max_N": result.tension_max_N,
+                        "tension_max_rel_error": result.tension_max_N / TENSION_MAX_REF_N - 1,
+                        "periods": result.periods, "periodic": result.periodic,
+                        "periodic_response_cpu_s": time.process_time() - t0}
+        row["speedup"] = row["chord"]["rtf"]["median"] / row["ts"]["rtf"]["median"]
+        row["tension_max_chord_vs_ts"] = row["chord"]["tension_max_N"] / row["ts"]["tension_max_N"] - 1
+        out[f"dt_{dt * 1e3:g}ms"] = row
+    out["profile_dt_0.5ms"] = chord_profile(ChordBackend(_chord_params(CHORD_DT_S[0]), MPI.COMM_SELF))
+    return out
+
+
 TARGETS = {
     "sweep": "FE at converged N: as fast as or faster than the paper's N = 2 reference (ratio <= 1)",
     "step_cost": "linear in N (exponent 1)",
@@ -341,10 +432,19 @@ def markdown(r: dict) -> str:
                      + (f" (FE with full Newton {_spread(few['fe_1_rank_full_newton']['wall_s'])}: "
                         f"ratio {few['ratio_fe_full_newton_over_spline']:.2f})"
                         if "fe_1_rank_full_newton" in few else "") + f" | {TARGETS['sweep_few']} |")
+    for key, v in (r.get("chord") or {}).items():
+        if not key.startswith("dt_"):
+            continue
+        c, t = v["chord"], v["ts"]
+        lines.append(f"| 8. chord step loop (solvers/chord.py), {key.replace('_', ' = ')}, CPU time | "
+                     f"real-time factor {_spread(c['rtf'], '.2f', '')} against TS "
+                     f"{_spread(t['rtf'], '.2f', '')} (x{v['speedup']:.2f}); T max error "
+                     f"{c['tension_max_rel_error']:+.2e} (TS {t['tension_max_rel_error']:+.2e}) | "
+                     f"{TARGETS['rtf']['sec5.3']} |")
     return "\n".join(lines) + "\n"
 
 
-SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few")
+SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord")
 
 
 def main():
@@ -371,7 +471,8 @@ def main():
                      ("rtf", lambda: bench_rtf(repeats)),
                      ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats)),
                      ("levers", lambda: bench_levers(repeats)),
-                     ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats))):
+                     ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats)),
+                     ("chord", lambda: bench_chord(repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -12,11 +12,13 @@ V_a(z), A_a(z)) = 0 for z = U_{n+alpha_f}, with V_a, A_a linear in z
   that one or two chord iterations suffice;
 - the stopping test is Hairer's (Hairer and Wanner, Solving ODEs II, IV.8):
   eta |dz|_inf <= tol with eta = theta / (1 - theta) from the contraction theta
-  = |dz_k| / |dz_{k-1}| of this step, or at the first iteration of a step from
-  the last step's (eta_prev^0.8: it creeps towards 1, so a stale estimate forces
-  a second iteration that measures theta again);  eta |dz| bounds the distance to
-  the solution of R(z) = 0 if the contraction holds.  A step that does not meet
-  it in ``max_it`` iterations, or diverges with a fresh Jacobian, or leaves a
+  = |dz_k| / |dz_{k-1}| measured in this step with this LU (so at least two
+  iterations, unless dz is at round-off); eta |dz| bounds the distance to the
+  solution of R(z) = 0 while the contraction holds.  Hairer's carry-over of
+  eta from the last step (one-iteration steps) is not used: right after a
+  refresh it measures the round-off, not the chord's rate, and let steps pass
+  with errors ~1e-6 (found in testing).  A step that does not meet the test in
+  ``max_it`` iterations, or diverges with a fresh Jacobian, or leaves a
   non-finite state, raises SolverError;
 - the Dirichlet rows (35)-(36) as in AlphaMap (z = g(t_n + alpha_f h); the
   predictor puts z on g, so their rows of R are zero);
@@ -35,12 +37,15 @@ import numpy as np
 import scipy.linalg
 
 import dolfinx.fem
+import ufl
 
 from rawehelix import compat
+from rawehelix.forms import kinematics
 from rawehelix.solvers.orbits import AlphaMap
 from rawehelix.solvers.snes import SolverError
 
 BACKWARD_EULER = (1.0, 1.0, 1.0, 0.5)  # (alpha_m, alpha_f, gamma, beta) of TSAlpha_Restart
+ROUNDOFF = 1e-14  # |dz| / max(1, |z|) at which an iterate is round-off, not a correction
 #: weights of the newest-first stage values in the extrapolation of order k
 EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0), 3: (4.0, -6.0, 4.0, -1.0)}
 
@@ -51,14 +56,13 @@ class ChordAlpha(AlphaMap):
     ``tol``: Hairer's test on the stage value (normalised, max norm); ``rate``:
     the contraction above which the LU is refreshed; ``max_it``: per step."""
 
-    def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-10,
-                 rate: float = 0.1, max_it: int = 8, order: int = 2):
+    def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
+                 rate: float = 0.03, max_it: int = 8, order: int = 2):
         super().__init__(params, rho_inf, solver=solver)
         self.tol, self.rate, self.max_it, self.order = tol, rate, max_it, order
         self._lu = {}  # (scheme, h) -> LU factors of J
-        self.eta = 1.0  # Hairer's eta = theta / (1 - theta), carried from step to step
         self.iterations = self.factorisations = self.steps = 0
-        self._tension = self.solver.probes.forms["tension0"]
+        self._tension_map()
         self._J = compat.create_matrix(self.form.J)
         self._getrs = scipy.linalg.get_lapack_funcs("getrs", (np.zeros(1),))
 
@@ -84,7 +88,8 @@ class ChordAlpha(AlphaMap):
         _, _, _, va, aa = self.newmark(z, u, v, a, h, scheme)
         key = (scheme, h)
         lu = self._lu.get(key)
-        fresh, last, eta = False, None, max(self.eta, 1e-16) ** 0.8
+        fresh, last = False, None
+        noise = ROUNDOFF * max(1.0, abs(z).max())
         x_u, x_v, x_a = form.u.x.array, form.v.x.array, form.a.x.array
         for it in range(1, self.max_it + 1):
             x_u[:] = z
@@ -99,6 +104,12 @@ class ChordAlpha(AlphaMap):
             if not size < math.inf:  # NaN or Inf
                 raise SolverError(f"chord alpha2: the state became NaN or Inf at t = {t:.6g} "
                                   f"(normalised)")
+            if size <= noise:  # at round-off: R(z) is at its floor
+                z -= dz
+                va -= sv * dz
+                aa -= sa * dz
+                self.iterations += 1
+                break
             theta = None if last is None else size / last
             if theta is not None and theta >= 1.0:  # diverging: back, and a fresh Jacobian
                 if fresh:
@@ -113,13 +124,15 @@ class ChordAlpha(AlphaMap):
             aa -= sa * dz
             self.iterations += 1
             if theta is not None:
-                eta = self.eta = theta / (1.0 - theta)
-                if theta > self.rate:  # slow: a fresh LU at the next use
+                eta = theta / (1.0 - theta)  # |z - z*| <= eta |dz| while theta holds
+                if eta * size <= self.tol:
+                    if theta > self.rate:  # slow: a fresh LU at the next step
+                        self._lu.pop(key, None)
+                    break
+                if theta > self.rate:  # slow: a fresh LU now
                     self._lu.pop(key, None)
-                    lu = None if eta * size > self.tol else lu
-                    fresh = False
-            if eta * size <= self.tol:
-                break
+                    lu, fresh = None, False
+                    continue
             last = size
         else:
             raise SolverError(
@@ -127,8 +140,8 @@ class ChordAlpha(AlphaMap):
                 f"(normalised; last |dz| = {size:.3g}, tol {self.tol:g}); try a smaller step "
                 f"(time.dt_s)")
         self.steps += 1
-        u1, v1, a1, _, _ = self.newmark(z, u, v, a, h, scheme)
-        return u1, v1, a1, z
+        am, af = scheme[:2]  # newmark's U_a, V_a, A_a solved for the step's end
+        return u + (z - u) / af, v + (va - v) / af, a + (aa - a) / am, z
 
     def start(self, t, h, u, v):
         """A_0 as TSALPHA2's restart: two half steps of the scheme (1, 1, 1, 1/2)."""
@@ -138,10 +151,24 @@ class ChordAlpha(AlphaMap):
                                        BACKWARD_EULER)
         return (-3.0 * v + 4.0 * v1 - v2) / (h / 2)
 
+    def _tension_map(self):
+        """T(0) = sigma (|r'(0)| - 1) (29) with r'(0) = D U linear in the dofs: D's
+        rows assembled once, checked against the probe's point form."""
+        rod, u = self.solver.rod, self.form.u
+        s = ufl.SpatialCoordinate(rod.mesh)[0]
+        r = ufl.split(u)[0]
+        rows = [dolfinx.fem.form(ufl.derivative(kinematics.d(r)[i] * (1 - s) * ufl.ds(domain=rod.mesh),
+                                                u, rod.test)) for i in range(3)]
+        self._D = np.array([compat.assemble_vector_array(np.zeros(self.n), f) for f in rows])
+        self._sigma = float(self.solver.q.sigma)
+        probe = self.solver.probes.value("tension0")
+        if not abs(self.tension0(u.x.array) - probe) <= 1e-9 * abs(probe):
+            raise RuntimeError(f"chord alpha2: T(0) from r'(0) = D U ({self.tension0(u.x.array)}) "
+                               f"is not the probe's ({probe})")
+
     def tension0(self, u) -> float:
-        """T(0) (normalised) of the configuration u: the probe's point form (one rank)."""
-        self.form.u.x.array[:] = u
-        return dolfinx.fem.assemble_scalar(self._tension)
+        """T(0) (normalised) of the configuration u (one rank): Eq. (29) at s = 0."""
+        return self._sigma * (math.sqrt(float(np.dot(d := self._D @ u, d))) - 1.0)
 
     def run(self, t0, h, steps, u, v):
         """``steps`` steps of h from (u, v) at t0, with alpha2's start: the final (u, v)

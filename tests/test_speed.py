@@ -73,3 +73,60 @@ def test_reused_jacobian_gives_the_same_tension_max():
     assert solver.convergence.rebuilds < solver.steps / 10
     assert solver.newton_iterations > full_solver.newton_iterations
     assert math.isfinite(reused.tension_max_N) and not hasattr(full_solver.convergence, "rebuilds")
+
+
+def _chord_against_ts(rho_inf=None, steps=200):
+    """200 steps at 10 Hz (N = 4, p = 3, dt = 0.5 ms) from the stationary state:
+    PETSc TSALPHA2 with full Newton (rtol 1e-8) and the chord step loop (tol 1e-12)."""
+    import numpy as np
+    from rawehelix.solvers.chord import ChordAlpha
+    from rawehelix.solvers.forced import ChordBackend
+    params = scene.load("mobile_end", elements=4, degree=3)
+    out = []
+    for backend in (FEBackend(params, MPI.COMM_SELF, options=FEBackend.FULL_NEWTON),
+                    ChordBackend(params, MPI.COMM_SELF, tol=1e-12)):
+        if rho_inf is not None and isinstance(backend, ChordBackend):  # a wrong scheme, on purpose
+            backend.stepper = ChordAlpha(params, rho_inf, solver=backend.solver, tol=1e-12)
+        backend.set_frequency(10.0, 0.0)
+        t1 = steps * backend.dt
+        state, tension = backend.advance(backend.stationary(), 0.0, t1,
+                                         np.linspace(0.0, t1, steps + 1))
+        out.append((state, tension, backend))
+    return out
+
+
+def test_chord_step_loop_equals_petsc_alpha2():
+    """The chord stepper (solvers/chord.py) is TSALPHA2, start included: over 200
+    steps its state and T(0) at every step equal PETSc's to the Newton
+    tolerance (measured |dU| 2e-10, T 2e-7 relative); a scheme with another
+    rho_inf (0.8) is 100x further off, so the comparison can tell them apart.
+    The LU is held across steps: far fewer factorisations than steps."""
+    import numpy as np
+    (ts, T_ts, _), (chord, T_chord, backend) = _chord_against_ts()
+    assert np.max(np.abs(chord.w - ts.w)) <= 1e-8
+    assert np.max(np.abs(chord.w_t - ts.w_t)) <= 1e-5 * np.max(np.abs(ts.w_t))
+    assert np.max(np.abs(T_chord - T_ts)) <= 1e-5 * np.max(np.abs(T_ts))
+    assert chord.offset == ts.offset and chord.t == pytest.approx(ts.t, rel=1e-14)
+    s = backend.stepper
+    assert s.steps == 202 and s.factorisations < 20 and s.iterations <= 6 * s.steps
+    (_, T_ts, _), (_, T_wrong, _) = _chord_against_ts(rho_inf=0.8)
+    assert np.max(np.abs(T_wrong - T_ts)) > 1e-3 * np.max(np.abs(T_ts))
+
+
+def test_chord_step_that_does_not_converge_raises():
+    """A step that cannot meet the stopping test raises SolverError (one
+    iteration allowed: the contraction is never measured), and so does a
+    non-finite state: no silent wrong numbers."""
+    import numpy as np
+    from rawehelix.solvers.forced import ChordBackend
+    from rawehelix.solvers.snes import SolverError
+    params = scene.load("mobile_end", elements=4, degree=3)
+    backend = ChordBackend(params, MPI.COMM_SELF, max_it=1)
+    backend.set_frequency(10.0, 0.0)
+    with pytest.raises(SolverError, match="no convergence in 1 iterations"):
+        backend.advance(backend.stationary(), 0.0, 10 * backend.dt, [backend.dt])
+    backend.stepper.max_it = 8
+    bad = backend.stationary().copy()
+    bad.w[5] = np.nan
+    with pytest.raises(SolverError, match="NaN"):
+        backend.advance(bad, 0.0, 10 * backend.dt, [backend.dt])
