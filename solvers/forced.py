@@ -89,7 +89,10 @@ class FEBackend:
 class ChordBackend(FEBackend):
     """FEBackend's periods with :class:`~rawehelix.solvers.chord.ChordAlpha`'s
     step loop instead of PETSc TS: the same scheme, start and uniform steps, so
-    the same numbers to the Newton tolerance; one rank, dense LU (small N)."""
+    the same numbers to the Newton tolerance; one rank, dense LU (small N).
+    Where the TS path cuts a step after a Newton failure, this one raises
+    SolverError.  Not the sweep's backend: it is 1.8x faster, not the 5x of
+    issue 12 (docs/speed.md, section 5); ``chord`` options go to ChordAlpha."""
 
     def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None,
                  **chord):

@@ -188,8 +188,8 @@ class AlphaMap:
         am, af, g, b = scheme or self.scheme
         return g / (b * h), am / (af * b * h * h)
 
-    def _jacobian(self, Fu, Fv, Fa, h, scheme=None):
-        sv, sa = self.shifts(h, scheme)
+    def _jacobian(self, Fu, Fv, Fa, h):
+        sv, sa = self.shifts(h)
         J = Fu + sv * Fv + sa * Fa
         J[self.bc_dofs, :] = 0.0
         J[self.bc_dofs, self.bc_dofs] = 1.0
