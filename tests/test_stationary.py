@@ -175,11 +175,14 @@ def test_stationary_command_says_which_model(tmp_path):
     s = stationary.compute(table2(8), MPI.COMM_SELF).summary
     assert s["model"].startswith("planar")
     s = stationary.compute(table2(8).replace(model={"reduction": "off"}), MPI.COMM_SELF).summary
-    assert s["model"] == "full (r, alpha); terms: gravity, drag, bending"
+    assert s["model"] == "full (r, alpha); terms: gravity, drag, bending; kinematics: paper"
     s = stationary.compute(table2(8).replace(model={"reduction": "off", "twist": False,
                                                     "drag": False}), MPI.COMM_SELF).summary
     assert s["model"].startswith("centre line only (model.twist = false")
-    assert s["model"].endswith("terms: gravity, bending")
+    assert s["model"].endswith("terms: gravity, bending; kinematics: paper")
+    s = stationary.compute(table2(8).replace(model={"kinematics": "extensible"}),
+                           MPI.COMM_SELF).summary
+    assert s["model"].startswith("planar") and s["model"].endswith("kinematics: extensible")
 
 
 def test_solver_defaults_do_not_leak_into_the_options_database():
