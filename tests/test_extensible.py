@@ -179,3 +179,19 @@ def test_residual_is_the_variation_of_the_energy():
 def test_refused(sections):
     with pytest.raises(ParameterError, match="model.kinematics"):
         scene.load("stationary_table2").replace(**sections)
+
+
+@pytest.mark.mpi
+def test_same_on_one_and_two_ranks():
+    """The facet terms on t are assembled across ranks: the distributed
+    stationary state and spectrum equal the serial ones (COMM_SELF on each rank)."""
+    params = table2("extensible", reduction="off")
+    serial = StationarySolver(params, MPI.COMM_SELF).solve()
+    world = StationarySolver(params, MPI.COMM_WORLD).solve()
+    lam = [[abs(m.eigenvalue) for m in ModalSolver.from_stationary(params, comm).solve()][:8]
+           for comm in (MPI.COMM_SELF, MPI.COMM_WORLD)]
+    if MPI.COMM_WORLD.rank == 0:
+        assert np.max(np.abs(serial.centre_line - world.centre_line)) < 1e-10
+        # T = sigma (|r'| - 1) with sigma = 7275: 1e-10 in r' is 1e-6 in T
+        assert np.max(np.abs(serial.tension - world.tension)) < 1e-7 * np.max(serial.tension)
+        assert np.allclose(lam[0][1:], lam[1][1:], rtol=1e-8)  # [0]: the rigid rotation
