@@ -17,6 +17,11 @@ curvature kappa, and B is replaced by the mixed form of
 :mod:`rawehelix.forms.mixed` (second order, kappa = 0 at the ends
 essential); the functions below see it as ``kappa`` (and its test ``eta``).
 
+With ``model.kinematics = "extensible"`` the centre-line forces (F_NL and
+B) are instead the variation of the extensible rod's stored energy,
+:mod:`rawehelix.forms.extensible`; :func:`elastic_residual` is the one place
+that chooses.
+
 No solver code here: functions take UFL objects and numbers (or constants)
 and return UFL.
 """
