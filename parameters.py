@@ -131,6 +131,7 @@ class Controller:
 
 
 GAMMA_TREATMENTS = ("regularised", "off")
+KINEMATICS = ("paper", "extensible")  # forms/rod.py (Eqs. 30-33), forms/extensible.py
 
 
 @dataclass(frozen=True)
@@ -154,6 +155,10 @@ class Model:
     # rod for a planar, torque-free stationary state); "off": always the full one
     reduction: str = "auto"
     gamma_eps: float = 1.0e-3  # regularisation of |r''|^2 in gamma (normalised curvature)
+    # "paper": the forces of Eqs. (30)-(33) (bending acts on the whole r, the
+    # tension force is T r'); "extensible": stretch and bending from the stored
+    # energy 1/2 EA eps^2 + 1/2 EI |t'|^2, t = r'/|r'| (forms/extensible.py)
+    kinematics: str = "paper"
 
     def describe(self, planar: bool = False) -> str:
         """The model that runs, for summary.json: reduction and the terms switched on."""
@@ -167,15 +172,23 @@ class Model:
         terms = [name for name in ("gravity", "drag", "bending") if getattr(self, name)]
         if self.gamma != "off" and self.twist and not planar:
             terms.append(f"gamma ({self.gamma})")
-        return f"{head}; terms: {', '.join(terms) or 'tension only'}"
+        return (f"{head}; terms: {', '.join(terms) or 'tension only'}; "
+                f"kinematics: {self.kinematics}")
 
     def __post_init__(self):
         if self.gamma not in GAMMA_TREATMENTS:
             raise ParameterError("model.gamma", self.gamma, f"must be one of {GAMMA_TREATMENTS}")
         if self.reduction not in ("auto", "off"):
             raise ParameterError("model.reduction", self.reduction, "must be one of ('auto', 'off')")
+        if self.kinematics not in KINEMATICS:
+            raise ParameterError("model.kinematics", self.kinematics, f"must be one of {KINEMATICS}")
         _positive("model", self, "gamma_eps")
 
+
+#: model switches added after results were stored (sweep checkpoints, the
+#: convergence cache): left out of :meth:`Parameters.as_dict` at their
+#: defaults, so that those results keep their fingerprints
+LATER_MODEL_SWITCHES = {"kinematics": "paper"}
 
 SCHEMES = ("fe", "spline")
 MESHES = ("uniform", "graded")
@@ -300,6 +313,11 @@ class Parameters:
                                      "torque is carried by the twist, Eq. (31)")
             if self.discretisation.scheme != "fe":
                 raise ParameterError("model.twist", False, "is implemented by the FE scheme only")
+        if self.model.kinematics == "extensible" and (
+                self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"):
+            raise ParameterError("model.kinematics", "extensible",
+                                 "is implemented by the FE scheme with discretisation.bending "
+                                 "= 'ip' only (forms/extensible.py)")
 
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:
@@ -315,6 +333,9 @@ class Parameters:
         data = dataclasses.asdict(self)
         data.pop("name")
         data.pop("title")
+        for key, default in LATER_MODEL_SWITCHES.items():  # fingerprints stored before them
+            if data["model"][key] == default:
+                data["model"].pop(key)
         return data
 
     def normalised(self) -> "Normalised":

@@ -23,6 +23,11 @@ gravity +k_E has the potential -k_E . r.  What is *not* the variation of E:
 With the mixed bending form (:mod:`rawehelix.forms.mixed`) mu/2 B(r, r) is
 mu/2 int |kappa|^2, and every r'' is the curvature field ``kappa``.
 
+With ``model.kinematics = "extensible"`` the stretch and bending parts of U
+are the stored energy of :mod:`rawehelix.forms.extensible`, whose variation is
+that model's residual; the one non-variational part of its F_NL is then the
+twist coupling beta tau (r' x r'').
+
 All normalised: energies in units of M g L0.
 """
 
@@ -31,8 +36,8 @@ from __future__ import annotations
 import ufl
 
 from rawehelix.forms.kinematics import d, internal_force, stretch, tension, twist
-from rawehelix.forms import mixed
-from rawehelix.forms.rod import K_E, Coefficients, bending
+from rawehelix.forms import extensible, mixed
+from rawehelix.forms.rod import K_E, Coefficients, bending, ip_penalty
 
 
 def kinetic(r_t, alpha_t, c: Coefficients, dx):
@@ -44,8 +49,12 @@ def potential(r, alpha, c: Coefficients, degree: int, penalty, measures, kappa=N
     """U = int sigma (l^3/3 - l^2/2) + mu/2 B(r, r) + beta/2 int tau^2 - int k_E.r, l = |r'|;
     B(r, r) = int |kappa|^2 with the curvature field ``kappa``."""
     dx, dS, _ = measures
-    lam = stretch(r)
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
+    if c.kinematics == "extensible":
+        return ((0.5 * c.beta * tau**2 - c.gravity * ufl.dot(K_E, r)) * dx
+                + extensible.stored_energy(r, c.sigma, c.bending * c.mu,
+                                           ip_penalty(degree, penalty, dS), dx, dS))
+    lam = stretch(r)
     bend = (0.5 * bending(r, r, degree, penalty, dx, dS) if kappa is None
             else mixed.energy(kappa, dx))
     return ((c.sigma * (lam**3 / 3 - lam**2 / 2) + 0.5 * c.beta * tau**2
@@ -58,6 +67,9 @@ def non_variational_power(r, alpha, r_t, c: Coefficients, dx, kappa=None):
     P = int (T r' - F_NL) . r_t' = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t',
     with F_NL of Eq. (32) and its variational part T r'."""
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    f = (tension(r, c.sigma) * d(r)
-         - internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa))  # (29), (32)
+    if c.kinematics == "extensible":
+        f = -extensible.twist_coupling(r, tau, c.beta)
+    else:
+        f = (tension(r, c.sigma) * d(r)
+             - internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa))  # (29), (32)
     return ufl.inner(f, d(r_t)) * dx

@@ -17,6 +17,11 @@ curvature kappa, and B is replaced by the mixed form of
 :mod:`rawehelix.forms.mixed` (second order, kappa = 0 at the ends
 essential); the functions below see it as ``kappa`` (and its test ``eta``).
 
+With ``model.kinematics = "extensible"`` the centre-line forces (F_NL and
+B) are instead the variation of the extensible rod's stored energy,
+:mod:`rawehelix.forms.extensible`; :func:`elastic_residual` is the one place
+that chooses.
+
 No solver code here: functions take UFL objects and numbers (or constants)
 and return UFL.
 """
@@ -28,7 +33,7 @@ from typing import Any
 
 import ufl
 
-from rawehelix.forms import mixed
+from rawehelix.forms import extensible, mixed
 from rawehelix.forms.kinematics import d, internal_force, tension, twist
 
 K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
@@ -56,6 +61,7 @@ class Coefficients:
     bending: Any = 1.0
     gamma_eps: Any = 1.0e-3
     gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
+    kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
@@ -67,6 +73,7 @@ class Coefficients:
             gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
             gamma_eps=make(model.gamma_eps),
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
+            kinematics=model.kinematics,
         )
 
 
@@ -107,17 +114,21 @@ def avg_d2(f):
     return 0.5 * (d(f, 2)("+") + d(f, 2)("-"))
 
 
+def ip_penalty(degree: int, penalty, dS):
+    """The interior-penalty factor eta p^2 / h_avg at a node; eta is
+    ``discretisation.penalty``."""
+    h = ufl.CellDiameter(dS.ufl_domain())
+    return penalty * degree**2 / (0.5 * (h("+") + h("-")))
+
+
 def bending(r, v, degree: int, penalty, dx, dS):
     """C0 interior-penalty form of int r''.v'' (the dolfinx biharmonic demo, in 1D).
 
-    The penalty eta p^2 / h_avg scales with the degree and the element size;
-    eta is ``discretisation.penalty``.
+    The penalty eta p^2 / h_avg (:func:`ip_penalty`) scales with the degree
+    and the element size.
     """
-    mesh = dS.ufl_domain()
-    n = ufl.FacetNormal(mesh)
-    h = ufl.CellDiameter(mesh)
-    h_avg = 0.5 * (h("+") + h("-"))
-    alpha_ip = penalty * degree**2 / h_avg
+    n = ufl.FacetNormal(dS.ufl_domain())
+    alpha_ip = ip_penalty(degree, penalty, dS)
     return (ufl.inner(d(r, 2), d(v, 2)) * dx
             - ufl.inner(avg_d2(r), jump_d(v, n)) * dS
             - ufl.inner(jump_d(r, n), avg_d2(v)) * dS
@@ -142,16 +153,21 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
                      kappa=None, eta=None):
     """Internal forces and end torques of Eqs. (30)-(31): everything but inertia and loads.
 
-    ``kappa``, ``eta``: the curvature field and its test (mixed bending form)."""
+    ``kappa``, ``eta``: the curvature field and its test (mixed bending form).
+    ``c.kinematics = "extensible"``: the centre-line forces are the variation
+    of the extensible rod's stored energy, :mod:`rawehelix.forms.extensible`
+    (IP bending only; the twist terms are the same)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    F_NL = internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa)  # (32)
-    F = ufl.inner(F_NL, d(v)) * dx
-    if kappa is None:
-        F += c.bending * c.mu * bending(r, v, degree, penalty, dx, dS)  # (33)
+    if c.kinematics == "extensible":  # stretch and bending from the stored energy
+        F = extensible.centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
+    elif kappa is None:
+        F = (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta), d(v)) * dx  # (32)
+             + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS))  # (33)
     else:  # (33) and kappa = r'' with kappa = 0 at the ends (37), forms/mixed.py
-        F += (c.bending * c.mu * mixed.bending_force(kappa, v, dx)
-              - c.mu * mixed.curvature_equation(r, kappa, eta, dx))
+        F = (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa), d(v)) * dx
+             + c.bending * c.mu * mixed.bending_force(kappa, v, dx)
+             - c.mu * mixed.curvature_equation(r, kappa, eta, dx))
     if psi is None:  # the planar model: no twist equation
         return F
     return (F + c.delta * tau * d(psi) * dx  # (31)

@@ -22,6 +22,10 @@ the full state at every interior breakpoint, the conditions are continuity at
 the breakpoints and the four conditions at s~ = 1.  With one segment this is
 the plain shooting of the paper.
 
+With ``model.kinematics = "extensible"`` (forms/extensible.py) the rod is
+Antman's extensible elastica instead; :func:`solve_extensible` shoots its
+planar equilibrium (see there).
+
 This module deliberately shares no code with the finite-element path: it uses
 numpy, scipy and the (numpy-only) parameter module, nothing else.  Everything
 is normalised as in Eqs. (25)-(29): lengths by L0, forces by M g.
@@ -38,7 +42,8 @@ from scipy.optimize import root
 
 from rawehelix.parameters import Normalised
 
-__all__ = ["ShootingSolution", "solve", "rhs", "load_vector", "default_segments"]
+__all__ = ["ShootingSolution", "solve", "rhs", "load_vector", "default_segments",
+           "ExtensibleSolution", "solve_extensible"]
 
 
 def load_vector(normalised: Normalised) -> np.ndarray:
@@ -225,3 +230,87 @@ def solve(normalised: Normalised, rtol: float = 1e-11, atol: float = 1e-13,
              for k in range(m)]
     return ShootingSolution(normalised=normalised, initial_state=starts[0],
                             boundary_residual=mismatch, breakpoints=nodes, _dense=dense)
+
+
+# -- extensible kinematics (model.kinematics = "extensible") -----------------------
+
+@dataclass
+class ExtensibleSolution:
+    """Stationary centre line of the extensible elastica; all quantities normalised."""
+
+    normalised: Normalised
+    resultant0: np.ndarray  # N(0), the (x, z) force at s~ = 0
+    boundary_residual: float
+    _dense: object = field(repr=False, default=None)  # OdeSolution of (x, z, theta, m)
+
+    def centre_line(self, s) -> np.ndarray:
+        """Normalised positions [x, 0, z], shape (n, 3)."""
+        y = self._dense(np.atleast_1d(np.asarray(s, dtype=float)))
+        return np.column_stack([y[0], 0 * y[0], y[1]])
+
+    def tension(self, s) -> np.ndarray:
+        """T = N.t = sigma (|r'| - 1), normalised."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        theta = self._dense(s)[2]
+        N = self.resultant0[:, None] - np.outer(load_vector(self.normalised), s)
+        return N[0] * np.cos(theta) + N[1] * np.sin(theta)
+
+
+def extensible_rhs(normalised: Normalised, resultant0):
+    """The planar extensible elastica as f(s, y), y = (x, z, theta, m).
+
+    With r' = lambda (cos theta, sin theta) = lambda t, the stored energy
+    sigma/2 (lambda - 1)^2 + mu/2 theta'^2 per unstretched length (kappa =
+    |t'| = |theta'|, forms/extensible.py) and the load q (:func:`load_vector`),
+    the stationarity of int [W - q.r + N.(r' - lambda t)] gives
+
+        N' = -q                      (so N = N(0) - q s: the force resultant)
+        sigma (lambda - 1) = N.t     (the tension law, Eq. 29)
+        mu theta'' = -lambda N.n,    n = (-sin theta, cos theta)  (moment balance)
+
+    and the natural end conditions m = mu theta' = 0 (zero moment) at s = 0, 1."""
+    sigma, mu = normalised.sigma, _bending_modulus(normalised)
+    q = load_vector(normalised)
+    N0 = np.asarray(resultant0, dtype=float)
+
+    def f(s, y):
+        theta, m = y[2], y[3]
+        c, sn = np.cos(theta), np.sin(theta)
+        Nx, Nz = N0[0] - q[0] * s, N0[1] - q[1] * s
+        lam = 1.0 + (Nx * c + Nz * sn) / sigma
+        return np.array([lam * c, lam * sn, m / mu, -lam * (-Nx * sn + Nz * c)])
+
+    return f
+
+
+def solve_extensible(normalised: Normalised, rtol: float = 1e-11, atol: float = 1e-13,
+                     tol: float = 1e-10) -> ExtensibleSolution:
+    """Shoot the planar extensible elastica (:func:`extensible_rhs`) from s~ = 0,
+    where r = 0 (35) and m = 0, for the unknowns (N(0), theta(0)), to r(1) =
+    the top of Eq. (66) and m(1) = 0.  One segment suffices: with the stretch
+    algebraic there is no axial mode, and the bending boundary layers grow only
+    like exp(sqrt(T/mu) s~) (e^2 for Table 2).
+
+    Raises RuntimeError if the conditions at s~ = 1 are not met to ``tol``."""
+    q = normalised
+    target = _top_conditions(q)
+    chord = math.hypot(*target)
+    t0 = target / chord
+    u0 = np.array([*(q.sigma * (chord - 1) * t0 + 0.5 * load_vector(q)),
+                   math.atan2(t0[1], t0[0])])
+
+    def end_state(u, dense=False):
+        f = extensible_rhs(q, u[:2])
+        return _integrate(f, 0.0, 1.0, np.array([0.0, 0.0, u[2], 0.0]), rtol, atol, dense)
+
+    def residual(u):
+        y1 = end_state(u).y[:, -1]
+        return np.array([y1[0] - target[0], y1[1] - target[1], y1[3]])
+
+    sol = root(residual, u0, method="hybr", options={"xtol": 1e-14})
+    mismatch = float(np.max(np.abs(residual(sol.x))))
+    if not np.isfinite(mismatch) or mismatch > tol:
+        raise RuntimeError(f"extensible shooting did not converge: boundary mismatch "
+                           f"{mismatch:.3e} > {tol:.1e} ({sol.message})")
+    return ExtensibleSolution(normalised=q, resultant0=sol.x[:2], boundary_residual=mismatch,
+                              _dense=end_state(sol.x, dense=True).sol)

@@ -160,12 +160,12 @@ def test_slack_is_detected():
         StationarySolver(params, MPI.COMM_SELF).solve()
 
 
-@pytest.mark.parametrize("N", (8, 64))
-def test_planar_reduction_is_exact(N):
+@pytest.mark.parametrize("N,kinematics", [(8, "paper"), (64, "paper"), (8, "extensible")])
+def test_planar_reduction_is_exact(N, kinematics):
     """The reduced (x, z) model of a planar, torque-free scene gives the full
-    model's stationary state to round-off."""
-    full = StationarySolver(table2(N), MPI.COMM_SELF).solve()
-    planar = StationarySolver(table2(N), MPI.COMM_SELF, planar=True).solve()
+    model's stationary state to round-off (with either kinematics)."""
+    full = StationarySolver(table2(N, kinematics=kinematics), MPI.COMM_SELF).solve()
+    planar = StationarySolver(table2(N, kinematics=kinematics), MPI.COMM_SELF, planar=True).solve()
     assert np.max(np.abs(full.centre_line - planar.centre_line)) < 1e-10
     assert np.max(np.abs(full.tension - planar.tension)) < 1e-7
 
@@ -175,11 +175,14 @@ def test_stationary_command_says_which_model(tmp_path):
     s = stationary.compute(table2(8), MPI.COMM_SELF).summary
     assert s["model"].startswith("planar")
     s = stationary.compute(table2(8).replace(model={"reduction": "off"}), MPI.COMM_SELF).summary
-    assert s["model"] == "full (r, alpha); terms: gravity, drag, bending"
+    assert s["model"] == "full (r, alpha); terms: gravity, drag, bending; kinematics: paper"
     s = stationary.compute(table2(8).replace(model={"reduction": "off", "twist": False,
                                                     "drag": False}), MPI.COMM_SELF).summary
     assert s["model"].startswith("centre line only (model.twist = false")
-    assert s["model"].endswith("terms: gravity, bending")
+    assert s["model"].endswith("terms: gravity, bending; kinematics: paper")
+    s = stationary.compute(table2(8).replace(model={"kinematics": "extensible"}),
+                           MPI.COMM_SELF).summary
+    assert s["model"].startswith("planar") and s["model"].endswith("kinematics: extensible")
 
 
 def test_solver_defaults_do_not_leak_into_the_options_database():

@@ -1,0 +1,114 @@
+"""Extensible kinematics (``model.kinematics = "extensible"``): elastic forces from a stored energy.
+
+The paper's Eq. (23) applies -EI r'''' to the whole vector r, and its tension
+force T r' uses the non-unit r'.  Along the chord an axial motion u then feels
+the bending stiffness mu u'''' and the axial stiffness sigma (1 + 2 eps0)
+(forms/rod.py, solvers/analytic.py).  Here the centre-line forces are instead
+the variation of the stored energy of an extensible, unshearable rod
+(Antman, *Nonlinear Problems of Elasticity*, 2005, Ch. 8), normalised as in
+:mod:`rawehelix.forms.energy` (energies in units of M g L0):
+
+    U = int sigma/2 eps^2 + mu/2 |t'|^2 ds,   eps = |r'| - 1,  t = r'/|r'|,
+
+per *unstretched* (material) length s, with kappa = |t'| = |dt/ds| the
+material curvature.  Why material: it is the strain measure of the
+reference configuration (the one conjugate to the bending moment in the
+Reissner-Antman rod, so m = EI kappa with the EI of the lab tests, which
+measure moment against curvature per unstretched length at strains of 1e-3);
+the per-stretched-length curvature |t'|/|r'| integrated over the stretched
+length would put EI/|r'| in place of EI, a change of O(eps) = 5e-3 that no
+measurement of Table 1 resolves.  The energy is quadratic in t', so at eps = 0
+it is the paper's mu/2 |r''|^2 restricted to lateral motions: with it
+
+- the axial force is d/dr' (sigma eps^2/2) = T t, T = sigma (|r'| - 1) (29),
+  so an axial motion has stiffness sigma: the fixed-fixed bar's n pi sqrt(sigma);
+- the bending acts on t only: a motion along t changes no curvature.
+
+The twist terms are the paper's: (31) (the variation of beta/2 int tau^2 with
+respect to alpha, scaled by delta/beta as in forms/energy.py) and the coupling
+beta tau (r' x r'') of F_NL, Eq. (32), in the centre-line equation: the shear
+force of the twisting moment (Kirchhoff's n = T t + GJ tau t x t' + ...),
+which with ``model.gamma = "off"`` (tau = alpha') has no energy partner; it is
+kept so that the two kinematics differ in the stretch and the bending only.
+The paper's -mu kappa^2 r' (the inextensibility's part of F_NL) has no place
+here: the variation of U takes its role.
+
+Discretisation: C0 Lagrange r, so t = r'/|r'| jumps at the nodes.  The
+interior-penalty energy of the dolfinx biharmonic demo (forms/rod.py::bending,
+whose symmetric form is the variation of 1/2 B(r, r) with [[r']] and {{r''}})
+is written on the unit tangent instead:
+
+    U_b = mu [ int 1/2 |t'|^2 dx - sum_nodes {{t'}}.[[t]] + alpha_ip/2 sum_nodes |[[t]]|^2 ].
+
+The exact solution has [[t]] = 0, so the energy and its variation are
+consistent (the -{{t'}}.[[dt]] term cancels the node terms of integrating
+int t'.dt' by parts), symmetric, and coercive on the jumps for the same
+penalty alpha_ip = eta p^2 / h as the paper's form (they agree for |r'| = 1
+and lateral jumps).  The jump is taken of t, not of r': a stretch jump
+[[|r'|]] carries no bending energy, as it must.  No boundary terms: the ends'
+t' = 0 (zero moment, the extensible form of r'' = 0, Eq. 37) is natural, as
+in the paper's form.  The mixed form (forms/mixed.py) would need a Lagrange
+multiplier for kappa = r'' under a nonlinear energy; it is not offered
+(parameters.py refuses ``discretisation.bending = "mixed"``).
+
+The residual is the Gateaux derivative d/de U(r + e v) at e = 0, taken by UFL
+(:func:`variation`), so it is the exact variation of U on the discrete space
+and its Jacobian (ufl.derivative of the residual, as everywhere) the exact
+second variation: residual, Jacobian and energy agree by construction.
+"""
+
+from __future__ import annotations
+
+import ufl
+from ufl.algorithms.apply_algebra_lowering import apply_algebra_lowering
+from ufl.algorithms.apply_derivatives import apply_derivatives
+from ufl.algorithms.map_integrands import map_integrands
+from ufl.algorithms.transformer import strip_variables
+
+from rawehelix.forms.kinematics import d, stretch
+
+
+def unit_tangent(r):
+    """t = r'/|r'|."""
+    return d(r) / stretch(r)
+
+
+def strain(r):
+    """eps = |r'| - 1, the axial strain (T = sigma eps, Eq. 29)."""
+    return stretch(r) - 1
+
+
+def stored_energy(r, sigma, mu, alpha_ip, dx, dS):
+    """U = int sigma/2 eps^2 + mu U_b(t), U_b the interior-penalty energy of
+    1/2 int |t'|^2 on the unit tangent (see above); ``alpha_ip`` the penalty
+    eta p^2 / h_avg (forms/rod.py::ip_penalty), ``mu`` includes the bending switch."""
+    n = ufl.FacetNormal(dS.ufl_domain())
+    t = unit_tangent(r)
+    jump_t = t("+") * n("+")[0] + t("-") * n("-")[0]  # [[t]] at a node
+    avg_dt = 0.5 * (d(t)("+") + d(t)("-"))  # {{t'}}
+    return ((0.5 * sigma * strain(r)**2 + 0.5 * mu * ufl.dot(d(t), d(t))) * dx
+            + mu * (-ufl.dot(avg_dt, jump_t) + 0.5 * alpha_ip * ufl.dot(jump_t, jump_t)) * dS)
+
+
+def variation(energy, r, v, domain):
+    """d/de energy(r + e v) at e = 0: the first variation of ``energy`` (a
+    callable r -> Form) in the direction v, for any UFL r and v (split fields
+    of a mixed space, or the planar embedding).  e is a placeholder constant,
+    replaced by 0 once UFL has differentiated (which removes every e v)."""
+    e0 = ufl.Constant(domain)
+    e = ufl.variable(e0)
+    dE = apply_derivatives(apply_algebra_lowering(ufl.diff(energy(r + e * v), e)))
+    return ufl.replace(map_integrands(strip_variables, dE), {e0: ufl.as_ufl(0.0)})
+
+
+def twist_coupling(r, tau, beta):
+    """beta tau (r' x r''): the twisting moment's shear force in F_NL, Eq. (32) (see above)."""
+    return beta * tau * ufl.cross(d(r), d(r, 2))
+
+
+def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS):
+    """delta U(r; v) + int beta tau (r' x r'').v': the elastic forces of the
+    centre-line equation (30) with extensible kinematics."""
+    def energy(x):
+        return stored_energy(x, c.sigma, c.bending * c.mu, alpha_ip, dx, dS)
+    return variation(energy, r, v, dx.ufl_domain()) + ufl.inner(twist_coupling(r, tau, c.beta), d(v)) * dx
