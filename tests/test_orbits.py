@@ -117,3 +117,144 @@ def test_floquet_multipliers_are_the_modes_exponentials(dt_s):
     torsional_17 = [e for f, e in errors if 16.5 < f < 18.0]
     limit = 4e-3 if dt_s == 5e-4 else 4e-3 / 3.0  # ~ /4 at half the step, with a margin
     assert torsional_17 and torsional_17[0] <= limit
+
+
+def test_the_branch_resumes_without_recomputing(tmp_path):
+    """`-o DIR` stores every point as it is found: a trace stopped after 2
+    points and rerun continues from the stored state, computes every point once
+    (computed.log) and ends with exactly the points of an uninterrupted trace;
+    a directory of another branch is refused."""
+    from rawehelix.studies import orbits
+
+    params = rh.load_scene("mobile_end", elements=4, degree=3, overrides=SCENE)
+    cut, whole = tmp_path / "cut", tmp_path / "whole"
+    stopped = orbits.compute(params, 9.0, 9.2, outdir=cut, max_points=2)
+    assert len(stopped.branch) == 2
+    resumed = orbits.compute(params, 9.0, 9.2, outdir=cut)
+    reference = orbits.compute(params, 9.0, 9.2, outdir=whole)
+    keys = ("f1_Hz", "tension_max_N", "tension_min_N", "max_multiplier", "newton_iterations")
+    assert len(resumed.branch) == len(reference.branch) >= 4
+    assert ([[p[k] for k in keys] for p in resumed.branch]
+            == [[p[k] for k in keys] for p in reference.branch])
+    log = (cut / "window0" / "computed.log").read_text().split("\n")[:-1]
+    assert [int(line.split()[0]) for line in log] == list(range(len(reference.branch)))
+    again = orbits.compute(params, 9.0, 9.2, outdir=cut)  # nothing left to compute
+    assert again.branch == resumed.branch
+    assert len((cut / "window0" / "computed.log").read_text().split("\n")[:-1]) == len(log)
+    with pytest.raises(orbits.OrbitsStoreError, match="another branch"):
+        orbits.compute(params, 9.0, 9.3, outdir=cut)
+
+
+@pytest.mark.mpi
+@pytest.mark.slow  # 85 s wall on 2 contended cores
+def test_ranks_trace_their_own_windows():
+    """Under mpirun -n 2: each rank traces one half of 9.0:9.4 Hz; rank 0's
+    points are those of a serial trace from 9.0 Hz (the same path), the two
+    halves meet on the same branch at 9.2 Hz (T max from both sides within
+    5e-3), and a failure on one rank raises on every rank with its message."""
+    from mpi4py import MPI
+
+    from rawehelix.solvers.snes import SolverError
+    from rawehelix.studies import orbits
+
+    comm = MPI.COMM_WORLD
+    if comm.size != 2:
+        pytest.skip("splits the window over 2 ranks: run under mpirun -n 2")
+    params = rh.load_scene("mobile_end", elements=4, degree=3, overrides=SCENE)
+    world = orbits.compute(params, 9.0, 9.4, comm=comm)
+    n0 = world.windows[0]["points"]
+    assert n0 >= 3 and world.windows[1]["points"] >= 3
+    assert world.branch[n0]["f1_Hz"] == 9.2
+    (junction,) = world.junctions
+    assert junction["same_branch"]
+    assert junction["tension_max_N_left"] == pytest.approx(junction["tension_max_N_right"],
+                                                           rel=5e-3)
+    if comm.rank == 0:
+        serial = orbits.compute(params, 9.0, 9.2, comm=MPI.COMM_SELF)
+        assert ([(p["f1_Hz"], p["tension_max_N"]) for p in serial.branch]
+                == [(p["f1_Hz"], p["tension_max_N"]) for p in world.branch[:n0]])
+
+    def fail_on_rank_1(orbit):
+        if comm.rank == 1:
+            raise SolverError("injected failure")
+
+    with pytest.raises(SolverError, match="rank 1 .*injected failure"):
+        orbits.compute(params, 9.0, 9.4, comm=comm, progress=fail_on_rank_1)
+
+
+@pytest.mark.slow  # ~100 s: 10 + 14 points at N = 4
+def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map):
+    """N = 4, 11.5 -> 12.66 Hz through the primary peak (T max moves by at most
+    5 % between points): the peak found between three points and refined by
+    correctors at the parabola's vertex (measured 12.591 Hz, 562.58 N; the
+    points' own maximum is 562.43 N at 12.574 Hz) agrees with a trace ten times
+    finer (0.5 % and steps <= 0.02 Hz) from the point before it: no point of
+    the finer trace is higher (to 1e-5), its highest point is within 2e-4 of
+    the height and 0.02 Hz, and its own located peak within 1e-5 and 0.01 Hz
+    (the peak is flat: T'' ~ 600 N/Hz^2, so 1e-5 in T is 4e-3 Hz in f1)."""
+    from rawehelix.solvers.continuation import Branch
+
+    m = alpha_map
+    first = m.orbit(m.X_stationary, 11.5, lead_in=5)
+    coarse = Branch(m)
+    points = coarse.trace(first, 12.66)
+    T = np.array([p.tension_max_N for p in points])
+    assert np.all(np.abs(np.diff(T)) <= 0.05 * T[:-1] + 1e-9)  # the stated bound
+    (peak,) = coarse.peaks
+    assert peak["located"] == "refined" and peak["tension_max_N"] > T.max()
+    k = int(np.argmax(T))
+    fine = Branch(m, ds=0.01, ds_max=0.02, tension_step=0.005)
+    fine_points = fine.trace(points[k - 1], points[k + 1].f1_Hz)
+    Tf = np.array([p.tension_max_N for p in fine_points])
+    top = int(np.argmax(Tf))
+    assert Tf.max() <= peak["tension_max_N"] * (1 + 1e-5)
+    assert Tf.max() == pytest.approx(peak["tension_max_N"], rel=2e-4)
+    assert fine_points[top].f1_Hz == pytest.approx(peak["f1_Hz"], abs=0.02)
+    (fine_peak,) = fine.peaks
+    assert fine_peak["tension_max_N"] == pytest.approx(peak["tension_max_N"], rel=1e-5)
+    assert fine_peak["f1_Hz"] == pytest.approx(peak["f1_Hz"], abs=0.01)
+
+
+@pytest.mark.parametrize("kind", ["period_doubling", "neimark_sacker"])
+def test_the_bisection_locates_a_synthetic_crossing(kind):
+    """A synthetic multiplier path over arclength s in (0, 1), f1 = 10 + 0.3 s:
+    a real multiplier -(0.9 + 0.17 s) (period doubling) or a pair
+    (0.8 + 0.34 s) e^{+-1.2 i} (Neimark-Sacker) crosses the unit circle at
+    s* = 1/1.7; a fold's multiplier 1.2 and a stable one 0.3 ride along
+    (they do not count).  The bisection brackets s* to the f1 width 1e-4 Hz."""
+    from rawehelix.solvers.continuation import _unstable, bisect_crossing
+
+    def path(s):
+        if kind == "period_doubling":
+            mu = [-(0.9 + 0.17 * s)]
+        else:
+            mu = list((0.8 + 0.34 * s) * np.exp(np.array([1.2j, -1.2j])))
+        return np.array(mu + [1.2, 0.3], dtype=complex)
+
+    probes = []
+
+    def probe(s):
+        probes.append(s)
+        return 10 + 0.3 * s, path(s), s
+
+    count_a = _unstable(path(0.0))[kind]
+    assert count_a == 0 and _unstable(path(1.0))[kind] >= 1
+    lo, hi, f_lo, f_hi, info, n = bisect_crossing(probe, 1.0, count_a, kind)
+    assert lo < 1 / 1.7 < hi and abs(f_hi - f_lo) <= 1e-4 and info == hi
+    assert n == len(probes) <= 12
+
+
+def test_fold_location_is_the_hermite_extremum():
+    """f1(s) = 12.7 - (s - 0.3)^2 between s = 0 and 0.5 (slopes 0.6 and -0.4):
+    the fold at 12.7 Hz exactly (a parabola is its own Hermite cubic), and the
+    error estimate is the distance to the linear interpolant, 0.06 Hz."""
+    from types import SimpleNamespace
+
+    from rawehelix.solvers.continuation import fold_between
+
+    f = lambda s: 12.7 - (s - 0.3) ** 2  # noqa: E731
+    a, b = (SimpleNamespace(f1_Hz=f(s), tension_max_N=500.0 - 100 * s) for s in (0.0, 0.5))
+    fold = fold_between(a, b, 0.6, -0.4, 0.5)
+    assert fold["f1_Hz"] == pytest.approx(12.7, abs=1e-12)
+    assert fold["f1_error_Hz"] == pytest.approx(0.06, abs=1e-12)
+    assert fold["tension_max_N"] == pytest.approx(470.0)
