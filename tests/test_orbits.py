@@ -182,28 +182,39 @@ def test_ranks_trace_their_own_windows():
         orbits.compute(params, 9.0, 9.4, comm=comm, progress=fail_on_rank_1)
 
 
-@pytest.mark.slow  # ~100 s: 10 + 14 points at N = 4
-def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map):
-    """N = 4, 11.5 -> 12.66 Hz through the primary peak (T max moves by at most
-    5 % between points): the peak found between three points and refined by
-    correctors at the parabola's vertex (measured 12.591 Hz, 562.58 N; the
-    points' own maximum is 562.43 N at 12.574 Hz) agrees with a trace ten times
-    finer (0.5 % and steps <= 0.02 Hz) from the point before it: no point of
-    the finer trace is higher (to 1e-5), its highest point is within 2e-4 of
-    the height and 0.02 Hz, and its own located peak within 1e-5 and 0.01 Hz
-    (the peak is flat: T'' ~ 600 N/Hz^2, so 1e-5 in T is 4e-3 Hz in f1)."""
+@pytest.fixture(scope="module")
+def s_curve(alpha_map):
+    """The N = 4 branch from 11.5 Hz up through the primary peak, the fold at
+    12.70 Hz, down the unstable branch to the fold at 11.97 Hz and up the lower
+    stable branch past 12.9 Hz (49 points, ~110 s)."""
     from rawehelix.solvers.continuation import Branch
 
     m = alpha_map
     first = m.orbit(m.X_stationary, 11.5, lead_in=5)
-    coarse = Branch(m)
-    points = coarse.trace(first, 12.66)
+    branch = Branch(m)
+    branch.trace(first, 12.9)
+    return branch
+
+
+@pytest.mark.slow  # the s_curve and 14 points
+def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map, s_curve):
+    """N = 4, through the primary peak (T max moves by at most 5 % between
+    points): the peak found between three points and refined by correctors at
+    the parabola's vertex (measured 12.591 Hz, 562.58 N; the points' own
+    maximum is 562.43 N at 12.574 Hz) agrees with a trace ten times finer
+    (0.5 % and steps <= 0.02 Hz) from the point before it: no point of the
+    finer trace is higher (to 1e-5), its highest point is within 2e-4 of the
+    height and 0.02 Hz, and its own located peak within 1e-5 and 0.01 Hz (the
+    peak is flat: T'' ~ 600 N/Hz^2, so 1e-5 in T is 4e-3 Hz in f1)."""
+    from rawehelix.solvers.continuation import Branch
+
+    points = s_curve.points
     T = np.array([p.tension_max_N for p in points])
     assert np.all(np.abs(np.diff(T)) <= 0.05 * T[:-1] + 1e-9)  # the stated bound
-    (peak,) = coarse.peaks
+    (peak,) = s_curve.peaks
     assert peak["located"] == "refined" and peak["tension_max_N"] > T.max()
     k = int(np.argmax(T))
-    fine = Branch(m, ds=0.01, ds_max=0.02, tension_step=0.005)
+    fine = Branch(alpha_map, ds=0.01, ds_max=0.02, tension_step=0.005)
     fine_points = fine.trace(points[k - 1], points[k + 1].f1_Hz)
     Tf = np.array([p.tension_max_N for p in fine_points])
     top = int(np.argmax(Tf))
@@ -213,6 +224,50 @@ def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map):
     (fine_peak,) = fine.peaks
     assert fine_peak["tension_max_N"] == pytest.approx(peak["tension_max_N"], rel=1e-5)
     assert fine_peak["f1_Hz"] == pytest.approx(peak["f1_Hz"], abs=0.01)
+
+
+@pytest.mark.slow  # the s_curve and 6 orbits
+def test_folds_and_stability_verdicts_under_refinement(alpha_map, s_curve):
+    """Issue test 5 at N = 4: two folds (12.700 Hz, 539.0 N and 11.972 Hz,
+    211.1 N, each beyond both points of its bracket, error estimates 4.4e-3 /
+    3.5e-4 Hz), and at each the largest multiplier crosses 1 between the same
+    two points.  Three points over 0.05 Hz from the folds - the upper stable
+    branch at its highest point (12.57 Hz, |mu| 0.97294), the unstable branch
+    (12.28 Hz, 1.29593) and the lower stable branch (12.03 Hz) - keep their verdicts when
+    dt is halved (twice the steps per period: |mu| moves by at most 6.3e-4)
+    and when the shooting tolerance is 1e-8 instead of 1e-7 (|mu| moves by
+    < 1e-6); each verdict's margin |(|mu| - 1)| is > 10x those moves."""
+    m, points, folds = alpha_map, s_curve.points, s_curve.folds
+    assert len(folds) == 2
+    upper, lower = folds
+    assert upper["f1_Hz"] == pytest.approx(12.70, abs=0.01) and upper["f1_error_Hz"] < 0.01
+    assert lower["f1_Hz"] == pytest.approx(11.97, abs=0.01) and lower["f1_error_Hz"] < 0.01
+    f = [p.f1_Hz for p in points]
+    at = []  # the index of each fold's first point
+    for fold in folds:
+        k = f.index(fold["bracket_Hz"][0])
+        assert f[k + 1] == fold["bracket_Hz"][1]
+        assert points[k].stable != points[k + 1].stable  # the multiplier crosses 1 there
+        at.append(k)
+    # an extremum of f1 lies beyond both its points
+    assert upper["f1_Hz"] >= max(upper["bracket_Hz"]) - 1e-9
+    assert lower["f1_Hz"] <= min(lower["bracket_Hz"]) + 1e-9
+    def far(p):
+        return min(abs(p.f1_Hz - x["f1_Hz"]) for x in folds) > 0.05
+
+    upper_point = max((p for p in points[:at[0] + 1] if far(p)), key=lambda p: p.tension_max_N)
+    unstable = [p for p in points[at[0] + 1:at[1] + 1] if far(p)]
+    middle = unstable[len(unstable) // 2]
+    lower_point = next(p for p in points[at[1] + 1:] if far(p))
+    for p in (upper_point, middle, lower_point):
+        half = m.orbit(p.X, p.f1_Hz, steps=2 * p.steps)
+        tight = m.orbit(p.X, p.f1_Hz, steps=p.steps, tol=1e-8)
+        for other, move in ((half, 1e-3), (tight, 1e-5)):
+            assert other.stable == p.stable
+            assert abs(other.max_multiplier - p.max_multiplier) <= move
+            assert abs(p.max_multiplier - 1) > 10 * move
+    assert upper_point.stable and not middle.stable and lower_point.stable
+    assert middle.f1_Hz < upper["f1_Hz"] and middle.f1_Hz > lower["f1_Hz"]
 
 
 @pytest.mark.parametrize("kind", ["period_doubling", "neimark_sacker"])
