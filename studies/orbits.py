@@ -138,7 +138,9 @@ class WindowStore:
         from rawehelix.solvers.continuation import State
         from rawehelix.solvers.orbits import Orbit
         path = self.dir / "state.npz"
-        if not path.exists():
+        if not path.exists():  # stopped before the first point was whole
+            for stray in self.dir.glob("p*.*"):
+                stray.unlink()
             return None
         with np.load(path) as data:
             state, last = State.from_arrays(data), int(data["index"])
