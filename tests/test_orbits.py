@@ -354,3 +354,67 @@ def test_small_amplitude_orbit_is_the_linear_response():
         amplitudes.append(h.q.length_m(max(lateral)))
     assert amplitudes[1] == pytest.approx(amplitudes[0], rel=2e-4)
     assert amplitudes[0] == pytest.approx(linear, rel=1e-3)
+
+
+class _LinearMap:
+    """A stand-in for AlphaMap with a period map whose fixed point X*(f1) and
+    monodromy M(f1) are known: P(X) = X* + M (X - X*).  ``kind`` picks the
+    crossing at f1 = 10.5 Hz: a real multiplier -(0.9 + 0.2 (f1 - 10)) or the
+    pair (0.9 + 0.2 (f1 - 10)) e^{+-1.2 i}; a stable 0.5 rides along."""
+
+    controller = True
+
+    def __init__(self, kind):
+        from types import SimpleNamespace
+        self.kind, self.q = kind, SimpleNamespace(tension_N=lambda t: np.asarray(t))
+
+    def monodromy(self, f1):
+        r = 0.9 + 0.2 * (f1 - 10.0)
+        if self.kind == "period_doubling":
+            return np.diag([-r, 0.5, 0.5])
+        c, s = r * np.cos(1.2), r * np.sin(1.2)
+        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 0.5]])
+
+    def fixed(self, f1):
+        return np.array([1.0, 2.0, 3.0]) * (f1 - 10.0)
+
+    def rotation(self, f1):
+        return 0.0
+
+    def steps_per_period(self, f1):
+        return 1
+
+    def shooting_residual(self, X, f1, delta, tangent=False, steps=None):
+        M = self.monodromy(f1)
+        G = (M - np.eye(3)) @ (X - self.fixed(f1))
+        return G, np.array([100.0 + 10.0 * f1]), (M if tangent else None)
+
+    def finish(self, X, f1, delta, its, res, start, steps=None):
+        from rawehelix.solvers.orbits import Orbit
+        M = self.monodromy(f1)
+        mu = np.linalg.eigvals(M)
+        return Orbit(f1_Hz=f1, X=X, delta=0.0, tension_max_N=100.0 + 10.0 * f1,
+                     tension_min_N=0.0, multipliers=mu[np.argsort(-np.abs(mu))],
+                     newton_iterations=its, residual=res, steps=1, wall_s=0.0, monodromy=M)
+
+
+@pytest.mark.parametrize("kind", ["period_doubling", "neimark_sacker"])
+def test_the_branch_locates_period_doubling_and_neimark_sacker(kind):
+    """Branch.trace on a map with a known crossing at 10.5 Hz: the point is
+    flagged between two branch points, bisected in arclength (correctors from
+    the earlier point) to within 1e-4 Hz, reported once with its kind and the
+    crossing multiplier on the unit circle (to the bracket's width)."""
+    from rawehelix.solvers.continuation import Branch
+
+    m = _LinearMap(kind)
+    first = m.finish(m.fixed(10.0), 10.0, 0.0, 1, 0.0, 0.0)
+    branch = Branch(m, ds=0.1, ds_max=0.2)
+    points = branch.trace(first, 11.0)
+    assert points[-1].f1_Hz > 11.0 and not branch.folds
+    (bif,) = branch.bifurcations
+    assert bif["kind"] == kind
+    assert bif["f1_Hz"] == pytest.approx(10.5, abs=1e-4) and bif["f1_error_Hz"] <= 1e-4
+    mu = complex(*bif["multiplier"])
+    assert abs(abs(mu) - 1.0) <= 1e-4
+    assert (mu.real < 0 and mu.imag == 0) if kind == "period_doubling" else abs(mu.imag) > 0.5
+    assert bif["probes"] <= 12
