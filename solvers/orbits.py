@@ -236,9 +236,12 @@ class AlphaMap:
         period = 1.0 / (f1_Hz * self.q_base.t_scale)  # normalised
         return max(8, math.ceil(period / (self.params.time.dt_s / self.q_base.t_scale) - 1e-9))
 
-    def period(self, X, f1_Hz: float, tangent: bool = False, steps: int | None = None):
+    def period(self, X, f1_Hz: float, tangent: bool = False, steps: int | None = None,
+               on_step=None):
         """P(X) over one period at f1 (phase 0 at t = 0), the tension at s = 0 at
-        every step (normalised) and, with ``tangent``, the monodromy dP/dX."""
+        every step (normalised) and, with ``tangent``, the monodromy dP/dX.
+        ``on_step(probes)`` is called after every step with the rod's probes
+        (:class:`~rawehelix.solvers.probes.Probes`) at the new state."""
         self.set_frequency(f1_Hz)
         M = steps or self.steps_per_period(f1_Hz)
         T1 = 2 * math.pi / self.q.omega1
@@ -251,6 +254,8 @@ class AlphaMap:
                 raise SolverError(f"orbits: the state became NaN or Inf at f1 = {f1_Hz} Hz")
             compat.petsc_vec(self.form.u).setArray(X[:self.n])
             tension.append(self.solver.probes.value("tension0"))
+            if on_step:
+                on_step(self.solver.probes)
         return X, np.array(tension), Phi
 
     def rotation(self, f1_Hz: float) -> float:

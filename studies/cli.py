@@ -70,6 +70,12 @@ def _parser() -> argparse.ArgumentParser:
                            help="the f1 window in Hz, traced from START towards STOP")
             p.add_argument("--sweep", type=Path, default=None, metavar="DIR",
                            help="a sweep's output directory: its points on the diagram")
+            p.add_argument("--tension-step", type=float, default=None, metavar="FRACTION",
+                           help="largest relative change of T max between two points "
+                                "(default 0.05)")
+            p.add_argument("--max-points", type=int, default=400,
+                           help="stop each rank's window after this many points (a rerun "
+                                "with the same -o resumes)")
         if name in ("sweep", "response"):
             p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
                            help="frequencies in Hz (default: the scene's [sweep] section)")
@@ -206,11 +212,16 @@ def _orbits(rh, params, args, outdir, comm) -> int:
         start, stop = (float(x) for x in args.f1.split(":"))
     except ValueError:
         raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
-    result = rh.orbits(params, start, stop, comm=comm,
-                       progress=lambda o: _say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
-                                               f"{o.tension_max_N:.2f} N, |multiplier| "
-                                               f"{o.max_multiplier:.5f}"))
-    result.write(outdir, sweep_dir=args.sweep)
+    try:
+        result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
+                           tension_step=args.tension_step, max_points=args.max_points,
+                           progress=lambda o: _say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
+                                                   f"{o.tension_max_N:.2f} N, |multiplier| "
+                                                   f"{o.max_multiplier:.5f}"))
+    except orbits.OrbitsStoreError as err:
+        raise SceneError("-o", str(outdir), str(err)) from None
+    if comm.rank == 0:
+        result.write(outdir, sweep_dir=args.sweep)
     _say(comm, orbits.report(result) + f"\n  wrote {outdir}/")
     return 0
 

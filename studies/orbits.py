@@ -7,16 +7,28 @@ through folds, until f1 leaves the window.  Every point carries its Floquet
 multipliers' largest modulus and its stability.  The torque ramp (69) is
 at its final value (the summary says so).
 
-Not yet: resuming a stopped branch, the spline backend, the free twist
-rotation without a controller (refused), bisection of period doubling and
-Neimark-Sacker points (flagged between two points).
+MPI: the f1 window is cut into one equal window per rank; each rank traces
+its own window on one rank (from its own first orbit), and rank 0 joins the
+pieces in order.  Where a window starts inside a multi-valued range the
+shooting may land on another branch than the one the window before it left
+on: ``junctions`` gives T max on both sides of each cut, and the report
+says where they differ by more than ``tension_step``.  A failure on one rank
+stops the others at their next point, and every rank raises.
+
+Resumable (``outdir``): every point is stored as it is found (its entry,
+multipliers and state, and the continuation's state after it), one
+directory per window; a rerun continues after the last stored point.
+
+Not yet: the spline backend, the free twist rotation without a controller
+(refused).
 """
 
 from __future__ import annotations
 
 import json
+import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -26,13 +38,12 @@ from rawehelix.parameters import Parameters
 from rawehelix.studies import writers
 
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
+HEADER = "orbits.json"
+ABORT_TAG = 713  # a rank's failure, sent to the others
 
 
-def peaks(points: list[dict]) -> list[dict]:
-    """Local maxima of T max along the branch (in branch order)."""
-    T = [p["tension_max_N"] for p in points]
-    return [{"f1_Hz": points[k]["f1_Hz"], "tension_max_N": T[k]}
-            for k in range(1, len(T) - 1) if T[k] > T[k - 1] and T[k] >= T[k + 1]]
+class OrbitsStoreError(ValueError):
+    """The output directory holds another branch."""
 
 
 @dataclass
@@ -46,13 +57,19 @@ class OrbitsResult:
     folds: list[dict]
     bifurcations: list[dict]
     wall_s: float
+    peaks: list[dict] = field(default_factory=list)
+    windows: list[dict] = field(default_factory=list)  # per rank: f1 range, points
+    junctions: list[dict] = field(default_factory=list)  # T max on both sides of each cut
+    tension_step: float = 0.0
 
     @property
     def summary(self) -> dict:
         return {"scene": self.scene, "elements": self.elements, "degree": self.degree,
                 "dt_s": self.dt_s, "torque": "the ramp (69) at its final value",
+                "tension_step": self.tension_step,
                 "branch": self.branch, "folds": self.folds, "bifurcations": self.bifurcations,
-                "peaks": peaks(self.branch), "wall_s": self.wall_s}
+                "peaks": self.peaks, "windows": self.windows, "junctions": self.junctions,
+                "wall_s": self.wall_s}
 
     def write(self, outdir, sweep_dir=None) -> Path:
         outdir = Path(outdir)
@@ -95,27 +112,195 @@ def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
     return writers._finish(fig, path, title)
 
 
-def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
-            progress=None) -> OrbitsResult:
-    """The branch from f1_start to f1_stop (either order) on one rank."""
+class WindowStore:
+    """The points of one window in ``DIR/window<k>``: per point ``p<i>.json``
+    (entry, multipliers, events) and ``p<i>.npz`` (X), the continuation's state
+    after the last point in ``state.npz`` (with its index), and
+    ``computed.log`` (one line per point computed)."""
+
+    def __init__(self, directory: Path):
+        self.dir = Path(directory)
+        self.dir.mkdir(parents=True, exist_ok=True)
+
+    def save(self, orbit, events, state):
+        k = len(list(self.dir.glob("p*.json")))
+        record = {"entry": orbit.entry(), "delta": orbit.delta, "events": events,
+                  "multipliers": [[float(m.real), float(m.imag)] for m in orbit.multipliers]}
+        writers.write_npz(self.dir / f"p{k:04d}.npz", {"X": orbit.X})
+        writers.write_json(self.dir / f"p{k:04d}.json", record)
+        writers.write_npz(self.dir / "state.npz", {**state.arrays(), "index": np.array(k)})
+        with open(self.dir / "computed.log", "a") as fh:
+            fh.write(f"{k} {orbit.f1_Hz!r} pid {os.getpid()}\n")
+
+    def load(self):
+        """(orbits, state, folds, bifurcations, peaks) of the stored points, or None.
+        Points after the state's index (written before an interruption) are dropped."""
+        from rawehelix.solvers.continuation import State
+        from rawehelix.solvers.orbits import Orbit
+        path = self.dir / "state.npz"
+        if not path.exists():  # stopped before the first point was whole
+            for stray in self.dir.glob("p*.*"):
+                stray.unlink()
+            return None
+        with np.load(path) as data:
+            state, last = State.from_arrays(data), int(data["index"])
+        orbits, events = [], {"fold": [], "peak": [], "bifurcation": []}
+        for k in range(last + 1):
+            record = json.loads((self.dir / f"p{k:04d}.json").read_text())
+            with np.load(self.dir / f"p{k:04d}.npz") as data:
+                X = data["X"]
+            e = record["entry"]
+            mu = np.array([complex(re, im) for re, im in record["multipliers"]])
+            orbits.append(Orbit(f1_Hz=e["f1_Hz"], X=X, delta=record["delta"],
+                                tension_max_N=e["tension_max_N"], tension_min_N=e["tension_min_N"],
+                                multipliers=mu, newton_iterations=e["newton_iterations"],
+                                residual=e["residual"], steps=e["steps_per_period"],
+                                wall_s=e["wall_s"]))
+            for ev in record["events"]:
+                events.get(ev["kind"], events["bifurcation"]).append(ev)
+        for extra in sorted(self.dir.glob("p*.json"))[last + 1:]:
+            extra.unlink()
+            extra.with_suffix(".npz").unlink(missing_ok=True)
+        return orbits, state, events["fold"], events["bifurcation"], events["peak"]
+
+
+def open_directory(outdir: Path, header: dict, comm):
+    """Refuse a directory that holds another branch, then write its header (collective)."""
+    error = None
+    if comm.rank == 0:
+        path = Path(outdir) / HEADER
+        if path.exists():
+            old = json.loads(path.read_text())
+            if old != header:
+                error = (f"{path}: holds another branch (scene {old.get('scene')!r}, "
+                         f"f1 windows {old.get('windows')}, tension_step "
+                         f"{old.get('tension_step')}); use another -o directory or delete it")
+        else:
+            writers.write_json(path, header)
+    error = comm.bcast(error, root=0)
+    if error:
+        raise OrbitsStoreError(error)
+
+
+def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[float]]:
+    """The f1 window cut into ``ranks`` equal windows, each traced from its first end."""
+    edges = np.linspace(f1_start_Hz, f1_stop_Hz, ranks + 1)
+    return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
+
+
+def _trace_window(params, window, tension_step, max_points, store, progress, stop):
+    """One window on this rank: (entries, folds, bifurcations, peaks)."""
     from rawehelix.solvers.continuation import Branch
     from rawehelix.solvers.orbits import AlphaMap
+
+    m = AlphaMap(params, comm=MPI.COMM_SELF)
+    branch = Branch(m, tension_step=tension_step)
+    start_f1, stop_f1 = window
+    stored = store.load() if store else None
+    if stored:
+        branch.resume(*stored)
+    else:
+        first = m.orbit(m.X_stationary, start_f1, lead_in=LEAD_IN_PERIODS)
+        branch.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
+        if store:
+            store.save(first, [], branch.state)
+        if progress:
+            progress(first)
+
+    def each(orbit):
+        stop()
+        if progress:
+            progress(orbit)
+
+    branch.trace(None, stop_f1, max_points=max_points, progress=each,
+                 on_point=store.save if store else None)
+    entries = [o.entry() for o in branch.points]
+    return entries, branch.folds, branch.bifurcations, branch.peaks
+
+
+def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
+            progress=None, outdir=None, tension_step: float | None = None,
+            max_points: int = 400) -> OrbitsResult:
+    """The branch from f1_start to f1_stop (either order), one window per rank
+    of ``comm``; with ``outdir``, stored point by point and resumed from it."""
+    from rawehelix.solvers.continuation import TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
     if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
                           f"different frequencies > 0 [Hz]")
+    tension_step = TENSION_STEP if tension_step is None else tension_step
     start = time.perf_counter()
-    m = AlphaMap(params, comm=comm if comm.size == 1 else MPI.COMM_SELF)
-    first = m.orbit(m.X_stationary, f1_start_Hz, lead_in=LEAD_IN_PERIODS)
-    branch = Branch(m)
-    branch.trace(first, f1_stop_Hz, direction=1.0 if f1_stop_Hz > f1_start_Hz else -1.0,
-                 progress=progress)
+    cuts = windows(f1_start_Hz, f1_stop_Hz, comm.size)
+    store = None
+    if outdir is not None:
+        from rawehelix.studies.sweep_store import fingerprint
+        header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
+                  "tension_step": tension_step}
+        open_directory(Path(outdir), header, comm)
+        store = WindowStore(Path(outdir) / f"window{comm.rank}")
+
+    def stop():  # another rank failed: stop here too
+        if comm.size > 1 and comm.Iprobe(source=MPI.ANY_SOURCE, tag=ABORT_TAG):
+            raise _Stopped()
+
+    error, sent, piece = None, [], None
+    try:
+        piece = _trace_window(params, cuts[comm.rank], tension_step, max_points, store,
+                              progress, stop)
+    except _Stopped:
+        error = (False, f"rank {comm.rank}: stopped")
+    except Exception as err:  # noqa: BLE001 - reported on every rank below
+        if comm.size == 1:
+            raise
+        error = (True, f"rank {comm.rank} (f1 {cuts[comm.rank][0]:g}:{cuts[comm.rank][1]:g} "
+                       f"Hz): {type(err).__name__}: {err}")
+        sent = [comm.isend(error[1], dest=r, tag=ABORT_TAG) for r in range(comm.size)
+                if r != comm.rank]
+    errors = comm.allgather(error)
+    failed = [r for r, e in enumerate(errors) if e and e[0]]
+    for r in failed:
+        if r != comm.rank:
+            comm.recv(source=r, tag=ABORT_TAG)
+    for req in sent:
+        req.wait()
+    if failed:
+        raise SolverError("orbits: " + "; ".join(errors[r][1] for r in failed))
+    pieces = comm.gather(piece, root=0)
+    result = None
+    if comm.rank == 0:
+        result = _join(params, cuts, pieces, tension_step, time.perf_counter() - start)
+    return comm.bcast(result, root=0)
+
+
+class _Stopped(Exception):
+    """Another rank failed."""
+
+
+def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
+    """The windows' pieces in order, with T max on both sides of each cut."""
+    branch, folds, bifurcations, found, info, junctions = [], [], [], [], [], []
+    for k, (entries, f, b, p) in enumerate(pieces):
+        if k > 0:
+            left, right, x = branch[-2:], entries[0], cuts[k][0]
+            if len(left) < 2:
+                continue
+            (fa, Ta), (fb, Tb) = [(e["f1_Hz"], e["tension_max_N"]) for e in left]
+            T_left = Ta + (x - fa) / (fb - fa) * (Tb - Ta)
+            junctions.append({"f1_Hz": x, "tension_max_N_left": T_left,
+                              "tension_max_N_right": right["tension_max_N"],
+                              "same_branch": abs(T_left / right["tension_max_N"] - 1)
+                              <= tension_step})
+        branch += entries
+        folds += f
+        bifurcations += b
+        found += p
+        info.append({"rank": k, "f1_Hz": cuts[k], "points": len(entries)})
     disc = params.discretisation
     return OrbitsResult(scene=params.name, title=params.title, elements=disc.elements,
-                        degree=disc.degree, dt_s=params.time.dt_s,
-                        branch=[o.entry() for o in branch.points], folds=branch.folds,
-                        bifurcations=branch.bifurcations, wall_s=time.perf_counter() - start)
+                        degree=disc.degree, dt_s=params.time.dt_s, branch=branch, folds=folds,
+                        bifurcations=bifurcations, wall_s=wall_s, peaks=found, windows=info,
+                        junctions=junctions, tension_step=tension_step)
 
 
 def report(result: OrbitsResult) -> str:
@@ -130,6 +315,13 @@ def report(result: OrbitsResult) -> str:
     for kind, items in (("fold", s["folds"]), ("bifurcation", s["bifurcations"]),
                         ("peak", s["peaks"])):
         for x in items:
-            lines.append(f"  {x.get('kind', kind)} at f1 = {x['f1_Hz']:.4f} Hz, "
+            error = f" (+- {x['f1_error_Hz']:.1e} Hz)" if "f1_error_Hz" in x else ""
+            lines.append(f"  {x.get('kind', kind)} at f1 = {x['f1_Hz']:.4f} Hz{error}, "
                          f"T max = {x['tension_max_N']:.2f} N")
+    for j in s["junctions"]:
+        if not j["same_branch"]:
+            lines.append(f"  warning: at the cut f1 = {j['f1_Hz']:.4f} Hz between two ranks' "
+                         f"windows T max is {j['tension_max_N_left']:.2f} N on the left and "
+                         f"{j['tension_max_N_right']:.2f} N on the right: the windows are on "
+                         f"different branches there (trace it on one rank)")
     return "\n".join(lines)
