@@ -291,7 +291,7 @@ class AlphaMap:
             res = np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
             if res <= tol:
                 break
-            A = mono - np.eye(3 * self.n)
+            A = mono - np.eye(X.size)
             if res > 0.1 * last and not need:
                 mono = None  # slow: a fresh monodromy at the next iteration
             last = res
