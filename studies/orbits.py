@@ -19,7 +19,11 @@ Resumable (``outdir``): every point is stored as it is found (its entry,
 multipliers and state, and the continuation's state after it), one
 directory per window; a rerun continues after the last stored point.
 
-Not yet: the spline backend, the free twist rotation without a controller
+Both schemes: the FE generalised-alpha map (:mod:`rawehelix.solvers.orbits`)
+and the paper's spline-Galerkin flow (:mod:`rawehelix.solvers.spline_galerkin.orbits`),
+chosen by ``discretisation.scheme`` (``--scheme spline``).
+
+Not yet: the free twist rotation without a controller
 (refused).
 """
 
@@ -61,10 +65,18 @@ class OrbitsResult:
     windows: list[dict] = field(default_factory=list)  # per rank: f1 range, points
     junctions: list[dict] = field(default_factory=list)  # T max on both sides of each cut
     tension_step: float = 0.0
+    scheme: str = "fe"  # "fe" (generalised-alpha, dt_s) or "spline" (Radau, adaptive)
+
+    @property
+    def discretisation(self) -> str:
+        if self.scheme == "spline":
+            return f"spline N = {self.elements}, Radau (adaptive)"
+        return f"N = {self.elements}, p = {self.degree}, dt = {self.dt_s * 1e3:g} ms"
 
     @property
     def summary(self) -> dict:
-        return {"scene": self.scene, "elements": self.elements, "degree": self.degree,
+        return {"scene": self.scene, "scheme": self.scheme, "elements": self.elements,
+                "degree": self.degree,
                 "dt_s": self.dt_s, "torque": "the ramp (69) at its final value",
                 "tension_step": self.tension_step,
                 "branch": self.branch, "folds": self.folds, "bifurcations": self.bifurcations,
@@ -77,7 +89,7 @@ class OrbitsResult:
         writers.write_json(outdir / "summary.json", self.summary)
         sweep = _sweep_points(sweep_dir) if sweep_dir else []
         diagram_png(outdir / "orbits.png", self.branch, self.folds, sweep,
-                    f"{self.title}: periodic orbits, N = {self.elements}, p = {self.degree}")
+                    f"{self.title}: periodic orbits, {self.discretisation}")
         return outdir
 
 
@@ -188,12 +200,21 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
     return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
 
 
+def period_map(params: Parameters):
+    """The scene's scheme's period map on this rank: the FE generalised-alpha
+    map, or the paper's spline-Galerkin flow (``discretisation.scheme``)."""
+    if params.discretisation.scheme == "spline":
+        from rawehelix.solvers.spline_galerkin.orbits import SplineMap
+        return SplineMap(params)
+    from rawehelix.solvers.orbits import AlphaMap
+    return AlphaMap(params, comm=MPI.COMM_SELF)
+
+
 def _trace_window(params, window, tension_step, max_points, store, progress, stop):
     """One window on this rank: (entries, folds, bifurcations, peaks)."""
     from rawehelix.solvers.continuation import Branch
-    from rawehelix.solvers.orbits import AlphaMap
 
-    m = AlphaMap(params, comm=MPI.COMM_SELF)
+    m = period_map(params)
     branch = Branch(m, tension_step=tension_step)
     start_f1, stop_f1 = window
     stored = store.load() if store else None
@@ -297,16 +318,19 @@ def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
         found += p
         info.append({"rank": k, "f1_Hz": cuts[k], "points": len(entries)})
     disc = params.discretisation
+    spline = disc.scheme == "spline"
     return OrbitsResult(scene=params.name, title=params.title, elements=disc.elements,
-                        degree=disc.degree, dt_s=params.time.dt_s, branch=branch, folds=folds,
+                        degree=None if spline else disc.degree,
+                        dt_s=None if spline else params.time.dt_s, scheme=disc.scheme,
+                        branch=branch, folds=folds,
                         bifurcations=bifurcations, wall_s=wall_s, peaks=found, windows=info,
                         junctions=junctions, tension_step=tension_step)
 
 
 def report(result: OrbitsResult) -> str:
     s = result.summary
-    lines = [f"{result.title}: {len(s['branch'])} periodic orbits, N = {result.elements}, "
-             f"p = {result.degree}, dt = {result.dt_s * 1e3:g} ms, in {result.wall_s:.1f} s "
+    lines = [f"{result.title}: {len(s['branch'])} periodic orbits, {result.discretisation}, "
+             f"in {result.wall_s:.1f} s "
              f"(torque: {s['torque']})"]
     unstable = [p["f1_Hz"] for p in s["branch"] if not p["stable"]]
     lines.append(f"  largest Floquet multiplier modulus: "

@@ -61,3 +61,10 @@ def test_refuses_without_controller():
     with pytest.raises(SolverError, match="controller"):
         SplineMap(rh.load_scene("mobile_end", scheme="spline", elements=2,
                                 overrides={**SCENE, "controller.k1": 0.0}))
+
+
+@pytest.mark.parametrize("scheme, kind", [("spline", "SplineMap"), ("fe", "AlphaMap")])
+def test_the_orbits_command_takes_the_scenes_scheme(scheme, kind):
+    from rawehelix.studies.orbits import period_map
+    params = rh.load_scene("mobile_end", scheme=scheme, elements=2, overrides=SCENE)
+    assert type(period_map(params)).__name__ == kind
