@@ -106,6 +106,7 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
             backend, state, computed = backend_factory(), None, computed + 1
             continue
         store.save(f1, {"entry": result.entry(), "period_maxima_N": result.period_maxima_N,
+                        "period_minima_N": result.period_minima_N,
                         "series_t_s": result.series_t_s, "series_tension_N": result.series_tension_N},
                    {**backend.pack(state), "t": t})
         computed += 1

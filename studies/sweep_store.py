@@ -15,6 +15,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
+from rawehelix.solvers.periodic import CRITERION
 from rawehelix.studies import writers
 
 RESULTS = "sweep.json"
@@ -26,12 +27,14 @@ class SweepError(ValueError):
 
 def fingerprint(params: Parameters) -> str:
     """A hash of everything that changes the points: not f1 itself, the f1
-    list, the end time nor the output sampling (the time step does count)."""
+    list, the end time nor the output sampling (the time step and the
+    periodicity test do count)."""
     data = params.as_dict()
     data["ends"].pop("circle_frequency_Hz")
     data["time"] = {"dt_s": data["time"]["dt_s"]}
     for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
         data["sweep"].pop(key)
+    data["sweep"]["criterion"] = CRITERION  # the periodicity test judges the points too
     return writers.digest(data)
 
 
@@ -145,6 +148,6 @@ def check_directory(outdir: Path, header: dict):
         return  # cannot happen with atomic writes; treat as empty
     if old.get("fingerprint") != header["fingerprint"]:
         raise SweepError(
-            f"{path}: holds a sweep of another scene or discretisation (scene "
+            f"{path}: holds a sweep of another scene or discretisation or periodicity test (scene "
             f"{old.get('scene')!r}, scheme {old.get('scheme')!r}, N = {old.get('elements')}, "
             f"p = {old.get('degree')}); use another -o directory or delete it")

@@ -186,10 +186,11 @@ TENSION_MAX_SPACE_DT_S = 1.25e-4
 def tension_max(params: Parameters, method: Method, value) -> np.ndarray:
     """Maximum tension at s = 0 [N] of the periodic response at f1 = 10 Hz
     (Fig. 8 inset), from the stationary state with a 3 s lead-in; periodic to
-    1e-5 (which moves T max by 2e-6 relative against 1e-4 and 1e-6)."""
+    5e-4 of the oscillation T max - T min (4.4 N of 244 N: 1e-5 of T max,
+    which moved T max by 2e-6 relative against 1e-4 and 1e-6)."""
     from rawehelix.solvers.periodic import periodic_response
     p = with_method(params, method, value).replace(
-        sweep={"lead_in_s": 3.0, "periodic_tolerance": 1e-5})
+        sweep={"lead_in_s": 3.0, "periodic_tolerance": 5e-4})
     if method.variable == "elements" and method.scheme == "fe":
         p = p.replace(time={"dt_s": TENSION_MAX_SPACE_DT_S})
     q = p.normalised()
