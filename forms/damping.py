@@ -65,10 +65,7 @@ def tangent_rate(r, r_t):
 
 def frenet_torsion_rate(r, r_t, eps):
     """d gamma/dt along r_t of the regularised Frenet torsion of Eq. (34),
-    gamma = r'.(r'' x r''')/(|r''|^2 + eps^2) (forms/kinematics.py::frenet_torsion).
-    Written out: a Gateaux derivative (extensible.variation) nested in the one of
-    :func:`viscous_residual` would lose the outer variable (each strips every
-    ufl.variable)."""
+    gamma = r'.(r'' x r''')/(|r''|^2 + eps^2) (forms/kinematics.py::frenet_torsion)."""
     r1, r2, r3 = d(r), d(r, 2), d(r, 3)
     u1, u2, u3 = d(r_t), d(r_t, 2), d(r_t, 3)
     num = ufl.dot(r1, ufl.cross(r2, r3))
@@ -78,12 +75,9 @@ def frenet_torsion_rate(r, r_t, eps):
     return num_t / den - num * 2 * ufl.dot(r2, u2) / den**2
 
 
-def dissipation(r, alpha, r_t, alpha_t, c: Coefficients, degree: int, penalty, measures):
-    """D of the module docstring at the state (r, alpha) and the rates (r_t,
-    alpha_t); ``alpha`` None (the planar model) drops the torsion term."""
-    dx, dS, _ = measures
-    domain = dx.ufl_domain()
-    n = ufl.FacetNormal(domain)
+def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
+    """(eps_t, tau_t, b, [[j]]_t) of the module docstring at the state r, each linear
+    in (r_t, alpha_t); ``alpha_t`` None (the planar model): tau_t None."""
     t, t_t = extensible.unit_tangent(r), tangent_rate(r, r_t)
     w = ufl.cross(t, t_t)  # the tangent's spin
 
@@ -96,24 +90,41 @@ def dissipation(r, alpha, r_t, alpha_t, c: Coefficients, degree: int, penalty, m
         q, q_t, j, j_t = d(r, 2), d(r_t, 2), jump_d(r, n), jump_d(r_t, n)
     b = q_t - ufl.cross(w, q)
     jb = j_t - ufl.cross(0.5 * (w("+") + w("-")), j)
-    D_b = (0.5 * ufl.dot(b, b) * dx
-           + (-ufl.dot(0.5 * (b("+") + b("-")), jb)
-              + 0.5 * ip_penalty(degree, penalty, dS) * ufl.dot(jb, jb)) * dS)
     eps_t = ufl.dot(t, d(r_t))  # d|r'|/dt
-    D = 0.5 * c.sigma * c.tau_a * eps_t**2 * dx + c.bending * c.mu * c.tau_b * D_b
-    if alpha is not None:
-        tau_t = c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps) + d(alpha_t)  # (34)
-        D += 0.5 * c.beta * c.tau_t * tau_t**2 * dx
-    return D
+    tau_t = None if alpha_t is None else (
+        c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps) + d(alpha_t))  # (34)
+    return eps_t, tau_t, b, jb
 
 
-def viscous_residual(r, alpha, r_t, alpha_t, v, psi, c: Coefficients, degree: int, penalty,
-                     measures):
-    """dD/d(r_t, alpha_t) in the direction (v, delta/beta psi): the viscous forces."""
-    domain = measures[0].ufl_domain()
-    if psi is None:  # the planar model: no twist
-        return extensible.variation(
-            lambda u: dissipation(r, None, u, None, c, degree, penalty, measures), r_t, v, domain)
-    return extensible.variation(
-        lambda u, a: dissipation(r, alpha, u, a, c, degree, penalty, measures),
-        (r_t, alpha_t), (v, c.delta / c.beta * psi), domain)
+def _bilinear(x, y, c: Coefficients, degree: int, penalty, measures):
+    """The symmetric form B(x, y) of D = 1/2 B(x, x), x = :func:`strain_rates`."""
+    dx, dS, _ = measures
+    (ea, ta, ba, ja), (eb, tb, bb, jb) = x, y
+    B_b = (ufl.dot(ba, bb) * dx
+           + (-ufl.dot(0.5 * (ba("+") + ba("-")), jb) - ufl.dot(0.5 * (bb("+") + bb("-")), ja)
+              + ip_penalty(degree, penalty, dS) * ufl.dot(ja, jb)) * dS)
+    B = c.sigma * c.tau_a * ea * eb * dx + c.bending * c.mu * c.tau_b * B_b
+    if ta is not None:
+        B += c.beta * c.tau_t * ta * tb * dx
+    return B
+
+
+def dissipation(r, r_t, alpha_t, c: Coefficients, degree: int, penalty, measures):
+    """D of the module docstring at the state r and the rates (r_t, alpha_t);
+    ``alpha_t`` None (the planar model) drops the torsion term."""
+    x = strain_rates(r, r_t, alpha_t, c, ufl.FacetNormal(measures[0].ufl_domain()))
+    return 0.5 * _bilinear(x, x, c, degree, penalty, measures)
+
+
+def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, penalty, measures):
+    """dD/d(r_t, alpha_t) in the direction (v, delta/beta psi): the viscous forces.
+
+    The rates are linear in (r_t, alpha_t), so this derivative is B(x(r_t, alpha_t),
+    x(v, delta/beta psi)), x the rates.  Written so, its UFL is a fraction of that
+    of the Gateaux derivative of :func:`dissipation` (extensible.variation), which
+    tests/test_damping.py assembles against it."""
+    n = ufl.FacetNormal(measures[0].ufl_domain())
+    planar = psi is None
+    x = strain_rates(r, r_t, None if planar else alpha_t, c, n)
+    y = strain_rates(r, v, None if planar else c.delta / c.beta * psi, c, n)
+    return _bilinear(x, y, c, degree, penalty, measures)

@@ -222,8 +222,7 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
          - ufl.inner(body_force(r_t, c), v) * dx)
     if c.damped and moving:  # Kelvin-Voigt, from the dissipation potential
         from rawehelix.forms import damping  # (damping builds on this module)
-        F += damping.viscous_residual(r, alpha, r_t, alpha_t, v, psi, c, degree, penalty,
-                                      measures)
+        F += damping.viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
     return F

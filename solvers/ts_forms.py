@@ -101,7 +101,7 @@ class _Formulation:
             fields.r, fields.alpha, fields.r_t, self.rod.c, dx, kappa=fields.kappa))
         # 2 D, the power of the structural damping (forms/damping.py); None: undamped
         self.dissipation = None if not self.rod.c.damped else dolfinx.fem.form(
-            2 * damping.dissipation(fields.r, fields.alpha, fields.r_t, fields.alpha_t,
+            2 * damping.dissipation(fields.r, fields.r_t, fields.alpha_t,
                                     self.rod.c, self.rod.degree, self.rod.penalty,
                                     self.rod.measures))
         self.b = compat.create_vector(self.F)

@@ -29,7 +29,7 @@ from mpi4py import MPI
 
 import dolfinx.fem.petsc
 
-from rawehelix.forms import damping as damping_forms
+from rawehelix.forms import damping as damping_forms, extensible
 from rawehelix.forms import rod as rod_forms
 from rawehelix.parameters import ParameterError
 from rawehelix.solvers.dynamics import DynamicsSolver
@@ -98,12 +98,12 @@ def _velocity_forms(solver):
     """(velocity Function, viscous residual form, 2 D form) on the solver's rod."""
     rod = solver.rod
     w_t = dolfinx.fem.Function(rod.W)
-    r, alpha = ufl.split(rod.w)[:2]
+    r = ufl.split(rod.w)[0]
     r_t, alpha_t = ufl.split(w_t)[:2]
     v, psi = rod_forms.test_fields(rod.test)[:2]
     args = (rod.c, rod.degree, rod.penalty, rod.measures)
-    F = damping_forms.viscous_residual(r, alpha, r_t, alpha_t, v, psi, *args)
-    D2 = 2 * damping_forms.dissipation(r, alpha, r_t, alpha_t, *args)
+    F = damping_forms.viscous_residual(r, r_t, alpha_t, v, psi, *args)
+    D2 = 2 * damping_forms.dissipation(r, r_t, alpha_t, *args)
     return w_t, F, D2
 
 
@@ -166,8 +166,9 @@ def test_rigid_motions_and_the_steady_spin_are_not_damped(kinematics):
 
 @pytest.mark.parametrize("kinematics", KINEMATICS)
 def test_viscous_power_is_twice_the_dissipation_potential(kinematics):
-    """R_v(w_t; w_t) = 2 D(w_t) (D is quadratic in the rates) for a generic velocity
-    on the sagging state, and the modal C is symmetric positive semidefinite."""
+    """For a generic velocity on the sagging state: R_v(w_t; w_t) = 2 D(w_t) (D is
+    quadratic in the rates), R_v is the Gateaux derivative of D in the velocity
+    (UFL's, extensible.variation), and the modal C is symmetric positive semidefinite."""
     solver = ModalSolver.from_stationary(table2(kinematics, N=4, **ALL_ON), MPI.COMM_SELF)
     rod = solver.rod
     w_t, F, D2 = _velocity_forms(solver)
@@ -183,6 +184,16 @@ def test_viscous_power_is_twice_the_dissipation_potential(kinematics):
     print(f"{kinematics}: R_v(w_t) = {power:.12e}, 2D = {twice_D:.12e}")
     assert twice_D > 0
     assert power == pytest.approx(twice_D, rel=1e-12)
+    # the viscous residual is the Gateaux derivative of D in the velocity
+    r = ufl.split(rod.w)[0]
+    r_t, alpha_t = ufl.split(w_t)[:2]
+    v, psi = rod_forms.test_fields(rod.test)[:2]
+    gateaux = extensible.variation(
+        lambda u, a: damping_forms.dissipation(r, u, a, rod.c, rod.degree, rod.penalty,
+                                               rod.measures),
+        (r_t, alpha_t), (v, rod.c.delta / rod.c.beta * psi), rod.mesh)
+    a, b = (dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(f)) for f in (F, gateaux))
+    assert (a - b).norm() < 1e-12 * a.norm()
     C = solver.C.convert("dense").getDenseArray()
     sym = np.abs(C - C.T).max() / np.abs(C).max()
     assert sym < 1e-12
