@@ -31,6 +31,7 @@ import dolfinx.fem.petsc
 
 from rawehelix.forms import damping as damping_forms, extensible
 from rawehelix.forms import rod as rod_forms
+from rawehelix.forms.kinematics import frenet_torsion
 from rawehelix.parameters import ParameterError
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
@@ -194,6 +195,13 @@ def test_viscous_power_is_twice_the_dissipation_potential(kinematics):
         (r_t, alpha_t), (v, rod.c.delta / rod.c.beta * psi), rod.mesh)
     a, b = (dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(f)) for f in (F, gateaux))
     assert (a - b).norm() < 1e-12 * a.norm()
+    # the written-out rate of the Frenet torsion gamma (model.gamma = "regularised")
+    eps = rod.c.gamma_eps
+    rate = damping_forms.frenet_torsion_rate(r, r_t, eps)
+    exact = extensible.variation(lambda x: frenet_torsion(x, eps), r, r_t, rod.mesh)
+    diff, size = (dolfinx.fem.assemble_scalar(dolfinx.fem.form(e**2 * rod.measures[0]))
+                  for e in (rate - exact, exact))
+    assert size > 0 and diff < 1e-24 * size
     C = solver.C.convert("dense").getDenseArray()
     sym = np.abs(C - C.T).max() / np.abs(C).max()
     assert sym < 1e-12
@@ -272,3 +280,17 @@ def test_scene_section_and_refusals(tmp_path):
     for change in ({"scheme": "spline"}, {"bending": "mixed"}):
         with pytest.raises(ParameterError, match="structural damping"):
             table2(bending_s=1e-3).replace(discretisation=change)
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("kinematics", KINEMATICS)
+def test_same_damped_spectrum_on_one_and_two_ranks(kinematics):
+    """The viscous facet terms are assembled across ranks: the damped eigenvalues
+    (all three mechanisms on) equal the serial ones."""
+    params = table2(kinematics, **ALL_ON)
+    lam = [sorted((m.eigenvalue for m in ModalSolver.from_stationary(params, comm).solve()),
+                  key=lambda z: (round(abs(z), 6), z.imag))[:10]
+           for comm in (MPI.COMM_SELF, MPI.COMM_WORLD)]
+    a, b = np.array(lam[0][1:]), np.array(lam[1][1:])  # [0]: the rigid rotation
+    assert np.max(np.abs(a - b) / np.abs(a)) < 1e-8
+    assert np.all(a.real < 0)
