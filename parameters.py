@@ -130,6 +130,28 @@ class Controller:
         return self.k1 > 0 or self.k2 > 0
 
 
+@dataclass(frozen=True)
+class Damping:
+    """Structural damping, Kelvin-Voigt on the strain rates (forms/damping.py): each
+    viscous stress is the elastic modulus x the retardation time x the strain rate.
+    A scene's ``[damping]`` section; all zero (the default) is the paper's model."""
+
+    axial_s: float = 0.0  # tau_a: N_v = EA tau_a d|r'|/dt [s]
+    bending_s: float = 0.0  # tau_b: m_v = EI tau_b (objective rate of the curvature) [s]
+    torsion_s: float = 0.0  # tau_t: M_v = GJ tau_t d(tau)/dt [s]
+
+    def __post_init__(self):
+        _non_negative("damping", self, "axial_s", "bending_s", "torsion_s")
+
+    @property
+    def active(self) -> bool:
+        return self.axial_s > 0 or self.bending_s > 0 or self.torsion_s > 0
+
+    def describe(self) -> str:
+        return (f"damping: Kelvin-Voigt tau_a = {self.axial_s:g} s, tau_b = {self.bending_s:g} s, "
+                f"tau_t = {self.torsion_s:g} s")
+
+
 GAMMA_TREATMENTS = ("regularised", "off")
 KINEMATICS = ("paper", "extensible")  # forms/rod.py (Eqs. 30-33), forms/extensible.py
 
@@ -159,6 +181,8 @@ class Model:
     # tension force is T r'); "extensible": stretch and bending from the stored
     # energy 1/2 EA eps^2 + 1/2 EI |t'|^2, t = r'/|r'| (forms/extensible.py)
     kinematics: str = "paper"
+    # structural damping: the scene's [damping] section (studies/scene.py puts it here)
+    damping: Damping = field(default_factory=Damping)
 
     def describe(self, planar: bool = False) -> str:
         """The model that runs, for summary.json: reduction and the terms switched on."""
@@ -172,8 +196,9 @@ class Model:
         terms = [name for name in ("gravity", "drag", "bending") if getattr(self, name)]
         if self.gamma != "off" and self.twist and not planar:
             terms.append(f"gamma ({self.gamma})")
-        return (f"{head}; terms: {', '.join(terms) or 'tension only'}; "
+        text = (f"{head}; terms: {', '.join(terms) or 'tension only'}; "
                 f"kinematics: {self.kinematics}")
+        return f"{text}; {self.damping.describe()}" if self.damping.active else text
 
     def __post_init__(self):
         if self.gamma not in GAMMA_TREATMENTS:
@@ -188,7 +213,7 @@ class Model:
 #: model switches added after results were stored (sweep checkpoints, the
 #: convergence cache): left out of :meth:`Parameters.as_dict` at their
 #: defaults, so that those results keep their fingerprints
-LATER_MODEL_SWITCHES = {"kinematics": "paper"}
+LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Damping())}
 
 SCHEMES = ("fe", "spline")
 MESHES = ("uniform", "graded")
@@ -318,10 +343,20 @@ class Parameters:
             raise ParameterError("model.kinematics", "extensible",
                                  "is implemented by the FE scheme with discretisation.bending "
                                  "= 'ip' only (forms/extensible.py)")
+        if self.model.damping.active and (
+                self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"):
+            raise ParameterError("damping", self.model.damping,
+                                 "structural damping is implemented by the FE scheme with "
+                                 "discretisation.bending = 'ip' only (forms/damping.py)")
 
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:
-        ``p.replace(discretisation={"elements": 32})``."""
+        ``p.replace(discretisation={"elements": 32})``; ``damping={...}`` changes
+        the model's damping (the scene's ``[damping]`` section)."""
+        sections = dict(sections)
+        if "damping" in sections:
+            damping = dataclasses.replace(self.model.damping, **sections.pop("damping"))
+            sections["model"] = {**sections.get("model", {}), "damping": damping}
         changed = {name: values if isinstance(values, str)
                    else dataclasses.replace(getattr(self, name), **values)
                    for name, values in sections.items()}
@@ -374,6 +409,14 @@ class Normalised:
     gravity: float
     drag: float
     bending: float
+    # structural damping: the retardation times / t_scale (0: off), forms/damping.py
+    tau_axial: float = 0.0
+    tau_bending: float = 0.0
+    tau_torsion: float = 0.0
+
+    @property
+    def damped(self) -> bool:
+        return self.tau_axial > 0 or self.tau_bending > 0 or self.tau_torsion > 0
 
     @classmethod
     def from_parameters(cls, p: Parameters) -> "Normalised":
@@ -397,6 +440,9 @@ class Normalised:
             spin_target=p.controller.target_rpm * RPM * t_scale,
             gravity=float(p.model.gravity), drag=float(p.model.drag),
             bending=float(p.model.bending),
+            tau_axial=p.model.damping.axial_s / t_scale,
+            tau_bending=p.model.damping.bending_s / t_scale,
+            tau_torsion=p.model.damping.torsion_s / t_scale,
         )
 
     # -- units back to SI ---------------------------------------------------

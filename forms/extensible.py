@@ -92,13 +92,19 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS):
 
 def variation(energy, r, v, domain):
     """d/de energy(r + e v) at e = 0: the first variation of ``energy`` (a
-    callable r -> Form) in the direction v, for any UFL r and v (split fields
-    of a mixed space, or the planar embedding).  e is a placeholder constant,
-    replaced by 0 once UFL has differentiated (which removes every e v)."""
+    callable r -> Form, or -> expression) in the direction v, for any UFL r and
+    v (split fields of a mixed space, or the planar embedding); tuples r and v
+    vary several arguments at once, ``energy(*(r + e v))``.  e is a placeholder
+    constant, replaced by 0 once UFL has differentiated (which removes every e v)."""
     e0 = ufl.Constant(domain)
     e = ufl.variable(e0)
-    dE = apply_derivatives(apply_algebra_lowering(ufl.diff(energy(r + e * v), e)))
-    return ufl.replace(map_integrands(strip_variables, dE), {e0: ufl.as_ufl(0.0)})
+    if isinstance(r, tuple):
+        varied = energy(*(x + e * y for x, y in zip(r, v)))
+    else:
+        varied = energy(r + e * v)
+    dE = apply_derivatives(apply_algebra_lowering(ufl.diff(varied, e)))
+    dE = map_integrands(strip_variables, dE) if isinstance(dE, ufl.Form) else strip_variables(dE)
+    return ufl.replace(dE, {e0: ufl.as_ufl(0.0)})
 
 
 def twist_coupling(r, tau, beta):

@@ -62,6 +62,12 @@ class Coefficients:
     gamma_eps: Any = 1.0e-3
     gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
     kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
+    # structural damping (forms/damping.py): retardation times / t_scale; ``damped``
+    # False leaves the viscous terms out of the forms altogether
+    tau_a: Any = 0.0
+    tau_b: Any = 0.0
+    tau_t: Any = 0.0
+    damped: bool = False
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
@@ -74,6 +80,8 @@ class Coefficients:
             gamma_eps=make(model.gamma_eps),
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
             kinematics=model.kinematics,
+            tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
+            damped=q.damped,
         )
 
 
@@ -184,10 +192,11 @@ def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures
     (r, alpha, kappa) of the mixed bending form the third field is kappa
     (which has no rate: the rates' kappa parts are unused)."""
     r, alpha, *kappa = ufl.split(w)
-    r_t = ufl.split(w_t)[0] if w_t is not None else None
+    r_t, alpha_t = ufl.split(w_t)[:2] if w_t is not None else (None, None)
     r_tt, alpha_tt = ufl.split(w_tt)[:2] if w_tt is not None else (None, None)
     return residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, test_fields(test), c, degree,
-                              penalty, measures, kappa=kappa[0] if kappa else None)
+                              penalty, measures, kappa=kappa[0] if kappa else None,
+                              alpha_t=alpha_t)
 
 
 def test_fields(test):
@@ -196,19 +205,24 @@ def test_fields(test):
 
 
 def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, degree: int,
-                       penalty, measures, kappa=None):
+                       penalty, measures, kappa=None, alpha_t=None):
     """:func:`residual` on fields given one by one, so that (r, alpha) and
     their rates may live in a larger mixed space (the first-order form of the
     dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
     the curvature field of the mixed bending form, with the test
-    ``tests[2]``."""
+    ``tests[2]``.  ``alpha_t``: the twist rate, read by the structural damping
+    (``c.damped``, forms/damping.py) only."""
     dx, dS, ds = measures
     v, psi, *eta = tests
+    moving = r_t is not None
     if r_t is None:
         r_t = ufl.as_vector((0.0, 0.0, 0.0))
     F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds,
                           kappa=kappa, eta=eta[0] if eta else None)
          - ufl.inner(body_force(r_t, c), v) * dx)
+    if c.damped and moving:  # Kelvin-Voigt, from the dissipation potential
+        from rawehelix.forms import damping  # (damping builds on this module)
+        F += damping.viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
     return F

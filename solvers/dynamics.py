@@ -426,11 +426,13 @@ class DynamicsSolver:
 
     # -- energy (normalised) ----------------------------------------------------------
     def energy(self) -> dict:
-        """Kinetic, potential and non-variational power of the current state (collective)."""
-        out = {}
-        for name in ("kinetic", "potential", "power_nv"):
-            out[name] = self.comm.allreduce(
-                dolfinx.fem.assemble_scalar(getattr(self.form, name)), op=MPI.SUM)
+        """Kinetic, potential, non-variational power and the power dissipated by the
+        structural damping, 2 D (0 without it), of the current state (collective)."""
+        out = {"dissipation": 0.0}
+        for name in ("kinetic", "potential", "power_nv", "dissipation"):
+            form = getattr(self.form, name)
+            if form is not None:
+                out[name] = self.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
         return out
 
 

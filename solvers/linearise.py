@@ -8,7 +8,8 @@ with the three Jacobians of the full residual F(w, w_t, w_tt; v) of
 Eqs. (30)-(31) (:func:`rawehelix.forms.rod.residual`):
 
     K = dF/dw     at (w0, 0, 0)   elastic + geometric stiffness (32)-(34),
-    C = dF/dw_t   at (w0, 0, 0)   the linearised drag of Eq. (28),
+    C = dF/dw_t   at (w0, 0, 0)   the linearised drag of Eq. (28) and the
+                                  structural damping (forms/damping.py),
     M = dF/dw_tt                  the mass, int r_tt.v + alpha_tt psi.
 
 Boundary conditions: the displacement vanishes at s = 0 and s = 1
@@ -34,6 +35,8 @@ conditions kappa = 0 (37) are in the bcs like the displacement's.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import ufl
 from mpi4py import MPI
@@ -66,7 +69,13 @@ class Linearisation:
         F = rod_forms.residual(rod.w, self.w_t, self.w_tt, rod.test, rod.c, rod.degree,
                                rod.penalty, rod.measures)  # (30)-(31)
         du = rod.trial
-        self.a_K = dolfinx.fem.form(ufl.derivative(F, rod.w, du))
+        # structural damping (forms/damping.py): its forces are linear in the rates, so
+        # they add nothing to K at w_t = 0; K is taken of the residual without them
+        # (the same K, for a fraction of the assembly)
+        F_K = F if not rod.c.damped else rod_forms.residual(
+            rod.w, self.w_t, self.w_tt, rod.test, dataclasses.replace(rod.c, damped=False),
+            rod.degree, rod.penalty, rod.measures)
+        self.a_K = dolfinx.fem.form(ufl.derivative(F_K, rod.w, du))
         self.a_C = dolfinx.fem.form(ufl.derivative(F, self.w_t, du))
         self.a_M = dolfinx.fem.form(ufl.derivative(F, self.w_tt, du))
         self.bcs = self._fixed_ends()

@@ -45,7 +45,7 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.errors import SceneError
 from rawehelix.solvers.fields import set_constant
-from rawehelix.forms import energy, rod
+from rawehelix.forms import damping, energy, rod
 from rawehelix.solvers.discrete import RodDiscretisation
 
 
@@ -99,6 +99,11 @@ class _Formulation:
             self.rod.measures, kappa=fields.kappa))
         self.power_nv = dolfinx.fem.form(energy.non_variational_power(
             fields.r, fields.alpha, fields.r_t, self.rod.c, dx, kappa=fields.kappa))
+        # 2 D, the power of the structural damping (forms/damping.py); None: undamped
+        self.dissipation = None if not self.rod.c.damped else dolfinx.fem.form(
+            2 * damping.dissipation(fields.r, fields.r_t, fields.alpha_t,
+                                    self.rod.c, self.rod.degree, self.rod.penalty,
+                                    self.rod.measures))
         self.b = compat.create_vector(self.F)
         self._scratch = self.b.duplicate()
         owned = self.b.getLocalSize()
@@ -258,7 +263,7 @@ class FirstOrder(_Formulation):
         dx = rod_.measures[0]
         F = (ufl.inner(r_t - v_r, w_r) + (alpha_t - omega) * chi) * dx \
             + rod.residual_of_fields(r, alpha, v_r, v_r_t, omega_t, (v, psi), c_dyn,
-                                     rod_.degree, rod_.penalty, rod_.measures)
+                                     rod_.degree, rod_.penalty, rod_.measures, alpha_t=omega)
         trial = ufl.TrialFunction(self.W2)
         J = ufl.derivative(F, self.x, trial) + self.shift * ufl.derivative(F, self.x_t, trial)
         self._compile(F, J, fields, c_dyn)

@@ -2,7 +2,7 @@
 
 A scene has the sections of :class:`rawehelix.parameters.Parameters`
 (``[helix]``, ``[ends]``, ``[environment]``, ``[torque]``, ``[controller]``,
-``[model]``, ``[discretisation]``, ``[time]``) and an optional top-level
+``[model]``, ``[damping]``, ``[discretisation]``, ``[time]``) and an optional top-level
 ``title``.  ``studies/scenes/example.toml`` documents every key.
 
 Any problem raises :class:`SceneError`, whose message names the file, the key
@@ -17,15 +17,16 @@ import tomllib
 from pathlib import Path
 
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
-from rawehelix.parameters import (Controller, Discretisation, Ends, Environment,
+from rawehelix.parameters import (Controller, Damping, Discretisation, Ends, Environment,
                                         Helix, Model, ParameterError, Parameters, Sweep,
                                         Time, Torque)
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
     "controller": Controller, "model": Model, "discretisation": Discretisation,
-    "time": Time, "sweep": Sweep,
+    "time": Time, "sweep": Sweep, "damping": Damping,
 }
+NESTED = {"damping": "model"}  # sections held by another section's dataclass
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"
@@ -50,7 +51,7 @@ def _section(path, name: str, table) -> object:
     cls = SECTIONS[name]
     if not isinstance(table, dict):
         raise SceneError(path, name, "must be a table [" + name + "]")
-    fields = {f.name: f for f in dataclasses.fields(cls)}
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.name not in NESTED}
     values = {}
     for key, value in table.items():
         if key not in fields:
@@ -80,6 +81,10 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
         if name_ not in data:
             raise SceneError(path, name_, f"the section [{name_}] is required")
     sections = {s: _section(path, s, data[s]) for s in SECTIONS if s in data}
+    for nested, holder in NESTED.items():  # [damping] -> Model.damping
+        if nested in sections:
+            sections[holder] = dataclasses.replace(sections.get(holder, SECTIONS[holder]()),
+                                                   **{nested: sections.pop(nested)})
     label = name if name is not None else Path(str(path)).stem
     try:
         return Parameters(**sections, name=label, title=data.get("title", label))

@@ -56,15 +56,18 @@ def test_example_documents_every_key_with_its_default():
     path = scene.resolve("example")
     data = tomllib.loads(path.read_text())
     required = set()
-    for section in dataclasses.fields(parameters.Parameters):
-        if section.name not in scene.SECTIONS:
-            continue  # the labels name and title: from the file's name and its title line
-        table = data.get(section.name)
-        assert isinstance(table, dict), f"[{section.name}] is missing"
-        fields = dataclasses.fields(getattr(parameters, section.type))  # type names: annotations
-        assert set(table) == {f.name for f in fields}, f"[{section.name}]: keys differ"
+    # the sections of Parameters, and those held by another section ([damping] in the model)
+    sections = [(s.name, s.type) for s in dataclasses.fields(parameters.Parameters)
+                if s.name in scene.SECTIONS] + [(n, scene.SECTIONS[n].__name__) for n in scene.NESTED]
+    assert {name for name, _ in sections} == set(scene.SECTIONS)
+    for name, type_name in sections:  # (not the labels name and title: file name, title line)
+        table = data.get(name)
+        assert isinstance(table, dict), f"[{name}] is missing"
+        fields = [f for f in dataclasses.fields(getattr(parameters, type_name))  # annotations
+                  if f.name not in scene.NESTED]
+        assert set(table) == {f.name for f in fields}, f"[{name}]: keys differ"
         for f in fields:
-            key = f"{section.name}.{f.name}"
+            key = f"{name}.{f.name}"
             if f.default is dataclasses.MISSING:
                 required.add(key)
             elif key not in EXAMPLE_NOT_DEFAULT:

@@ -1,0 +1,130 @@
+"""Structural damping (the scene's ``[damping]``): Kelvin-Voigt on the strain rates.
+
+Each viscous stress is the elastic modulus x the retardation time x the
+strain rate: N_v = EA tau_a eps_t, m_v = EI tau_b kappa_t, M_v = GJ tau_t tau_t.
+They come from a Rayleigh dissipation potential, normalised as
+:mod:`rawehelix.forms.energy` (power in units of M g L0 / t_scale, the
+retardation times divided by t_scale, Eq. 25):
+
+    D = 1/2 int sigma tau_a eps_t^2 + beta tau_t tau_t^2 ds + tau_b mu D_b,
+
+and the viscous part of the residual is its derivative with respect to the
+velocity (r_t, alpha_t) in the direction (v, delta/beta psi) (the twist row
+scaled by delta/beta like the elastic one, forms/energy.py): residual and
+Jacobian agree, C = d^2 D / d w_t^2 is symmetric, and since D is quadratic in
+the rates the dissipated power is R_v(w_t) = 2 D.
+
+The rates (t = r'/|r'|, t_t = (I - t t) r_t'/|r'| its rate):
+
+* eps_t = d|r'|/dt = t . r_t' (the rate of eps = |r'| - 1, Eq. 29);
+* tau_t = d tau/dt of Eq. (34) (alpha_t' with gamma off);
+* bending: the co-rotational rate of the curvature measure q (r'' with the
+  paper's kinematics, t' with the extensible ones, forms/extensible.py) in the
+  frame that turns with the tangent, w = t x t_t:
+
+      b = q_t - w x q.
+
+Which motions are not damped.  A rigid translation (r_t = c) and the steady
+spin of Sec. 5.2 (r_t = 0, alpha_t uniform) have eps_t = tau_t = b = 0.  A
+rigid rotation r_t = Omega x r has eps_t = tau_t = 0 (|r'| and tau are
+invariants) and b = (Omega . t) t x q: zero on a straight rod (to first order
+about one: the modes of Table 3), and for a planar state turning about the
+normal of its plane (Omega . t = 0), but not for a curved rod turning about an
+axis along its tangent.  Making that zero needs the sections' axial spin in
+the rate; in this model that is alpha_t, and with it the steady spin of a
+sagging rod would be damped (the rotating damping of a bent shaft), which the
+switch is specified not to do (tests/test_damping.py measures both).
+
+Discretisation (C0 Lagrange, interior penalty): D_b is the IP energy of the
+rate, as the elastic bending form is that of r (forms/rod.py::bending) or of t
+(forms/extensible.py),
+
+    D_b = 1/2 int |b|^2 dx - sum_nodes {{b}}.[[j]]_t + alpha_ip/2 sum_nodes |[[j]]_t|^2,
+
+with [[j]] the node jump of r' (paper) or t (extensible) and [[j]]_t =
+[[j_t]] - {{w}} x [[j]] its co-rotational rate.  About a straight state it is
+1/2 B(r_t, r_t) (paper) or U_b(t_t) (extensible): symmetric and coercive on
+the jumps like the elastic form.  The mixed bending form and the spline
+scheme are refused (parameters.py).
+"""
+
+from __future__ import annotations
+
+import ufl
+
+from rawehelix.forms import extensible
+from rawehelix.forms.kinematics import d, stretch, twist
+from rawehelix.forms.rod import Coefficients, ip_penalty, jump_d
+
+
+def tangent_rate(r, r_t):
+    """t_t = (I - t t) r_t' / |r'|, the rate of t = r'/|r'|."""
+    t = extensible.unit_tangent(r)
+    return (d(r_t) - ufl.dot(t, d(r_t)) * t) / stretch(r)
+
+
+def frenet_torsion_rate(r, r_t, eps):
+    """d gamma/dt along r_t of the regularised Frenet torsion of Eq. (34),
+    gamma = r'.(r'' x r''')/(|r''|^2 + eps^2) (forms/kinematics.py::frenet_torsion)."""
+    r1, r2, r3 = d(r), d(r, 2), d(r, 3)
+    u1, u2, u3 = d(r_t), d(r_t, 2), d(r_t, 3)
+    num = ufl.dot(r1, ufl.cross(r2, r3))
+    num_t = (ufl.dot(u1, ufl.cross(r2, r3)) + ufl.dot(r1, ufl.cross(u2, r3))
+             + ufl.dot(r1, ufl.cross(r2, u3)))
+    den = ufl.dot(r2, r2) + eps**2
+    return num_t / den - num * 2 * ufl.dot(r2, u2) / den**2
+
+
+def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
+    """(eps_t, tau_t, b, [[j]]_t) of the module docstring at the state r, each linear
+    in (r_t, alpha_t); ``alpha_t`` None (the planar model): tau_t None."""
+    t, t_t = extensible.unit_tangent(r), tangent_rate(r, r_t)
+    w = ufl.cross(t, t_t)  # the tangent's spin
+
+    def jump(f):  # [[f]] at a node
+        return f("+") * n("+")[0] + f("-") * n("-")[0]
+
+    if c.kinematics == "extensible":  # q = t', [[j]] = [[t]]
+        q, q_t, j, j_t = d(t), d(t_t), jump(t), jump(t_t)
+    else:  # q = r'', [[j]] = [[r']]
+        q, q_t, j, j_t = d(r, 2), d(r_t, 2), jump_d(r, n), jump_d(r_t, n)
+    b = q_t - ufl.cross(w, q)
+    jb = j_t - ufl.cross(0.5 * (w("+") + w("-")), j)
+    eps_t = ufl.dot(t, d(r_t))  # d|r'|/dt
+    tau_t = None if alpha_t is None else (
+        c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps) + d(alpha_t))  # (34)
+    return eps_t, tau_t, b, jb
+
+
+def _bilinear(x, y, c: Coefficients, degree: int, penalty, measures):
+    """The symmetric form B(x, y) of D = 1/2 B(x, x), x = :func:`strain_rates`."""
+    dx, dS, _ = measures
+    (ea, ta, ba, ja), (eb, tb, bb, jb) = x, y
+    B_b = (ufl.dot(ba, bb) * dx
+           + (-ufl.dot(0.5 * (ba("+") + ba("-")), jb) - ufl.dot(0.5 * (bb("+") + bb("-")), ja)
+              + ip_penalty(degree, penalty, dS) * ufl.dot(ja, jb)) * dS)
+    B = c.sigma * c.tau_a * ea * eb * dx + c.bending * c.mu * c.tau_b * B_b
+    if ta is not None:
+        B += c.beta * c.tau_t * ta * tb * dx
+    return B
+
+
+def dissipation(r, r_t, alpha_t, c: Coefficients, degree: int, penalty, measures):
+    """D of the module docstring at the state r and the rates (r_t, alpha_t);
+    ``alpha_t`` None (the planar model) drops the torsion term."""
+    x = strain_rates(r, r_t, alpha_t, c, ufl.FacetNormal(measures[0].ufl_domain()))
+    return 0.5 * _bilinear(x, x, c, degree, penalty, measures)
+
+
+def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, penalty, measures):
+    """dD/d(r_t, alpha_t) in the direction (v, delta/beta psi): the viscous forces.
+
+    The rates are linear in (r_t, alpha_t), so this derivative is B(x(r_t, alpha_t),
+    x(v, delta/beta psi)), x the rates.  Written so, its UFL is a fraction of that
+    of the Gateaux derivative of :func:`dissipation` (extensible.variation), which
+    tests/test_damping.py assembles against it."""
+    n = ufl.FacetNormal(measures[0].ufl_domain())
+    planar = psi is None
+    x = strain_rates(r, r_t, None if planar else alpha_t, c, n)
+    y = strain_rates(r, v, None if planar else c.delta / c.beta * psi, c, n)
+    return _bilinear(x, y, c, degree, penalty, measures)
