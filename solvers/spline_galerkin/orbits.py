@@ -28,9 +28,9 @@ of the stationary start (the constant the brute-force sweep keeps); m0 is
 then periodic by itself when Delta = alpha_dot* T1, and the reduced map's
 multipliers are the physical ones.
 
-The shooting Newton, the rotation Delta and the orbit's summary are those of
-:class:`rawehelix.solvers.orbits.AlphaMap` (inherited); only the period map
-is this scheme's own, so the continuation (:mod:`rawehelix.solvers.continuation`)
+The shooting Newton, the rotation Delta and the orbit's summary are the
+scheme-independent ones of :class:`rawehelix.solvers.floquet.PeriodMap`
+(numpy only: no FE code); only the period map is this scheme's own, so the continuation (:mod:`rawehelix.solvers.continuation`)
 traces the paper's N = 2 curve with its unstable branch as it does the FE's.
 """
 
@@ -43,8 +43,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rawehelix.parameters import Parameters
-from rawehelix.solvers.orbits import AlphaMap
-from rawehelix.solvers.snes import SolverError
+from rawehelix.errors import SolverError
+from rawehelix.solvers.floquet import PeriodMap
 
 from . import stationary
 from .dynamics import initial_state
@@ -58,7 +58,7 @@ VARIATIONAL_TOL = 1e-5  # its estimated error, relative to max |Phi| (a chord Ja
 # and multipliers to 1e-5; observed order 4: 512 substeps at 10 Hz, N = 2)
 
 
-class SplineMap(AlphaMap):
+class SplineMap(PeriodMap):
     """The period map of the spline-Galerkin scheme at N elements, with its tangent."""
 
     def __init__(self, params: Parameters, elements: int | None = None):
