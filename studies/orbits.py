@@ -70,7 +70,7 @@ class OrbitsResult:
     @property
     def discretisation(self) -> str:
         if self.scheme == "spline":
-            return f"spline N = {self.elements}, Radau (adaptive)"
+            return f"spline N = {self.elements}, Radau"
         return f"N = {self.elements}, p = {self.degree}, dt = {self.dt_s * 1e3:g} ms"
 
     @property
