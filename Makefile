@@ -11,8 +11,9 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 MPIRUN  := mpirun -n $(NP) --oversubscribe
 PYTEST_ARGS ?=
+MARKS   ?= not long
 
-.PHONY: install demo test test-debian13 bench clean
+.PHONY: install demo test test-long test-debian13 bench clean
 
 install:
 	@bash scripts/install.sh
@@ -21,8 +22,11 @@ demo: install
 	$(PY) -m rawehelix.studies.demo results
 
 test: install
-	$(PY) -m pytest -q $(PYTEST_ARGS)
-	$(MPIRUN) $(PY) -m pytest -q -m mpi -p no:cacheprovider $(PYTEST_ARGS)
+	$(PY) -m pytest -q -m "$(MARKS)" $(PYTEST_ARGS)
+	$(MPIRUN) $(PY) -m pytest -q -m "mpi and ($(MARKS))" -p no:cacheprovider $(PYTEST_ARGS)
+
+test-long: install
+	$(PY) -m pytest -q -m long $(PYTEST_ARGS)
 
 test-debian13:
 	@bash scripts/test-debian13.sh

@@ -223,7 +223,8 @@ def s_curve(alpha_map):
     return branch
 
 
-@pytest.mark.slow  # the s_curve and 14 points
+@pytest.mark.long  # the s_curve (~2 min) and 14 points
+@pytest.mark.slow
 def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map, s_curve):
     """N = 4, through the primary peak (T max moves by at most 5 % between
     points): the peak found between three points and refined by correctors at
@@ -253,7 +254,8 @@ def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map, s_curve
     assert fine_peak["f1_Hz"] == pytest.approx(peak["f1_Hz"], abs=0.01)
 
 
-@pytest.mark.slow  # the s_curve and 6 orbits
+@pytest.mark.long  # the s_curve (~2 min) and 6 orbits
+@pytest.mark.slow
 def test_folds_and_stability_verdicts_under_refinement(alpha_map, s_curve):
     """Issue test 5 at N = 4: two folds (12.700 Hz, 539.0 N and 11.972 Hz,
     211.1 N, each beyond both points of its bracket, error estimates 4.4e-3 /
