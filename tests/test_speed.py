@@ -7,7 +7,6 @@ import pytest
 from mpi4py import MPI
 
 from rawehelix import compat
-
 from rawehelix.families import VIBRATIONS
 from rawehelix.forms import rod
 from rawehelix.solvers.forced import FEBackend
