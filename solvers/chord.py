@@ -111,13 +111,8 @@ class ChordAlpha(AlphaMap):
             if not size < math.inf:  # NaN or Inf
                 raise SolverError(f"chord alpha2: the state became NaN or Inf at t = {t:.6g} "
                                   f"(normalised)")
-            if size <= noise:  # at round-off: R(z) is at its floor
-                z -= dz
-                va -= sv * dz
-                aa -= sa * dz
-                self.iterations += 1
-                break
-            theta = None if last is None else size / last
+            at_floor = size <= noise  # at round-off: R(z) is at its floor
+            theta = None if at_floor or last is None else size / last
             if theta is not None and theta >= 1.0:  # diverging: back, and a fresh Jacobian
                 if fresh:
                     raise SolverError(
@@ -130,6 +125,8 @@ class ChordAlpha(AlphaMap):
             va -= sv * dz
             aa -= sa * dz
             self.iterations += 1
+            if at_floor:
+                break
             if theta is not None:
                 eta = theta / (1.0 - theta)  # |z - z*| <= eta |dz| while theta holds
                 if eta * size <= self.tol:

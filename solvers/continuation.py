@@ -39,7 +39,7 @@ import time
 import numpy as np
 import scipy.linalg
 
-from rawehelix.solvers.orbits import AlphaMap, Orbit
+from rawehelix.solvers.floquet import Orbit, PeriodMap
 from rawehelix.solvers.snes import SolverError
 
 log = logging.getLogger(__name__)
@@ -103,7 +103,7 @@ class State:
 class Branch:
     """A branch of orbits traced by pseudo-arclength continuation."""
 
-    def __init__(self, alpha_map: AlphaMap, ds: float = 0.1, ds_min: float = 1e-4,
+    def __init__(self, alpha_map: PeriodMap, ds: float = 0.1, ds_min: float = 1e-4,
                  ds_max: float = 0.5, tol: float = 1e-7, max_it: int = 8,
                  tension_step: float = TENSION_STEP):
         if not alpha_map.controller:

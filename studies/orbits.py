@@ -148,7 +148,7 @@ class WindowStore:
         """(orbits, state, folds, bifurcations, peaks) of the stored points, or None.
         Points after the state's index (written before an interruption) are dropped."""
         from rawehelix.solvers.continuation import State
-        from rawehelix.solvers.orbits import Orbit
+        from rawehelix.solvers.floquet import Orbit
         path = self.dir / "state.npz"
         if not path.exists():  # stopped before the first point was whole
             for stray in self.dir.glob("p*.*"):
