@@ -37,9 +37,9 @@ from mpi4py import MPI  # noqa: E402
 
 from rawehelix.solvers.modal import ModalSolver  # noqa: E402
 from rawehelix.solvers.stationary import StationarySolver  # noqa: E402
+from rawehelix.parameters import PAPER_EI_LAW  # noqa: E402
 from rawehelix.studies import scene  # noqa: E402
 
-EQ64 = {"a_Nm2_per_N": 52.4, "b_Nm2": 2290.0}  # Eq. (64)
 MODELS = ("paper", "extensible", "law")
 LATERAL = ("lateral_in_plane", "lateral_out_of_plane")
 
@@ -52,7 +52,7 @@ def params(name: str, model: str, N: int):
     if model == "paper":
         return p
     return p.replace(model={"kinematics": "extensible"},
-                     helix={"EI_law": EQ64 if model == "law" else None})
+                     helix={"EI_law": PAPER_EI_LAW if model == "law" else None})
 
 
 def run(p):

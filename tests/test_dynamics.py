@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from rawehelix.parameters import PAPER_EI_LAW
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import scene, simulate
@@ -202,9 +203,9 @@ def test_energy_is_conserved(kinematics):
     Eq. (64) as well (helix.EI_law, U with mu(eps)): drift 6.7e-7, work 6.4e-8,
     balance 7.0e-7."""
     kinematics, _, law = kinematics.partition("+")
-    p = free_scene(elements=8).replace(  # EI_law: Eq. (64), tests/test_eilaw.py
+    p = free_scene(elements=8).replace(  # EI_law: Eq. (64)
         model={"kinematics": kinematics},
-        helix={"EI_law": {"a_Nm2_per_N": 52.4, "b_Nm2": 2290.0} if law else None})
+        helix={"EI_law": PAPER_EI_LAW if law else None})
     q = p.normalised()
     T = q.chord_tension()
     period = 2 * math.pi / math.sqrt(T * math.pi**2 + q.mu * math.pi**4)  # pinned tensioned beam

@@ -24,14 +24,14 @@ from mpi4py import MPI
 
 from rawehelix.forms import extensible
 from rawehelix.forms.kinematics import d
-from rawehelix.parameters import EILaw, ParameterError
+from rawehelix.parameters import PAPER_EI_LAW, EILaw, ParameterError
 from rawehelix.solvers import shooting
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene
 from tests_util import assert_same_on_one_and_two_ranks, residual_and_energy_derivative
 
-EQ64 = {"a_Nm2_per_N": 52.4, "b_Nm2": 2290.0}  # Eq. (64)
+EQ64 = PAPER_EI_LAW  # Eq. (64)
 P = 3
 
 
@@ -47,7 +47,7 @@ def test_law_parameters_and_normalisation():
     the torsional inertia (delta) and mu; the scene file's inline table is read."""
     p = table2()
     q, h = p.normalised(), p.helix
-    assert isinstance(h.EI_law, EILaw) and q.bending_law
+    assert h.EI_law == EILaw(52.4, 2290.0) and q.bending_law
     T_N = 200.0
     mu_of_T = q.mu_per_tension * T_N / q.force_scale + q.mu_at_zero_tension
     assert mu_of_T == pytest.approx(h.EI_law.EI_Nm2(T_N) / (h.mass_kg * 9.81 * h.length_m**2),
@@ -63,7 +63,7 @@ def test_default_is_off_and_fingerprints_unchanged():
     assert p.helix.EI_law is None and not p.normalised().bending_law
     assert "EI_law" not in p.as_dict()["helix"]
     assert p.describe_model() == p.model.describe()
-    assert table2().as_dict()["helix"]["EI_law"] == EQ64
+    assert table2().as_dict()["helix"]["EI_law"] == {"a_Nm2_per_N": 52.4, "b_Nm2": 2290.0}
 
 
 def test_scene_file(tmp_path):
@@ -71,7 +71,7 @@ def test_scene_file(tmp_path):
     text = text.replace("[helix]", "[helix]\nEI_law = {a_Nm2_per_N = 52.4, b_Nm2 = 2290}", 1)
     path = tmp_path / "law.toml"
     path.write_text(text + '\n[model]\nkinematics = "extensible"\n')
-    assert scene.load(path).helix.EI_law == EILaw(**EQ64)
+    assert scene.load(path).helix.EI_law == EQ64
     path.write_text(text)  # the paper's kinematics: refused, the key named
     with pytest.raises(scene.SceneError, match="helix.EI_law.*extensible"):
         scene.load(path)
