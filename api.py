@@ -108,12 +108,14 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
 
 
 def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None,
-           outdir=None, tension_step=None, max_points: int = 400):
+           outdir=None, tension_step=None, max_points: int = 400, superharmonics=None):
     """The branch of periodic orbits of Sec. 5.3 from f1_start towards f1_stop [Hz]:
     shooting on the period map of the generalised-alpha integrator, Floquet
     multipliers from its tangent, pseudo-arclength continuation through folds,
     the step held so that T max changes by at most ``tension_step`` (relative)
-    between points.  An :class:`~rawehelix.studies.orbits.OrbitsResult` with
+    between points, and closing in on the k:1 superharmonic sites f_n / k of the
+    lateral natural frequencies (k in ``superharmonics``, default (2, 3); () for
+    none), reported in ``peaks``.  An :class:`~rawehelix.studies.orbits.OrbitsResult` with
     ``branch`` (``f1_Hz``, ``tension_max_N``, ``tension_min_N``, ``stable``,
     ``max_multiplier``, ``newton_iterations``), ``folds``, ``bifurcations``,
     ``peaks`` and ``summary``.  ``progress(orbit)`` is called at every point.
@@ -121,5 +123,6 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     ``outdir`` every point is stored as found and a rerun resumes after the last."""
     from rawehelix.studies import orbits as study
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
-                         outdir=outdir, tension_step=tension_step, max_points=max_points)
+                         outdir=outdir, tension_step=tension_step, max_points=max_points,
+                         superharmonics=superharmonics)
 

@@ -76,6 +76,10 @@ def _parser() -> argparse.ArgumentParser:
             p.add_argument("--max-points", type=int, default=400,
                            help="stop each rank's window after this many points (a rerun "
                                 "with the same -o resumes)")
+            p.add_argument("--superharmonics", default="2,3", metavar="K[,K...]",
+                           help="orders k of the k:1 resonances f_n / k of the lateral natural "
+                                "frequencies where the step closes in on a multiplier's "
+                                "crossing of +1 ('none': the T max step only)")
         if name in ("sweep", "response"):
             p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
                            help="frequencies in Hz (default: the scene's [sweep] section)")
@@ -213,8 +217,15 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     except ValueError:
         raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
     try:
+        orders = (() if args.superharmonics.strip().lower() == "none"
+                  else tuple(int(k) for k in args.superharmonics.split(",")))
+    except ValueError:
+        raise SceneError("--superharmonics", args.superharmonics,
+                         "must be integers K[,K...] >= 2 or 'none'") from None
+    try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
+                           superharmonics=orders,
                            progress=lambda o: _say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
                                                    f"{o.tension_max_N:.2f} N, |multiplier| "
                                                    f"{o.max_multiplier:.5f}"))
