@@ -3,6 +3,7 @@ of the period map, and the orbit against the brute-force periodic response."""
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 import rawehelix as rh
 from rawehelix.solvers.forced import FEBackend
@@ -385,6 +386,10 @@ def test_small_amplitude_orbit_is_the_linear_response():
     assert amplitudes[0] == pytest.approx(linear, rel=1e-3)
 
 
+def _rotation(theta):
+    return np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+
+
 class _LinearMap:
     """A stand-in for AlphaMap with a period map whose fixed point X*(f1) and
     monodromy M(f1) are known: P(X) = X* + M (X - X*).  ``kind`` picks the
@@ -396,20 +401,21 @@ class _LinearMap:
     def __init__(self, kind):
         from types import SimpleNamespace
         self.kind, self.q = kind, SimpleNamespace(tension_N=lambda t: np.asarray(t))
+        self.size = 5 if kind == "superharmonic" else 3
 
     def monodromy(self, f1):
         r = 0.9 + 0.2 * (f1 - 10.0)
-        if self.kind == "superharmonic":  # a mode at 10 Hz, |mu| = 0.95: 2:1 at 5 Hz
-            theta = 2 * np.pi * 10.0 / f1
-            c, s = 0.95 * np.cos(theta), 0.95 * np.sin(theta)
-            return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 0.5]])
+        if self.kind == "superharmonic":  # a mode at 10 Hz, |mu| = 0.95: 2:1 at 5 Hz;
+            # a 14.6 Hz one (not a site), |mu| = 0.97, passes +1 at 4.867 Hz (3:1)
+            return scipy.linalg.block_diag(*(r * _rotation(2 * np.pi * f / f1)
+                                              for r, f in ((0.95, 10.0), (0.97, 14.6))), 0.5)
         if self.kind == "period_doubling":
             return np.diag([-r, 0.5, 0.5])
         c, s = r * np.cos(1.2), r * np.sin(1.2)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 0.5]])
 
     def fixed(self, f1):
-        return np.array([1.0, 2.0, 3.0]) * (f1 - 10.0)
+        return np.arange(1.0, 1.0 + self.size) * (f1 - 10.0)
 
     def rotation(self, f1):
         return 0.0
@@ -419,7 +425,7 @@ class _LinearMap:
 
     def shooting_residual(self, X, f1, delta, tangent=False, steps=None):
         M = self.monodromy(f1)
-        G = (M - np.eye(3)) @ (X - self.fixed(f1))
+        G = (M - np.eye(self.size)) @ (X - self.fixed(f1))
         return G, np.array([100.0 + 10.0 * f1]), (M if tangent else None)
 
     def finish(self, X, f1, delta, its, res, start, steps=None):
@@ -458,8 +464,10 @@ def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     """A stand-in map whose multiplier pair 0.95 exp(+-2 pi i 10 Hz / f1) passes +1
     at f1 = 5 Hz (2:1 of a 10 Hz mode): with the site named, the steps near it
     shrink with |mu - 1| and the resonance is located by the vertex of |mu - 1|^2
-    to 1e-3 Hz, |mu - 1| there = 1 - 0.95; without it the T max step alone (T max
-    is linear here) steps over it and reports nothing."""
+    to 1e-3 Hz, |mu - 1| there = 1 - 0.95; another mode's pair passing nearer +1
+    inside the window (at 4.867 Hz) is not taken for the site's (the tracking);
+    without the site the T max step alone (T max is linear here) steps over it
+    and reports nothing."""
     from rawehelix.solvers.continuation import Branch, Site, sites_for
 
     m = _LinearMap("superharmonic")
