@@ -274,7 +274,8 @@ class Branch:
         self.w[:n] = abs(tau[-1]) / max(np.linalg.norm(tau[:n]), 1e-300)
         tau, A, gf = self._tangent(first, tau, steps)
         self.points = [first]
-        self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=self.ds)
+        ds = max(self.ds_min, self._site_step(self.points, tau[-1], self.ds))
+        self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=ds)
 
     def resume(self, points: list[Orbit], state: State, folds=(), bifurcations=(), peaks=()):
         """Continue from stored points and the state after the last of them."""
