@@ -90,9 +90,12 @@ def count_below(q, tension: float, omega: float, twist: bool = True) -> int:
 #     w(L) = F/T (L - tanh(kL)/k),  k^2 = T/EI,
 # and F L^3 / (3 EI) at T = 0.  The paper's Eq. (63), EI = F L^3 / (3 w(L)),
 # then infers EI T L^2 / (3 EI (1 - tanh(kL)/(kL))) = EI + 2 T L^2 / 5 + O(T^2 L^4 / EI).
-# The paper's kinematics (forms/rod.py) carry the end's tension T_e as T r',
-# |r'| = 1 + eps, so that T_e = EA eps (1 + eps) and the tension of the
-# transverse equation is EA eps = T_e / (1 + eps).
+# The end's tension T_e sets T and EI of the transverse equation through the
+# kinematics (:func:`cantilever_transverse`): the paper's (forms/rod.py) carry
+# it as T r', |r'| = 1 + eps, so that T_e = EA eps (1 + eps), T = EA eps =
+# T_e / (1 + eps) and EI stays; the extensible rod (forms/extensible.py) as T t,
+# T = T_e, eps = T_e / EA, whose energy per unstretched length, linearised about
+# r' = (1 + eps) e, has T_e / (1 + eps) w'^2 / 2 + EI / (1 + eps)^2 w''^2 / 2.
 
 def cantilever_tip_deflection(force, tension, EI, length):
     """w(L) of the clamped segment under the end force F and the tension T (above)."""
@@ -108,6 +111,14 @@ def cantilever_tip_deflection(force, tension, EI, length):
 def cantilever_apparent_EI(EI, tension, length):
     """The EI that Eq. (63) infers from the tensioned cantilever: F L^3 / (3 w(L))."""
     return length**3 / (3 * cantilever_tip_deflection(1.0, tension, EI, length))
+
+
+def cantilever_transverse(tension, EI, EA, kinematics: str = "paper"):
+    """(T, EI) of the transverse equation under the end tension T_e (above)."""
+    if kinematics == "extensible":
+        stretch = 1 + np.asarray(tension, dtype=float) / EA
+        return tension / stretch, EI / stretch**2
+    return tension / (1 + paper_axial_strain(tension, EA)), EI
 
 
 def cantilever_intrinsic_EI(apparent_EI, tension, length):

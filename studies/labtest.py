@@ -221,18 +221,20 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
         summary.update(rod_EI=("Eq. (64) at T_e" if rod_EI_Nm2 is None else "constant"),
                        tension_N=list(tensions), load_N=list(loads), rod_EI_Nm2=rod_EI,
                        apparent_EI_Nm2=apparent, eq64_EI_Nm2=eq64(tensions).tolist(),
-                       closed_form_apparent_EI_Nm2=_closed_form_apparent(params, rod_EI, tensions))
+                       closed_form_apparent_EI_Nm2=closed_form_apparent_EI(params, rod_EI, tensions))
     summary["wall_s"] = time.perf_counter() - start
     log.debug("labtest %s: %.2f s", test, summary["wall_s"])
     return LabTest(params, test, rows, summary, comm.rank)
 
 
-def _closed_form_apparent(params, rod_EI, tensions) -> list:
-    """Eq. (63) on the closed-form tensioned cantilever (solvers/analytic.py), the
-    transverse tension of the paper's kinematics EA eps = T_e / (1 + eps)."""
-    EA = params.helix.EA_N
-    T = np.asarray(tensions) / (1 + analytic.paper_axial_strain(tensions, EA))
-    return [float(analytic.cantilever_apparent_EI(EI, t, LAB_LENGTH_M)) for EI, t in zip(rod_EI, T)]
+def closed_form_apparent_EI(params, rod_EI, tensions) -> list:
+    """Eq. (63) on the closed-form tensioned cantilever of the scene's kinematics
+    (solvers/analytic.py), linear in F_N and without gravity."""
+    out = []
+    for EI, T_e in zip(rod_EI, tensions):
+        T, EI_t = analytic.cantilever_transverse(T_e, EI, params.helix.EA_N, params.model.kinematics)
+        out.append(float(analytic.cantilever_apparent_EI(EI_t, T, LAB_LENGTH_M)))
+    return out
 
 
 def _fit(solver, tensions, loads):
