@@ -123,7 +123,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD) -> ResponseResu
                             "circle (R1 = 0), torque-free ends, at rest (K, C, M of "
                             "solvers.linearise); the rotor torque (69) and the controller "
                             "(40) are not in it",
-        "model": params.model.describe(),
+        "model": params.describe_model(),
         "mean_tension_N": float(q.tension_N(solver.modal.mean_tension_value)),
         "s_mid_m": float(q.length_m(solver.s_mid)),
         "points": [p.entry() for p in points],
