@@ -23,7 +23,10 @@ variation of U_clamp (ufl.derivative), so it is symmetric like the interior term
 
 With ``model.kinematics = "extensible"`` the bending energy lives on the unit
 tangent t = r'/|r'| (forms/extensible.py) and so does the clamp:
-[[t]] = (t - e) n, U_clamp = mu [ -t'.(t - e) n + alpha_ip/2 |t - e|^2 ].
+[[t]] = (t - e) n, U_clamp = -mu t'.(t - e) n + alpha_ip/2 mu |t - e|^2, with
+the EI law's mu(eps) at the wall (forms/extensible.py::bending_modulus): the
+wall term of int mu t'.dt' is -mu t'.dt, cancelled as above, and the
+variation of mu(eps) multiplies t - e = 0 at the exact solution.
 
 The end loads are dead loads, potentials at s = 1: a force P (the tension T_e
 along the undeformed axis plus the bending test's F_N normal to it) has the
@@ -51,8 +54,8 @@ def wall_weight(mesh):
 
 
 def clamp_energy(r, axis, mu, kinematics: str, degree: int, penalty, ds):
-    """U_clamp at the wall s = 0 (see above); ``mu`` includes the bending switch,
-    ``penalty`` is eta (discretisation.penalty)."""
+    """U_clamp at the wall s = 0 (see above); ``mu`` (a number, constant or UFL
+    field) includes the bending switch, ``penalty`` is eta (discretisation.penalty)."""
     mesh = ds.ufl_domain()
     n = ufl.FacetNormal(mesh)[0]
     alpha_ip = penalty * degree**2 / ufl.CellDiameter(mesh)
@@ -60,7 +63,7 @@ def clamp_energy(r, axis, mu, kinematics: str, degree: int, penalty, ds):
         jump, moment = unit_tangent(r) - axis, d(unit_tangent(r))  # [[t]] n, t'
     else:
         jump, moment = normal_part(d(r), axis), d(r, 2)  # [[r']] n, r''
-    return mu * wall_weight(mesh) * (-ufl.dot(moment, jump) * n
+    return wall_weight(mesh) * mu * (-ufl.dot(moment, jump) * n
                                      + 0.5 * alpha_ip * ufl.dot(jump, jump)) * ds
 
 

@@ -6,11 +6,17 @@ Dirichlet conditions, the slope r'(0) along the axis e by the Nitsche term of
 direction) and a torque M_t about the tangent (Eq. 39).  The residual is the
 stationary one of Eqs. (30)-(31) plus the variations of the clamp energy and
 of the load potential.  No file IO; loads and the bending stiffness are
-constants, so one compiled solver serves every load of a test.
+constants, so one compiled solver serves every load of a test.  With the
+helix's EI law (``helix.EI_law``, extensible kinematics) the rod's EI is the
+law's at the local tension, and :meth:`CantileverSolver.set_bending_law`
+changes (a, b) without compiling again; :meth:`set_bending_stiffness` then
+sets the constant EI as the law (0, EI).
 
 Each solve starts from the previous state (a load path, as in the lab); the
-first from the straight segment stretched by P.e / EA.  A load that Newton
-does not reach in one step is approached in halved increments.
+first (and the first after :meth:`CantileverSolver.reset`) from the straight
+segment stretched by P.e / EA.  A load that Newton
+does not reach in one step is approached in halved increments; if it is not
+reached at all, the solver keeps the last equilibrium and raises SolverError.
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.forms import cantilever, kinematics, rod
+from rawehelix.forms import cantilever, extensible, kinematics
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.snes import NewtonSolver, SolverError
@@ -75,7 +81,8 @@ class CantileverSolver:
         self.force = dolfinx.fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
         axis = ufl.as_vector(AXIS)
         x = r.centre_line()
-        U = (cantilever.clamp_energy(x, axis, c.bending * c.mu, c.kinematics, r.degree, r.penalty, ds)
+        mu = extensible.bending_modulus(x, c) if c.kinematics == "extensible" else c.bending * c.mu
+        U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)
         self.newton = NewtonSolver(F, w, r.bcs, prefix="rawehelix_labtest_")
@@ -90,11 +97,21 @@ class CantileverSolver:
         self.loads = None  # the (force, torque) of the current state; None: not solved yet
 
     def set_bending_stiffness(self, EI_Nm2: float):
-        """EI of the rod (and delta = beta sigma / (2 mu), Eq. 27, with it)."""
-        q = self.q
+        """A constant EI of the rod (and delta = beta sigma / (2 mu), Eq. 27, with it)."""
+        q, c = self.q, self.rod.c
         mu = EI_Nm2 / (q.force_scale * q.L0**2)  # (26)
-        self.rod.c.mu.value = mu
-        self.rod.c.delta.value = q.beta * q.sigma / (2 * mu)
+        c.mu.value = mu
+        c.delta.value = q.beta * q.sigma / (2 * mu)
+        if c.bending_law:
+            self.set_bending_law(0.0, EI_Nm2)
+
+    def set_bending_law(self, a_Nm2_per_N: float, b_Nm2: float):
+        """The EI law EI = a T + b of a rod built with one (parameters.Normalised)."""
+        q, c = self.q, self.rod.c
+        if not c.bending_law:
+            raise ValueError("set_bending_law needs a rod built with helix.EI_law")
+        c.mu_a.value = a_Nm2_per_N / q.L0**2
+        c.mu_b.value = b_Nm2 / (q.force_scale * q.L0**2)
 
     def _set_loads(self, force_N, torque_Nm: float):
         self.force.value[:] = np.asarray(force_N, dtype=float) / self.q.force_scale
@@ -115,15 +132,20 @@ class CantileverSolver:
         its = self._reach(force_N, torque_Nm, halvings)
         return self.tip(its)
 
+    def reset(self):
+        """The next solve starts again from the straight segment (a new load path)."""
+        self.loads = None
+
     def _reach(self, force_N, torque_Nm, halvings: int) -> int:
         start = self.rod.w.x.array.copy()
         self._set_loads(force_N, torque_Nm)
         try:
             its = self.newton.solve("the lab test's cantilever")
         except SolverError:
+            self.rod.w.x.array[:] = start  # the last equilibrium, not Newton's last iterate
+            self._set_loads(*self.loads)
             if halvings == 0:
                 raise
-            self.rod.w.x.array[:] = start
             f0, m0 = self.loads
             its = self._reach(0.5 * (f0 + force_N), 0.5 * (m0 + torque_Nm), halvings - 1)
             its += self._reach(force_N, torque_Nm, halvings - 1)

@@ -51,6 +51,7 @@ DEFAULT_TENSIONS_N = {"axial": (50.0, 100.0, 150.0, 200.0, 250.0),
                       "bending": PAPER_BENDING_TENSIONS_N,
                       "torsion": (200.0,)}  # T_e0 ~ 200 N, Fig. 5
 DEFAULT_LOADS = {"bending": (2.5, 5.0, 7.5, 10.0),  # F_N [N]
+                 "fit": (0.1, 0.2, 0.3, 0.4),  # F_N [N]: the small-load limit (docs/labtest.md)
                  "torsion": (5.0, 10.0, 15.0, 20.0, 25.0)}  # M_t [Nm], up to ~25 Nm (Sec. 4)
 FIT_TOLERANCE = 1e-4  # relative: the per-tension root find of the intrinsic EI
 FIT_TARGET = 0.01  # the law's simulated test reproduces Eq. (64) within 1 %
@@ -62,17 +63,23 @@ def eq64(tension_N):
 
 
 def lab_parameters(helix_scene: Parameters, elements: int | None = None,
-                   degree: int | None = None, gravity: bool = True) -> Parameters:
-    """The lab segment: L0 = 6.76 m, the scene helix's mass per length, EA and GJ
-    (EI is set per test), no wind or drag; ``gravity`` as in the lab."""
+                   degree: int | None = None, gravity: bool = True, law: bool = False) -> Parameters:
+    """The lab segment: L0 = 6.76 m, the scene helix's mass per length, EA, GJ and
+    EI law (EI is set per test), no wind or drag; ``gravity`` as in the lab.
+    ``law``: a rod with an EI law (Eq. 64 until the caller sets another), which
+    needs the extensible kinematics (parameters.py)."""
     h = helix_scene.helix
     disc = {"elements": elements or LAB_ELEMENTS}
     if degree is not None:
         disc["degree"] = degree
-    return helix_scene.replace(
-        helix={"length_m": LAB_LENGTH_M, "mass_kg": h.mass_kg / h.length_m * LAB_LENGTH_M},
-        environment={"wind_speed_m_s": 0.0}, model={"drag": False, "gravity": gravity},
-        discretisation=disc, name=f"{helix_scene.name}_lab")
+    helix = {"length_m": LAB_LENGTH_M, "mass_kg": h.mass_kg / h.length_m * LAB_LENGTH_M}
+    model = {"drag": False, "gravity": gravity}
+    if law:
+        model["kinematics"] = "extensible"
+        if h.EI_law is None:
+            helix["EI_law"] = {"a_Nm2_per_N": EQ64[0], "b_Nm2": EQ64[1]}
+    return helix_scene.replace(helix=helix, environment={"wind_speed_m_s": 0.0}, model=model,
+                               discretisation=disc, name=f"{helix_scene.name}_lab")
 
 
 def slope(x, y) -> float:
@@ -97,6 +104,7 @@ def axial_test(solver, tensions_N) -> dict:
 def bending_test(solver, tension_N: float, loads_N) -> dict:
     """Eq. (63) at one tension: end deflections under the loads and the apparent EI."""
     L0 = solver.q.L0
+    solver.reset()  # each tension's load path from the straight segment, as in the lab
     zero = solver.solve(tension_N * solver.axis).position_m
     deflection = [float((solver.solve(tension_N * solver.axis + F * NORMAL).position_m - zero) @ NORMAL)
                   for F in loads_N]
@@ -180,51 +188,68 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
     ``loads``: F_N [N] (bending) or M_t [Nm] (torsion); ``rod_EI_Nm2``: the
     rod's constant EI (default: Eq. (64) at each test's T_e, the paper's
     use of it; the axial and torsion tests at the scene's EI if not given).
-    ``fit`` (bending): identify the intrinsic law instead."""
+    ``fit`` (bending): identify the intrinsic law instead, with the law in the
+    rod (extensible kinematics, which the law needs).  A scene helix with an
+    EI law: the bending test's rod has it (unless ``rod_EI_Nm2``)."""
     from rawehelix.solvers.cantilever import CantileverSolver
 
     start = time.perf_counter()
     _check(test, tensions_N, loads, fit, rod_EI_Nm2)
     tensions = tuple(float(t) for t in (tensions_N or DEFAULT_TENSIONS_N[test]))
-    loads = tuple(float(x) for x in (loads or DEFAULT_LOADS.get(test, ())))
-    params = lab_parameters(helix_scene, elements, degree, gravity)
+    loads = tuple(float(x) for x in (loads or DEFAULT_LOADS.get("fit" if fit else test, ())))
+    scene_law = helix_scene.helix.EI_law if rod_EI_Nm2 is None else None
+    params = lab_parameters(helix_scene, elements, degree, gravity,
+                            law=fit or scene_law is not None)
     solver = CantileverSolver(params, comm)
     h = params.helix
     summary = {"test": test, "scene": helix_scene.name, "length_m": LAB_LENGTH_M,
                "mass_per_length_kg_m": h.mass_kg / h.length_m, "gravity": gravity,
                "elements": params.discretisation.elements,
                "degree": params.discretisation.degree,
-               "model": params.model.describe() + "; clamped at s = 0 (Nitsche slope), "
-               "dead end loads (forms/cantilever.py)",
+               "model": _describe(params),
                "EA_N": h.EA_N, "GJ_Nm2": h.GJ_Nm2}
-    if test == "axial":
+    if scene_law is not None:  # the scene's law, at the local tension
+        solver.set_bending_law(scene_law.a_Nm2_per_N, scene_law.b_Nm2)
+    else:
         solver.set_bending_stiffness(rod_EI_Nm2 or h.EI_Nm2)
+    rod = ("the scene's EI law at the local tension" if scene_law is not None
+           else rod_EI_Nm2 or h.EI_Nm2)
+    if test == "axial":
         rows = [axial_test(solver, tensions)]
-        summary.update(rod_EI_Nm2=rod_EI_Nm2 or h.EI_Nm2, tension_N=list(tensions),
+        summary.update(rod_EI_Nm2=rod, tension_N=list(tensions),
                        strain=rows[0]["strain"], apparent_EA_N=rows[0]["apparent_EA_N"])
     elif test == "torsion":
-        solver.set_bending_stiffness(rod_EI_Nm2 or h.EI_Nm2)
         rows = [torsion_test(solver, T, loads) for T in tensions]
-        summary.update(rod_EI_Nm2=rod_EI_Nm2 or h.EI_Nm2, tension_N=list(tensions),
+        summary.update(rod_EI_Nm2=rod, tension_N=list(tensions),
                        torque_Nm=list(loads),
                        apparent_GJ_Nm2=[r["apparent_GJ_Nm2"] for r in rows])
     elif fit:
         rows, law_summary = _fit(solver, tensions, loads)
         summary.update(law_summary)
+        summary["model"] = _describe(params.replace(helix={"EI_law": law_summary["law"]}))
     else:
-        rod_EI = [rod_EI_Nm2 or float(eq64(T)) for T in tensions]
+        rod_EI = [float(scene_law.EI_Nm2(T)) if scene_law is not None
+                  else rod_EI_Nm2 or float(eq64(T)) for T in tensions]
         rows = []
         for T, EI in zip(tensions, rod_EI):
-            solver.set_bending_stiffness(EI)
+            if scene_law is None:
+                solver.set_bending_stiffness(EI)
             rows.append(bending_test(solver, T, loads))
         apparent = [r["apparent_EI_Nm2"] for r in rows]
-        summary.update(rod_EI=("Eq. (64) at T_e" if rod_EI_Nm2 is None else "constant"),
+        summary.update(rod_EI=("the scene's EI law at the local tension" if scene_law is not None
+                               else "Eq. (64) at T_e" if rod_EI_Nm2 is None else "constant"),
                        tension_N=list(tensions), load_N=list(loads), rod_EI_Nm2=rod_EI,
                        apparent_EI_Nm2=apparent, eq64_EI_Nm2=eq64(tensions).tolist(),
                        closed_form_apparent_EI_Nm2=closed_form_apparent_EI(params, rod_EI, tensions))
     summary["wall_s"] = time.perf_counter() - start
     log.debug("labtest %s: %.2f s", test, summary["wall_s"])
     return LabTest(params, test, rows, summary, comm.rank)
+
+
+def _describe(params) -> str:
+    """summary.json's "model": the rod's terms and law, the clamp and the loads."""
+    return (params.describe_model() + "; clamped at s = 0 (Nitsche slope), dead end loads "
+            "(forms/cantilever.py)")
 
 
 def closed_form_apparent_EI(params, rod_EI, tensions) -> list:
@@ -238,26 +263,54 @@ def closed_form_apparent_EI(params, rod_EI, tensions) -> list:
 
 
 def _fit(solver, tensions, loads):
-    """The intrinsic law EI = a T + b (see the module doc) and its check run."""
+    """The intrinsic law EI = a T + b (see the module doc): the roots of a constant
+    EI per tension, the line through them, then (a, b) refined by Gauss-Newton
+    on the law's own simulated tests (the law in the rod at the local tension)."""
     targets = eq64(tensions)
     roots = [intrinsic_EI(solver, T, t, loads) for T, t in zip(tensions, targets)]
-    a, b = np.polyfit(tensions, roots, 1)
-    law = {"a_Nm2_per_N": float(a), "b_Nm2": float(b)}
-    rows = []
-    for T in tensions:  # the law's own test: EI at the test's T_e
-        solver.set_bending_stiffness(a * T + b)
-        rows.append(bending_test(solver, T, loads))
+    line = np.polyfit(tensions, roots, 1)
+    law, rows, misfit, iterations = _refine_law(solver, tensions, targets, loads, line)
+    a, b = law
     apparent = np.array([r["apparent_EI_Nm2"] for r in rows])
     error = apparent / targets - 1
+    intrinsic = a * np.asarray(tensions) + b
     return rows, {
-        "fit": True, "tension_N": list(tensions), "load_N": list(loads), "law": law,
-        "law_applied_as": "constant EI = a T_e + b per test (helix.EI_law not available)",
-        "intrinsic_EI_Nm2": [float(a * T + b) for T in tensions],
-        "root_EI_Nm2": roots, "apparent_EI_Nm2": apparent.tolist(),
-        "eq64_EI_Nm2": targets.tolist(), "relative_error": error.tolist(),
+        "fit": True, "tension_N": list(tensions), "load_N": list(loads),
+        "law": {"a_Nm2_per_N": float(a), "b_Nm2": float(b)},
+        "law_applied_as": "helix.EI_law in the rod: EI = a T + b at the local tension T = EA eps",
+        "gauss_newton_iterations": iterations,
+        "intrinsic_EI_Nm2": intrinsic.tolist(),
+        "constant_EI_roots_Nm2": roots,
+        "line_through_roots": {"a_Nm2_per_N": float(line[0]), "b_Nm2": float(line[1])},
+        "apparent_EI_Nm2": apparent.tolist(), "eq64_EI_Nm2": targets.tolist(),
+        "relative_error": error.tolist(),
         "within_1_percent": bool(np.all(np.abs(error) <= FIT_TARGET)),
-        "eq64_over_intrinsic": (targets / np.array([a * T + b for T in tensions])).tolist(),
+        "eq64_over_intrinsic": (targets / intrinsic).tolist(),
     }
+
+
+def _refine_law(solver, tensions, targets, loads, start, max_iterations: int = 8):
+    """Gauss-Newton on (a, b) for log(apparent EI / Eq. 64) at the tensions, the law
+    in the rod; from ``start``, finite-difference Jacobian.  (law, rows, misfit, its)."""
+    def run(law):
+        solver.set_bending_law(*law)
+        rows = [bending_test(solver, T, loads) for T in tensions]
+        return rows, np.log(np.array([r["apparent_EI_Nm2"] for r in rows]) / targets)
+
+    law = np.asarray(start, dtype=float)
+    rows, misfit = run(law)
+    for iteration in range(max_iterations):
+        if np.abs(misfit).max() < FIT_TOLERANCE:
+            return law, rows, misfit, iteration
+        steps = 1e-3 * np.abs(law)
+        J = np.column_stack([(run(law + h * np.eye(2)[k])[1] - misfit) / h
+                             for k, h in enumerate(steps)])
+        step = np.linalg.lstsq(J, -misfit, rcond=None)[0]
+        law = law + step
+        rows, misfit = run(law)
+        if np.all(np.abs(step) <= 1e-6 * np.abs(law)):  # the least-squares floor
+            return law, rows, misfit, iteration + 1
+    return law, rows, misfit, max_iterations
 
 
 def _check(test, tensions, loads, fit, rod_EI):
