@@ -393,6 +393,7 @@ def labtest_png(path: Path, result: LabTest) -> Path:
         ax.set_ylabel("M_t [Nm]")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    title = f"virtual {result.test} test, {L0} m segment" + (" (intrinsic law fitted)"
-                                                          if s.get("fit") else "")
+    title = f"virtual {result.test} test, {L0} m segment" + (
+        " (intrinsic law fitted)" if s.get("fit") else
+        f" (rod EI: {s['rod_EI']})" if isinstance(s.get("rod_EI"), str) else "")
     return writers._finish(fig, path, title)
