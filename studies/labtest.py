@@ -17,9 +17,12 @@ theirs:
 Every regression is a least-squares line through the origin, as the
 formulas have no intercept.  ``bending`` with ``fit``: the intrinsic bending
 law EI = a T + b whose simulated test reproduces Eq. (64) at the paper's
-tensions (docs/labtest.md): per tension a 1-D root find of the rod's constant
+tensions (docs/labtest.md), on the rod with ``helix.EI_law`` (extensible
+kinematics, which the law needs): per tension a 1-D root find of a constant
 EI (secant, from the closed-form inverse of solvers/analytic.py), the line
-through the roots, and a check run of the law.
+through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
+small loads (the law's energy couples the axial force to kappa^2, so its
+test softens with the load: docs/labtest.md).
 
 :func:`compute` returns a :class:`LabTest`; :meth:`LabTest.write` writes
 summary.json and labtest.png.  Computing writes nothing.
@@ -171,13 +174,8 @@ class LabTest:
 
     def write(self, outdir) -> Path:
         """summary.json and labtest.png (the paper's Figs. 3-5 axes) into ``outdir``."""
-        outdir = Path(outdir)
-        if self.rank != 0:
-            return outdir
-        outdir.mkdir(parents=True, exist_ok=True)
-        writers.write_json(outdir / "summary.json", self.summary)
-        labtest_png(outdir / "labtest.png", self)
-        return outdir
+        return writers.summary_and_figure(outdir, self.rank, self.summary,
+                                          lambda d: labtest_png(d / "labtest.png", self))
 
 
 def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit: bool = False,
