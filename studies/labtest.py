@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix.errors import SolverError
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import analytic
 from rawehelix.studies import writers
@@ -109,8 +110,17 @@ def bending_test(solver, tension_N: float, loads_N) -> dict:
     L0 = solver.q.L0
     solver.reset()  # each tension's load path from the straight segment, as in the lab
     zero = solver.solve(tension_N * solver.axis).position_m
-    deflection = [float((solver.solve(tension_N * solver.axis + F * NORMAL).position_m - zero) @ NORMAL)
-                  for F in loads_N]
+    deflection = []
+    for F in loads_N:
+        try:
+            tip = solver.solve(tension_N * solver.axis + F * NORMAL)
+        except SolverError as err:
+            hint = (" With the EI law in the rod the energy 1/2 EI(eps) kappa^2 stops being "
+                    "convex at kappa^2 = EI / (a^2 EA) (docs/labtest.md): try smaller --loads."
+                    if solver.rod.c.bending_law else "")
+            raise SolverError(f"bending test at T_e = {tension_N:g} N, F_N = {F:g} N: "
+                              f"{err}{hint}") from None
+        deflection.append(float((tip.position_m - zero) @ NORMAL))
     x = 3 * np.asarray(deflection) / L0**3
     return {"tension_N": tension_N, "load_N": list(loads_N), "deflection_m": deflection,
             "apparent_EI_Nm2": slope(x, loads_N)}

@@ -169,3 +169,19 @@ def test_command_line(tmp_path, capsys):
     assert cli.main(["labtest", "bending", "--tension", "90,abc"]) == 2
     assert "--tension" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.mpi
+def test_same_lab_test_on_all_ranks(table2):
+    """COMM_WORLD (MUMPS) equals COMM_SELF (PETSc's LU): the bending test with the
+    law in the rod (the point probes summed over ranks) and the torsion test."""
+    from mpi4py import MPI
+    law = {"a_Nm2_per_N": 34.0, "b_Nm2": 2300.0}
+    scene = table2.replace(model={"kinematics": "extensible"}, helix={"EI_law": law})
+    for test, loads in (("bending", [0.5, 1.0]), ("torsion", [10.0])):
+        serial = rh.labtest(test, scene, tensions_N=[181.0], loads=loads, elements=4,
+                            comm=MPI.COMM_SELF)
+        parallel = rh.labtest(test, scene, tensions_N=[181.0], loads=loads, elements=4,
+                              comm=MPI.COMM_WORLD)
+        key = "apparent_EI_Nm2" if test == "bending" else "apparent_GJ_Nm2"
+        assert parallel.summary[key] == pytest.approx(serial.summary[key], rel=1e-9)
