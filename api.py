@@ -23,7 +23,7 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "SceneError", "SolverError", "Parameters"]
+           "labtest", "SceneError", "SolverError", "Parameters"]
 
 
 def _world(comm):
@@ -126,3 +126,22 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
                          superharmonics=superharmonics)
 
+
+
+def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=None,
+            fit: bool = False, rod_EI_Nm2: float | None = None, elements: int | None = None,
+            degree: int | None = None, gravity: bool = True, comm=None):
+    """The paper's lab test ``test`` ("axial", "bending" or "torsion", Sec. 4,
+    Fig. 2 a-c) run on a 6.76 m segment of ``scene``'s helix (default the
+    Table 2 helix) clamped at a wall, with the tension T_e [N] (``tensions_N``)
+    a dead load along its axis; ``loads`` are F_N [N] (bending) or M_t [Nm]
+    (torsion).  A :class:`~rawehelix.studies.labtest.LabTest` whose ``summary``
+    has the apparent EA, EI or GJ that Eqs. (62), (63), (65) infer.
+    ``fit`` (bending): the intrinsic law EI = a T + b whose simulated test
+    reproduces Eq. (64) (``summary["law"]``); ``rod_EI_Nm2``: the rod's constant
+    EI (default Eq. (64) at each T_e)."""
+    from rawehelix.studies import labtest as study
+    scene = scene if scene is not None else load_scene("stationary_table2")
+    return study.compute(scene, test, tensions_N=tensions_N, loads=loads, fit=fit,
+                         rod_EI_Nm2=rod_EI_Nm2, elements=elements, degree=degree,
+                         gravity=gravity, comm=_world(comm))

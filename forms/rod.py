@@ -68,6 +68,11 @@ class Coefficients:
     tau_b: Any = 0.0
     tau_t: Any = 0.0
     damped: bool = False
+    # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
+    # mu_a sigma eps + mu_b; ``bending_law`` False: mu
+    mu_a: Any = 0.0
+    mu_b: Any = 0.0
+    bending_law: bool = False
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
@@ -82,6 +87,8 @@ class Coefficients:
             kinematics=model.kinematics,
             tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
             damped=q.damped,
+            mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
+            bending_law=q.bending_law,
         )
 
 
