@@ -66,13 +66,8 @@ class ResponseResult:
 
     def write(self, outdir) -> Path:
         """summary.json and response.png (rank 0 writes)."""
-        outdir = Path(outdir)
-        if self.rank != 0:
-            return outdir
-        outdir.mkdir(parents=True, exist_ok=True)
-        writers.write_json(outdir / "summary.json", self.summary)
-        response_png(outdir / "response.png", self)
-        return outdir
+        return writers.summary_and_figure(outdir, self.rank, self.summary,
+                                          lambda d: response_png(d / "response.png", self))
 
 
 def check(params: Parameters, command: str = "response"):
