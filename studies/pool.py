@@ -103,8 +103,17 @@ class _Counter:
         return int(got[0])
 
     def free(self):
-        self.comm.Barrier()
+        idle_barrier(self.comm)
         self.win.Free()
+
+
+def idle_barrier(comm, poll_s: float = 0.01):
+    """A barrier that sleeps while it waits: Open MPI's blocking one spins, and
+    on a machine with as many cores as ranks it would take the core of the rank
+    still computing its last point."""
+    request = comm.Ibarrier()
+    while not request.Test():
+        time.sleep(poll_s)
 
 
 def _evaluate(task: Task, load, wanted: list[str]) -> dict:
@@ -165,6 +174,7 @@ def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_
         traceback.print_exc()
         sys.stderr.flush()
         comm.Abort(1)
+    idle_barrier(comm)
     new = [r for part in comm.allgather(mine) for r in part]
     records = {**done, **{r["id"]: r for r in new}}
     return {"records": {t.id: records[t.id] for t in tasks}, "computed": len(new), **loop}

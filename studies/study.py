@@ -43,6 +43,7 @@ import io
 import itertools
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -213,20 +214,23 @@ def variance_indices(sample: str, variables, X, Y, seed: int = SEED) -> dict | N
         return {"note": f"{int(np.sum(~np.isfinite(Y)))} failed points: no indices"}
     prob = problem(variables)
     try:
-        if sample == "sobol":
-            from SALib.analyze import sobol
-            r = sobol.analyze(prob, Y, calc_second_order=False, seed=seed)
-            keys = ("S1", "S1_conf", "ST", "ST_conf")
-            method = "Sobol' (Saltelli design, SALib.analyze.sobol)"
-        else:
-            from SALib.analyze import rbd_fast
-            r = rbd_fast.analyze(prob, X, Y, seed=seed)
-            keys = ("S1", "S1_conf")
-            method = "RBD-FAST first-order (SALib.analyze.rbd_fast)"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)  # SALib's call of pandas.unique
+            r, keys, method = _salib(sample, prob, X, Y, seed)
     except (ValueError, ZeroDivisionError, IndexError) as err:
         return {"note": f"SALib: {err}"}
     return {"method": method, **{v.key: {k: float(r[k][i]) for k in keys}
                                  for i, v in enumerate(variables)}}
+
+
+def _salib(sample: str, prob: dict, X, Y, seed: int):
+    if sample == "sobol":
+        from SALib.analyze import sobol
+        return (sobol.analyze(prob, Y, calc_second_order=False, seed=seed),
+                ("S1", "S1_conf", "ST", "ST_conf"), "Sobol' (Saltelli design, SALib.analyze.sobol)")
+    from SALib.analyze import rbd_fast
+    return (rbd_fast.analyze(prob, X, Y, seed=seed), ("S1", "S1_conf"),
+            "RBD-FAST first-order (SALib.analyze.rbd_fast)")
 
 
 @dataclass

@@ -152,6 +152,10 @@ def test_sampled_designs_and_salib_indices(tmp_path):
     idx = study.variance_indices("sobol", v, S, S[:, 0] ** 2)
     assert idx["helix.EI_Nm2"]["ST"] == pytest.approx(1, abs=0.05)
     assert abs(idx["helix.GJ_Nm2"]["ST"]) < 0.02
+    L = study.design(v, "lhs", 128)
+    fast = study.variance_indices("lhs", v, L, L[:, 0] ** 2)  # RBD-FAST on any sample
+    assert fast["helix.EI_Nm2"]["S1"] == pytest.approx(1, abs=0.1)
+    assert abs(fast["helix.GJ_Nm2"]["S1"]) < 0.1
 
 
 @pytest.mark.mpi
