@@ -137,12 +137,14 @@ class _Evaluator:
 
 
 def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict | None = None,
-            uncertainty: float = 0.01, fd_step: float = FD_STEP, comm=MPI.COMM_WORLD,
+            uncertainty: float = 0.01, fd_step: float | None = None, comm=MPI.COMM_WORLD,
             log=None) -> CalibrationResult:
-    """Fit ``fit`` to ``targets`` (collective; the result on every rank)."""
+    """Fit ``fit`` to ``targets`` (collective; the result on every rank);
+    ``fd_step`` None is FD_STEP."""
     from scipy.optimize import least_squares
 
     start = time.perf_counter()
+    fd_step = FD_STEP if fd_step is None else fd_step
     bounds = bounds or {}
     if not 0 < fd_step < 0.5:
         raise SceneError("--fd-step", fd_step, "must be in (0, 0.5)")
@@ -205,16 +207,20 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
     return CalibrationResult(params.name, summary)
 
 
+def _fitted_line(key: str, value: float, confidence, uncertainty: float) -> str:
+    if not confidence:
+        return f"  fitted {key} = {value:.6g} (not identified)"
+    return (f"  fitted {key} = {value:.6g} +- {confidence['std']:.4g} "
+            f"({100 * confidence['relative_std']:.2g} %, targets +- {100 * uncertainty:g} %)")
+
+
 def report(result: CalibrationResult) -> str:
     s = result.summary
-    lines = [f"{s['scene']}: {s['message']} ({s['nfev']} residuals, {s['njev']} Jacobians, "
-             f"{s['evaluations_now']} scenes computed now on {s['ranks']} rank(s), "
-             f"{s['wall_s']:.1f} s)"]
-    for k, v in s["fitted"].items():
-        c = s["confidence"][k]
-        unc = (f" +- {c['std']:.4g} ({100 * c['relative_std']:.2g} %, targets +- "
-               f"{100 * s['target_uncertainty']:g} %)" if c else " (not identified)")
-        lines.append(f"  fitted {k} = {v:.6g}{unc}")
+    head = (f"{s['scene']}: {s['message']} ({s['nfev']} residuals, {s['njev']} Jacobians, "
+            f"{s['evaluations_now']} scenes computed now on {s['ranks']} rank(s), "
+            f"{s['wall_s']:.1f} s)")
+    lines = [head] + [_fitted_line(k, v, s["confidence"][k], s["target_uncertainty"])
+                      for k, v in s["fitted"].items()]
     for q, rr in s["residuals"].items():
         lines.append(f"  {q} = {s['values'][q]:.6g} (target {s['targets'][q]:g}, "
                      f"relative residual {rr['relative']:+.2e})")

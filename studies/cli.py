@@ -297,29 +297,27 @@ def _source(args):
 def _study(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import quantities, study
     variables = [study.parse_vary(v) for v in args.vary]
-    wanted = quantities.parse_list(args.quantity)
-    result = study.compute(_source(args), variables, wanted, outdir, sample=args.sample,
-                           points=args.points,
-                           fd_step=study.FD_STEP if args.fd_step is None else args.fd_step,
+    result = study.compute(_source(args), variables, quantities.parse_list(args.quantity),
+                           outdir, sample=args.sample, points=args.points, fd_step=args.fd_step,
                            comm=comm, log=log.info)
-    if comm.rank == 0:
-        result.write(outdir)
-    _say(comm, study.report(result) + f"\n  wrote {outdir}/")
-    return 0
+    return _write_and_say(comm, result, study.report(result), outdir)
 
 
 def _calibrate(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import calibrate
     fit = calibrate.parse_fit(args.fit)
-    targets = calibrate.parse_targets(args.target)
-    bounds = calibrate.parse_bounds(args.bounds, fit)
-    result = calibrate.compute(_source(args), fit, targets, outdir, bounds=bounds,
-                               uncertainty=args.uncertainty,
-                               fd_step=calibrate.FD_STEP if args.fd_step is None else args.fd_step,
-                               comm=comm, log=log.info)
+    result = calibrate.compute(_source(args), fit, calibrate.parse_targets(args.target), outdir,
+                               bounds=calibrate.parse_bounds(args.bounds, fit),
+                               uncertainty=args.uncertainty, fd_step=args.fd_step, comm=comm,
+                               log=log.info)
+    return _write_and_say(comm, result, calibrate.report(result), outdir)
+
+
+def _write_and_say(comm, result, text: str, outdir) -> int:
+    """A study's or a calibration's files (rank 0) and its report."""
     if comm.rank == 0:
         result.write(outdir)
-    _say(comm, calibrate.report(result) + f"\n  wrote {outdir}/")
+    _say(comm, text + f"\n  wrote {outdir}/")
     return 0
 
 

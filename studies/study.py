@@ -331,12 +331,14 @@ def header(source: Source, params: Parameters, variables, sample, points, wanted
 
 
 def compute(source: Source, variables: list[Variable], wanted: list[str], outdir,
-            sample: str = "grid", points: int | None = None, fd_step: float = FD_STEP,
+            sample: str = "grid", points: int | None = None, fd_step: float | None = None,
             comm=MPI.COMM_WORLD, log=None) -> StudyResult:
     """Run (or resume) the study in ``outdir`` on the ranks of ``comm``
-    (collective); the result on every rank.  Raises SceneError for bad input
-    before anything is computed or written."""
+    (collective); the result on every rank.  ``fd_step``: None is FD_STEP, 0
+    no sensitivities.  Raises SceneError for bad input before anything is
+    computed or written."""
     start = time.perf_counter()
+    fd_step = FD_STEP if fd_step is None else fd_step
     if sample not in SAMPLES:
         raise SceneError("--sample", sample, f"must be one of {', '.join(SAMPLES)}")
     if not variables:
