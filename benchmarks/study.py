@@ -10,8 +10,10 @@
 2. The CPU time (time.process_time) and wall time of one point per stage, in
    this process on COMM_SELF (quantities.evaluate): a stationary quantity
    (``tension_s0_N``), a modal one (``lateral_frequency_Hz``), a sweep one
-   (``tension_max_N@10``) and an orbit one (``fold_Hz`` over 11.5-12.75 Hz, traced from 11.5 Hz (at 12.4 Hz the shooting from the stationary state fails),
-   the Sec. 5.3 fold near 12.70 Hz, docs/orbits.md).
+   (``tension_max_N@10``) and an orbit one (``fold_Hz``: the orbits traced
+   from 11.5 Hz to past the Sec. 5.3 fold at 12.70 Hz, docs/orbits.md; a
+   trace from 12.4 Hz fails, the shooting from the stationary state does
+   not converge there).
 
     .venv/bin/python benchmarks/study.py [--elements 8] [--points 16] [--repeats 3]
     .venv/bin/python benchmarks/run.py --only study      (the same, into results.json)
