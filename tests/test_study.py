@@ -51,6 +51,7 @@ def test_unknown_quantity_names_the_known_ones():
 
 
 # -- rawehelix study ------------------------------------------------------------------------
+import json  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
 import signal  # noqa: E402
@@ -220,3 +221,35 @@ def test_calibrated_EI_is_the_tensioned_pinned_beam(tmp_path):
     # linearised: d ln f / d ln EI = EI k^2 / (2 (T + EI k^2)); sigma(ln EI) = u / that
     slope = closed * k**2 / (2 * (T + closed * k**2))
     assert s["confidence"]["helix.EI_Nm2"]["relative_std"] == pytest.approx(0.01 / slope, rel=2e-2)
+
+
+def test_calibration_says_when_targets_do_not_identify_the_keys(tmp_path):
+    """Two keys, one target: the scaled Jacobian has rank 1, its condition
+    number is infinite and no confidence is claimed; the target is still met."""
+    source = study.Source("nominal_operation", elements=N)
+    s = calibrate.compute(source, ["helix.EA_N", "ends.elongation"], {"tension_s0_N": 210.0},
+                          tmp_path, comm=MPI.COMM_SELF).summary
+    assert abs(s["residuals"]["tension_s0_N"]["relative"]) < 1e-6
+    assert s["condition_number"] == math.inf
+    assert s["confidence"] == {"helix.EA_N": None, "ends.elongation": None}
+
+
+@pytest.mark.mpi
+def test_calibration_on_two_ranks_is_the_one_rank_fit(tmp_path_factory):
+    """The Jacobian's columns on 2 ranks (both compute) give the one-rank fit
+    to the last bit: fitted, residuals, Jacobian."""
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        pytest.skip("compares 1 and 2 ranks: run under mpirun -n 2")
+    base = Path(comm.bcast(str(tmp_path_factory.mktemp("cal")) if comm.rank == 0 else None))
+    source = study.Source("nominal_operation", elements=N)
+    args = (source, ["ends.elongation", "helix.mass_kg"], {"tension_s0_N": 210.0, "sag_m": 0.04})
+    world = calibrate.compute(*args, base / "world", comm=comm).summary
+    ranks = {json.loads(p.read_text())["rank"] for p in (base / "world" / "points").glob("*.json")}
+    if comm.rank == 0:
+        serial = calibrate.compute(*args, base / "serial", comm=MPI.COMM_SELF).summary
+        for key in ("fitted", "residuals", "scaled_jacobian", "condition_number"):
+            assert world[key] == serial[key]
+        assert ranks == {0, 1}
+        assert max(abs(r["relative"]) for r in world["residuals"].values()) < 1e-6
+    comm.Barrier()
