@@ -253,3 +253,24 @@ def test_calibration_on_two_ranks_is_the_one_rank_fit(tmp_path_factory):
         assert ranks == {0, 1}
         assert max(abs(r["relative"]) for r in world["residuals"].values()) < 1e-6
     comm.Barrier()
+
+
+TINY_SWEEP = {"sweep.lead_in_s": 0.2, "sweep.min_periods": 2, "sweep.max_periods": 3,
+              "sweep.record_periods": 1, "sweep.periodic_tolerance": 5e-2, "time.dt_s": 2e-3,
+              "sweep.f1_start_Hz": 6.0, "sweep.f1_stop_Hz": 8.0, "sweep.f1_step_Hz": 2.0}
+
+
+def test_time_integrating_quantities_equal_the_single_run_api():
+    """The spin-up and sweep stages give rh.simulate's settling time and
+    rh.sweep's T max and resonance, exactly (FE, tiny settings)."""
+    spin = rh.load_scene("nominal_operation", elements=N, overrides={"time.until_s": 6.0})
+    got = quantities.evaluate(spin, ["settling_time_s"])
+    assert got["values"]["settling_time_s"] == rh.simulate(
+        spin, comm=MPI.COMM_SELF, progress=False).summary["settling_time_s"]
+    sweep = rh.load_scene("mobile_end", elements=2, degree=2, overrides=TINY_SWEEP)
+    got = quantities.evaluate(sweep, ["tension_max_N@6", "resonance_Hz"])
+    assert got["errors"] == {}
+    assert got["values"]["tension_max_N@6"] == rh.sweep(
+        sweep, [6.0], comm=MPI.COMM_SELF).points[0]["tension_max_N"]
+    assert got["values"]["resonance_Hz"] == rh.sweep(
+        sweep, comm=MPI.COMM_SELF).summary["resonance_Hz"]
