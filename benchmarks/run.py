@@ -22,6 +22,8 @@ sections and keeps the others' last results.
    with held dense LU) against the TS path in the same process, in CPU time:
    real-time factor and T max error at 10 Hz, dt = 0.5 and 1 ms, and where a
    chord step's CPU time goes.
+9. ``study``: a 16-point modal ``rawehelix study`` on 2 ranks against 1, and
+   the cost of one study point per stage (benchmarks/study.py).
 """
 
 from __future__ import annotations
@@ -36,6 +38,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
@@ -441,10 +445,12 @@ def markdown(r: dict) -> str:
                      f"{_spread(t['rtf'], '.2f', '')} (x{v['speedup']:.2f}); T max error "
                      f"{c['tension_max_rel_error']:+.2e} (TS {t['tension_max_rel_error']:+.2e}) | "
                      f"{TARGETS['rtf']['sec5.3']} |")
+    if r.get("study"):
+        lines.append(study_bench.markdown(r["study"]).replace("| ", "| 9. ", 1))
     return "\n".join(lines) + "\n"
 
 
-SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord")
+SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study")
 
 
 def main():
@@ -472,7 +478,8 @@ def main():
                      ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats)),
                      ("levers", lambda: bench_levers(repeats)),
                      ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats)),
-                     ("chord", lambda: bench_chord(repeats))):
+                     ("chord", lambda: bench_chord(repeats)),
+                     ("study", lambda: study_bench.bench_study(repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

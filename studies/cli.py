@@ -9,6 +9,10 @@
     rawehelix extremes [CASE ...] [-o DIR]
     rawehelix labtest axial|bending|torsion [--tension T1,T2,...] [--loads X1,...] [--fit]
                       [--EI VALUE] [--scene SCENE] [--no-gravity] [--elements N] [-o DIR]
+    rawehelix study SCENE --vary KEY=START:STOP:COUNT [--vary ...] [--sample grid|lhs|sobol
+                    --points N] --quantity Q[,Q...] [--fd-step h] [-o DIR]
+    rawehelix calibrate SCENE --fit KEY[,KEY...] --target Q=VALUE[,...] [--bounds KEY=LO:HI]
+                    [--uncertainty REL] [-o DIR]
 
 SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
 ``nominal_operation``, ``mobile_end``).  ``--set KEY=VALUE`` sets any dotted
@@ -31,7 +35,7 @@ from pathlib import Path
 from rawehelix.studies.scene import SceneError
 
 COMMANDS = ("stationary", "modes", "simulate", "sweep", "response", "orbits", "converge",
-            "extremes", "labtest")
+            "extremes", "labtest", "study", "calibrate")
 log = logging.getLogger("rawehelix")
 
 
@@ -44,7 +48,9 @@ def _parser() -> argparse.ArgumentParser:
                             ("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)"),
                             ("response", "linear frequency response to the upper end's circle"),
                             ("orbits", "periodic orbits over f1 with Floquet stability, through folds"),
-                            ("converge", "refinement study and work-precision figure")):
+                            ("converge", "refinement study and work-precision figure"),
+                            ("study", "named quantities over a design of scene keys, on MPI ranks"),
+                            ("calibrate", "fit scene keys to target quantities (least squares)")):
         p = sub.add_parser(name, help=help_text)
         p.add_argument("scene", help="scene TOML file, or the name of a shipped scene")
         p.add_argument("-o", "--output", type=Path, default=None,
@@ -67,6 +73,30 @@ def _parser() -> argparse.ArgumentParser:
         if name == "converge":
             p.add_argument("--quantity", required=True,
                            help="quantity of interest: tension_s0, eigenvalues, ...")
+        if name == "study":
+            p.add_argument("--vary", action="append", required=True,
+                           metavar="KEY=START:STOP:COUNT",
+                           help="a dotted scene key and its range (repeatable; COUNT: grid points)")
+            p.add_argument("--sample", choices=("grid", "lhs", "sobol"), default="grid",
+                           help="the design (default grid; lhs, sobol: scipy.stats.qmc, SALib)")
+            p.add_argument("--points", type=int, default=None,
+                           help="lhs: points; sobol: base points N (N (d + 2) scenes)")
+        if name in ("study", "calibrate"):
+            p.add_argument("--quantity" if name == "study" else "--target", required=True,
+                           metavar="Q[,Q...]" if name == "study" else "Q=VALUE[,...]",
+                           help="quantities: " + ", ".join(_quantity_names())
+                           if name == "study" else "target values of quantities")
+            p.add_argument("--fd-step", type=float, default=None, metavar="h",
+                           help="relative finite-difference step (default 1e-2 for the "
+                                "sensitivities, 1e-3 for the Jacobian)")
+        if name == "calibrate":
+            p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
+                           help="the dotted scene keys to fit")
+            p.add_argument("--bounds", action="append", default=[], metavar="KEY=LO:HI",
+                           help="bounds of a fitted key (repeatable)")
+            p.add_argument("--uncertainty", type=float, default=0.01, metavar="REL",
+                           help="relative standard uncertainty of the targets, for the "
+                                "linearised confidence (default 0.01)")
         if name == "orbits":
             p.add_argument("--f1", required=True, metavar="START:STOP",
                            help="the f1 window in Hz, traced from START towards STOP")
@@ -115,6 +145,11 @@ def _parser() -> argparse.ArgumentParser:
                    help="output directory (default results/labtest/<test>)")
     p.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
     return parser
+
+
+def _quantity_names() -> list[str]:
+    from rawehelix.studies import quantities
+    return quantities.names()
 
 
 def _fail(message: str) -> int:
@@ -313,8 +348,41 @@ def _extremes(args) -> int:
     return 0
 
 
+def _source(args):
+    from rawehelix.studies.study import Source
+    return Source(args.scene, args.elements, args.degree, args.scheme, _overrides(args))
+
+
+def _study(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import quantities, study
+    variables = [study.parse_vary(v) for v in args.vary]
+    result = study.compute(_source(args), variables, quantities.parse_list(args.quantity),
+                           outdir, sample=args.sample, points=args.points, fd_step=args.fd_step,
+                           comm=comm, log=log.info)
+    return _write_and_say(comm, result, study.report(result), outdir)
+
+
+def _calibrate(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import calibrate
+    fit = calibrate.parse_fit(args.fit)
+    result = calibrate.compute(_source(args), fit, calibrate.parse_targets(args.target), outdir,
+                               bounds=calibrate.parse_bounds(args.bounds, fit),
+                               uncertainty=args.uncertainty, fd_step=args.fd_step, comm=comm,
+                               log=log.info)
+    return _write_and_say(comm, result, calibrate.report(result), outdir)
+
+
+def _write_and_say(comm, result, text: str, outdir) -> int:
+    """A study's or a calibration's files (rank 0) and its report."""
+    if comm.rank == 0:
+        result.write(outdir)
+    _say(comm, text + f"\n  wrote {outdir}/")
+    return 0
+
+
 COMMAND = {"stationary": _stationary, "modes": _modes, "simulate": _simulate, "sweep": _sweep,
-           "response": _response, "orbits": _orbits, "converge": _converge}
+           "response": _response, "orbits": _orbits, "converge": _converge, "study": _study,
+           "calibrate": _calibrate}
 
 
 def _abort_other_ranks(comm, code: int):

@@ -50,13 +50,30 @@ class Stationary:
         return outdir
 
 
+def solve(params: Parameters, comm=MPI.COMM_WORLD):
+    """Newton alone (no shooting reference): ``(solver, result, planar)`` on the
+    FE rod of :func:`compute` (the planar (x, z) rod where ``model.reduction``
+    allows it); the parameter studies' stationary quantities take it."""
+    from rawehelix.solvers.planar import planar_allowed
+    from rawehelix.solvers.stationary import StationarySolver
+
+    planar = params.model.reduction == "auto" and planar_allowed(params)
+    solver = StationarySolver(params, comm, scene=params.name, planar=planar)
+    return solver, solver.solve(), planar
+
+
+def sag_m(params: Parameters, result) -> float:
+    """The sag [m] of a stationary result: the centre line's largest distance from the chord."""
+    from rawehelix.solvers.stationary import sag
+    q = params.normalised()
+    return q.L0 * sag(result.centre_line, q.top_position())
+
+
 def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
     allows it), compared with the shooting solution of Sys. (67) (of the extensible
     elastica, solvers/shooting.py::solve_extensible, with model.kinematics = "extensible")."""
     from rawehelix.solvers import shooting
-    from rawehelix.solvers.planar import planar_allowed
-    from rawehelix.solvers.stationary import StationarySolver, sag
 
     if params.discretisation.scheme != "fe":
         raise SceneError(params.name, "discretisation.scheme",
@@ -65,9 +82,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
-    planar = params.model.reduction == "auto" and planar_allowed(params)
-    solver = StationarySolver(params, comm, scene=params.name, planar=planar)
-    result = solver.solve()
+    solver, result, planar = solve(params, comm)
     # the independent reference: Sys. (67), or the extensible elastica (with the EI law)
     reference = (shooting.solve_extensible(q) if params.model.kinematics == "extensible"
                  else shooting.solve(q))
@@ -92,7 +107,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
             "newton_iterations": result.newton_iterations,
             "tension_N": {"s0": float(T[0]), "s1": float(T[-1]),
                           "min": float(T.min()), "max": float(T.max())},
-            "sag_m": q.L0 * sag(result.centre_line, q.top_position()),
+            "sag_m": sag_m(params, result),
             "shooting_max_diff_m": float(np.max(np.linalg.norm(x - x_ref, axis=1))),
             "shooting_tension_s0_N": float(q.tension_N(reference.tension(0.0))),
             "residual_at_shooting": float(residual_at_shooting),

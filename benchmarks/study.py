@@ -1,0 +1,154 @@
+"""`rawehelix study` on MPI ranks, and what one point costs per kind of quantity.
+
+1. A 16-point modal study (``lateral_frequency_Hz`` over ``helix.EI_Nm2``,
+   mobile_end, N elements, no sensitivity points) as the whole command under
+   ``mpirun -n 1`` and ``-n 2``, after one run that compiles the forms.  The
+   speed-up is that of the point loop (``summary.json``: each rank's loop wall
+   and CPU time, start-up and the gathering excluded) and of the whole
+   command; the 1-minute load average before each run says how busy the
+   shared machine was.  The two CSVs must be the same bytes.
+2. The CPU time (time.process_time) and wall time of one point per stage, in
+   this process on COMM_SELF (quantities.evaluate): a stationary quantity
+   (``tension_s0_N``), a modal one (``lateral_frequency_Hz``), a sweep one
+   (``tension_max_N@10``) and an orbit one (``fold_Hz``: the orbits traced
+   from 11.5 Hz to past the Sec. 5.3 fold at 12.70 Hz, docs/orbits.md; a
+   trace from 12.4 Hz fails, the shooting from the stationary state does
+   not converge there).
+
+    .venv/bin/python benchmarks/study.py [--elements 8] [--points 16] [--repeats 3]
+    .venv/bin/python benchmarks/run.py --only study      (the same, into results.json)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ELEMENTS = 8
+POINTS = 16
+EI_RANGE = "3000:6000"
+FOLD_WINDOW = {"sweep.f1_start_Hz": 11.5, "sweep.f1_stop_Hz": 12.75}  # past the fold at 12.70 Hz
+
+
+def _study_command(ranks: int, points: int, elements: int, outdir: Path) -> dict:
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
+    exe = str(Path(sys.executable).with_name("rawehelix"))
+    cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", exe, "study", "mobile_end",
+           "--elements", str(elements), "--vary", f"helix.EI_Nm2={EI_RANGE}:{points}",
+           "--quantity", "lateral_frequency_Hz", "--fd-step", "0", "-o", str(outdir)]
+    shutil.rmtree(outdir, ignore_errors=True)
+    load = os.getloadavg()[0]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.perf_counter() - t0
+    s = json.loads((outdir / "summary.json").read_text())
+    return {"command_wall_s": wall, "load_1min_before": load,
+            "loop_wall_s": max(x["loop_wall_s"] for x in s["loops"]),
+            "loop_cpu_s": sum(x["loop_cpu_s"] for x in s["loops"]),
+            "loop_cpu_s_max_rank": max(x["loop_cpu_s"] for x in s["loops"]),
+            "per_rank": s["loops"], "failed": len(s["failed"]),
+            "csv": (outdir / "study.csv").read_text()}
+
+
+def bench_speedup(points: int = POINTS, elements: int = ELEMENTS, repeats: int = 1) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        _study_command(1, 2, elements, tmp / "warm")  # compiles the forms
+        runs = {1: [], 2: []}
+        for _ in range(repeats):
+            for ranks in (1, 2):
+                runs[ranks].append(_study_command(ranks, points, elements, tmp / f"r{ranks}"))
+    same = all(r["csv"] == runs[1][0]["csv"] for r in runs[1] + runs[2])
+    for rows in runs.values():
+        for r in rows:
+            r.pop("csv")
+    med = {k: {m: float(np.median([r[m] for r in rows])) for m in
+               ("command_wall_s", "loop_wall_s", "loop_cpu_s", "loop_cpu_s_max_rank",
+                "load_1min_before")}
+           for k, rows in runs.items()}
+    return {"points": points, "elements": elements, "quantity": "lateral_frequency_Hz",
+            "runs": {str(k): v for k, v in runs.items()}, "median": {str(k): v for k, v in med.items()},
+            "speedup_loop": med[1]["loop_wall_s"] / med[2]["loop_wall_s"],
+            "speedup_command": med[1]["command_wall_s"] / med[2]["command_wall_s"],
+            "cpu_ratio_2_over_1": med[2]["loop_cpu_s"] / med[1]["loop_cpu_s"],
+            # on dedicated cores: the 1-rank loop's CPU over the busier rank's of 2
+            "speedup_cpu": med[1]["loop_cpu_s"] / med[2]["loop_cpu_s_max_rank"],
+            "csv_1_equals_2_ranks": same, "cores": os.cpu_count()}
+
+
+def bench_cost(elements: int = ELEMENTS, repeats: int = 3) -> dict:
+    """CPU and wall time of one point per stage (the cheap ones: median of
+    ``repeats`` after one that compiles; the sweep and orbit ones: one run)."""
+    import petsc4py
+    petsc4py.init([sys.argv[0]])
+    from rawehelix.studies import quantities, scene
+
+    cases = {"stationary": ("tension_s0_N", {}, elements, repeats),
+             "modes": ("lateral_frequency_Hz", {}, elements, repeats),
+             "sweep": ("tension_max_N@10", {}, elements, 1),
+             "orbits": ("fold_Hz", FOLD_WINDOW, 4, 1)}
+    out = {}
+    for stage, (name, over, n, k) in cases.items():
+        params = scene.load("mobile_end", elements=n, overrides=over)
+        if k > 1:
+            quantities.evaluate(params, [name])
+        cpu, wall, value = [], [], None
+        for _ in range(k):
+            c0, w0 = time.process_time(), time.perf_counter()
+            got = quantities.evaluate(params, [name])
+            cpu.append(time.process_time() - c0)
+            wall.append(time.perf_counter() - w0)
+            value = got["values"][name] if got["values"][name] is not None else got["errors"][name]
+        out[stage] = {"quantity": name, "elements": n, "overrides": over, "value": value,
+                      "cpu_s": float(np.median(cpu)), "wall_s": float(np.median(wall)), "runs": k}
+        print(f"  {stage}: {name} = {value} ({out[stage]['cpu_s']:.2f} s CPU)", flush=True)
+    return out
+
+
+def bench_study(repeats: int = 1) -> dict:
+    return {"speedup": bench_speedup(repeats=repeats), "cost_per_point": bench_cost()}
+
+
+def markdown(r: dict) -> str:
+    sp, cost = r["speedup"], r["cost_per_point"]
+    m1, m2 = sp["median"]["1"], sp["median"]["2"]
+    lines = [f"| {sp['points']}-point modal study (mobile_end, N = {sp['elements']}), 2 ranks vs 1 | "
+             f"point loop {m1['loop_wall_s']:.1f} s -> {m2['loop_wall_s']:.1f} s wall: x"
+             f"{sp['speedup_loop']:.2f}; CPU {m1['loop_cpu_s']:.1f} s -> {m2['loop_cpu_s']:.1f} s "
+             f"summed over ranks, busier rank {m2['loop_cpu_s_max_rank']:.1f} s: x"
+             f"{sp['speedup_cpu']:.2f} on dedicated cores; whole command {m1['command_wall_s']:.1f} s -> "
+             f"{m2['command_wall_s']:.1f} s: x{sp['speedup_command']:.2f}; load before "
+             f"{m1['load_1min_before']:.1f} / {m2['load_1min_before']:.1f} on {sp['cores']} cores; "
+             f"CSVs equal: {sp['csv_1_equals_2_ranks']} | >= 1.9 (issue 15) |"]
+    per = "; ".join(f"{v['quantity']} (N = {v['elements']}) {v['cpu_s']:.2f} s CPU / "
+                    f"{v['wall_s']:.2f} s wall" for v in cost.values())
+    lines.append(f"| cost of one study point by stage | {per} | modal: no time loop |")
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--elements", type=int, default=ELEMENTS)
+    parser.add_argument("--points", type=int, default=POINTS)
+    parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--skip-cost", action="store_true")
+    args = parser.parse_args()
+    r = {"speedup": bench_speedup(args.points, args.elements, args.repeats)}
+    print(json.dumps(r["speedup"]["median"], indent=1), "speed-up loop",
+          r["speedup"]["speedup_loop"], "command", r["speedup"]["speedup_command"], flush=True)
+    if not args.skip_cost:
+        r["cost_per_point"] = bench_cost(args.elements)
+        print(markdown(r))
+
+
+if __name__ == "__main__":
+    main()

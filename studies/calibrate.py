@@ -1,0 +1,228 @@
+"""`rawehelix calibrate`: scene keys fitted to target quantities by least squares.
+
+    rawehelix calibrate SCENE --fit KEY[,KEY...] --target Q=VALUE[,...]
+                        [--bounds KEY=LO:HI] [--uncertainty REL] [-o DIR]
+
+``scipy.optimize.least_squares`` (trust region reflective) on the relative
+residuals r_j = Q_j(p) / target_j - 1 of the scaled unknowns x_i = p_i / p0_i
+(p0: the scene's values).  The Jacobian is forward differences in x with the
+step ``fd_step`` (default 1e-3; backwards at an upper bound); its columns are
+independent scenes, evaluated together on the ranks
+(:mod:`rawehelix.studies.pool`: dynamic, resumable: every evaluation is
+stored in ``DIR/points`` under a hash of its keys, so a rerun, with other
+target values too, recomputes none).  Without ``--bounds`` a key stays in
+[p0 / 1000, 1000 p0].
+
+The report: ``fitted`` (key -> value), the residuals, the condition number of
+the scaled Jacobian E_ji = d ln Q_j / d ln p_i at the fit (large: the targets
+do not identify the keys), and the linearised standard uncertainty of the
+fitted keys for a relative standard uncertainty u of the targets:
+Cov(ln p) = u^2 (E^T E)^-1 (Gauss-Newton, targets independent).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.errors import SceneError, SolverError
+from rawehelix.studies import pool, quantities, writers
+from rawehelix.studies.study import Source, base_value, key_type
+
+FD_STEP = 1e-3  # forward-difference step of the Jacobian, relative to the scene's value
+RANGE = 1e3  # default bounds: [p0 / RANGE, RANGE p0]
+
+
+def parse_fit(text: str) -> list[str]:
+    keys = [k.strip() for k in str(text).split(",") if k.strip()]
+    if not keys or len(set(keys)) != len(keys):
+        raise SceneError("--fit", text, "must be KEY[,KEY...], each key once, e.g. helix.EI_Nm2")
+    return keys
+
+
+def parse_targets(text: str) -> dict:
+    targets = {}
+    for item in str(text).split(","):
+        name, sep, value = item.strip().partition("=")
+        try:
+            v = float(value)
+        except ValueError:
+            v = math.nan
+        if not sep or not math.isfinite(v) or v == 0:
+            raise SceneError("--target", item, "must be Q=VALUE with a finite VALUE != 0, e.g. "
+                             "lateral_frequency_Hz=5")
+        quantities.parse(name.strip(), "--target")
+        targets[name.strip()] = v
+    return targets
+
+
+def parse_bounds(items: list[str], fit: list[str]) -> dict:
+    bounds = {}
+    for item in items:
+        key, sep, spec = item.partition("=")
+        try:
+            lo, hi = (float(v) for v in spec.split(":"))
+        except ValueError:
+            raise SceneError("--bounds", item, "must be KEY=LO:HI") from None
+        if key not in fit:
+            raise SceneError("--bounds", item, f"{key} is not one of --fit {','.join(fit)}")
+        if not lo < hi:
+            raise SceneError("--bounds", item, "needs LO < HI")
+        bounds[key] = (lo, hi)
+    return bounds
+
+
+@dataclass
+class CalibrationResult:
+    scene: str
+    summary: dict
+
+    def write(self, outdir) -> Path:
+        outdir = Path(outdir)
+        writers.write_json(outdir / "summary.json", self.summary)
+        return outdir
+
+
+class _Evaluator:
+    """Residuals of batches of x, the batch's scenes evaluated together on the ranks."""
+
+    def __init__(self, source, fit, p0, targets, store, comm, log):
+        self.source, self.fit, self.p0, self.targets = source, fit, p0, targets
+        self.store, self.comm, self.log = store, comm, log
+        self.wanted = list(targets)
+        self.seen: dict = {}  # id -> record
+        self.evaluations = 0
+
+    def overrides(self, x) -> dict:
+        return {k: float(p * xi) for k, p, xi in zip(self.fit, self.p0, x)}
+
+    @staticmethod
+    def task_id(over: dict) -> str:
+        return "e" + writers.digest({k: repr(v) for k, v in over.items()})
+
+    def batch(self, xs) -> list[np.ndarray]:
+        tasks = []
+        for x in xs:
+            over = self.overrides(x)
+            self.source.load(over)  # a bad value: the scene loader's message
+            tasks.append(pool.Task(self.task_id(over), over, "calibrate"))
+        new = list({t.id: t for t in tasks if t.id not in self.seen}.values())
+        if new:
+            out = pool.run(new, self.source.load, self.wanted, self.store, self.comm, self.log)
+            self.seen.update(out["records"])
+            self.evaluations += out["computed"]
+        rows = []
+        for t in tasks:
+            r = self.seen[t.id]
+            if r["status"] != "ok":
+                raise SolverError(f"calibrate: the scene at {t.overrides} failed: "
+                                  + "; ".join(r["errors"].values()))
+            rows.append(np.array([r["values"][q] / self.targets[q] - 1 for q in self.wanted]))
+        return rows
+
+    def fun(self, x):
+        return self.batch([x])[0]
+
+    def jac(self, x, lower, upper, step):
+        """Forward differences in x (backwards where a step would leave the bounds)."""
+        h = np.where(x + step <= upper, step, -step)
+        cols = [x + h[i] * np.eye(len(x))[i] for i in range(len(x))]
+        r0, *rs = self.batch([x, *cols])
+        return np.column_stack([(r - r0) / h[i] for i, r in enumerate(rs)])
+
+
+def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict | None = None,
+            uncertainty: float = 0.01, fd_step: float | None = None, comm=MPI.COMM_WORLD,
+            log=None) -> CalibrationResult:
+    """Fit ``fit`` to ``targets`` (collective; the result on every rank);
+    ``fd_step`` None is FD_STEP."""
+    from scipy.optimize import least_squares
+
+    start = time.perf_counter()
+    fd_step = FD_STEP if fd_step is None else fd_step
+    bounds = bounds or {}
+    if not 0 < fd_step < 0.5:
+        raise SceneError("--fd-step", fd_step, "must be in (0, 0.5)")
+    if not uncertainty > 0:
+        raise SceneError("--uncertainty", uncertainty, "must be > 0")
+    params = source.load()
+    p0 = []
+    for key in fit:
+        source.load({key: 1.0})  # an unknown key: the loader's message
+        value = base_value(params, key)
+        if key_type(key) != "float" or value == 0:
+            raise SceneError("--fit", key, "must be a real-valued key with a scene value != 0 "
+                             f"(the unknowns are scaled by it); it is {value!r}")
+        p0.append(float(value))
+    p0 = np.array(p0)
+    lo = np.array([bounds.get(k, (min(p / RANGE, p * RANGE), max(p / RANGE, p * RANGE)))[0]
+                   for k, p in zip(fit, p0)])
+    hi = np.array([bounds.get(k, (min(p / RANGE, p * RANGE), max(p / RANGE, p * RANGE)))[1]
+                   for k, p in zip(fit, p0)])
+    lower, upper = np.minimum(lo / p0, hi / p0), np.maximum(lo / p0, hi / p0)
+    x0 = np.clip(np.ones(len(fit)), lower + 1e-12, upper - 1e-12)
+    disc = params.discretisation
+    header = {"scene": params.name, "fingerprint": writers.digest(params.as_dict()),
+              "scheme": disc.scheme, "elements": disc.elements, "degree": disc.degree,
+              "calibrate": fit, "quantities": sorted(targets)}
+    store = pool.Store(outdir, header).open(comm)
+    ev = _Evaluator(source, fit, p0, {q: targets[q] for q in sorted(targets)}, store, comm, log)
+    res = least_squares(ev.fun, x0, jac=lambda x: ev.jac(x, lower, upper, fd_step),
+                        bounds=(lower, upper), method="trf", xtol=1e-10, ftol=1e-10,
+                        gtol=1e-10, max_nfev=100)
+    r = ev.fun(res.x)
+    J = ev.jac(res.x, lower, upper, fd_step)
+    E = J * res.x[None, :] / (1 + r)[:, None]  # d ln Q_j / d ln p_i
+    sv = np.linalg.svd(E, compute_uv=False)
+    cond = float(sv[0] / sv[-1]) if len(sv) == len(fit) and sv[-1] > 0 else math.inf
+    fitted = {k: float(p * x) for k, p, x in zip(fit, p0, res.x)}
+    if math.isfinite(cond):
+        cov_ln = uncertainty**2 * np.linalg.inv(E.T @ E)
+        rel = np.sqrt(np.diag(cov_ln))
+        confidence = {k: {"std": float(fitted[k] * s), "relative_std": float(s)}
+                      for k, s in zip(fit, rel)}
+    else:
+        confidence = {k: None for k in fit}
+    values = {q: float(targets[q] * (1 + rj)) for q, rj in zip(ev.wanted, r)}
+    summary = {**header, "targets": targets, "start": dict(zip(fit, p0.tolist())),
+               "bounds": {k: [float(a), float(b)] for k, a, b in zip(fit, lo, hi)},
+               "fitted": fitted, "values": values,
+               "residuals": {q: {"absolute": values[q] - targets[q], "relative": float(rj)}
+                             for q, rj in zip(ev.wanted, r)},
+               "scaled_jacobian": E.tolist(),
+               "scaled_jacobian_meaning": "d ln Q_j / d ln p_i (rows: quantities, columns: "
+                                          "fitted keys), forward differences",
+               "condition_number": cond,
+               "target_uncertainty": uncertainty, "confidence": confidence,
+               "confidence_meaning": "linearised 1-sigma: Cov(ln p) = u^2 (E^T E)^-1",
+               "fd_step": fd_step, "success": bool(res.success), "message": res.message,
+               "nfev": int(res.nfev), "njev": int(res.njev or 0),
+               "evaluations_now": ev.evaluations, "ranks": comm.size,
+               "wall_s": time.perf_counter() - start}
+    return CalibrationResult(params.name, summary)
+
+
+def _fitted_line(key: str, value: float, confidence, uncertainty: float) -> str:
+    if not confidence:
+        return f"  fitted {key} = {value:.6g} (not identified)"
+    return (f"  fitted {key} = {value:.6g} +- {confidence['std']:.4g} "
+            f"({100 * confidence['relative_std']:.2g} %, targets +- {100 * uncertainty:g} %)")
+
+
+def report(result: CalibrationResult) -> str:
+    s = result.summary
+    head = (f"{s['scene']}: {s['message']} ({s['nfev']} residuals, {s['njev']} Jacobians, "
+            f"{s['evaluations_now']} scenes computed now on {s['ranks']} rank(s), "
+            f"{s['wall_s']:.1f} s)")
+    lines = [head] + [_fitted_line(k, v, s["confidence"][k], s["target_uncertainty"])
+                      for k, v in s["fitted"].items()]
+    for q, rr in s["residuals"].items():
+        lines.append(f"  {q} = {s['values'][q]:.6g} (target {s['targets'][q]:g}, "
+                     f"relative residual {rr['relative']:+.2e})")
+    lines.append(f"  condition number of the scaled Jacobian: {s['condition_number']:.3g}")
+    return "\n".join(lines)

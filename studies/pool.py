@@ -1,0 +1,180 @@
+"""Scenes evaluated on MPI ranks with dynamic load balancing, kept in a directory.
+
+:func:`run` is collective on ``comm``: every rank takes the next unfinished
+task from a shared counter, evaluates it on MPI.COMM_SELF (one scene per
+rank, :func:`rawehelix.studies.quantities.evaluate`) and stores its record,
+until none is left.  The counter is one integer on rank 0, taken with an
+atomic MPI one-sided ``Fetch_and_op``: a queue without a manager rank, so
+that every rank computes (with 2 ranks a manager-worker loop would leave one
+worker), and a slow point holds up no other.  With one rank it is a loop.
+
+Resumable: a task's record is written atomically to ``DIR/points/<id>.json``
+as soon as it is finished; a run started again (after SIGKILL too) skips
+every task whose record exists, and ``DIR/computed.log`` gets one line per
+task computed.  A failed task (the stage raised one of
+``quantities.POINT_ERRORS``) is recorded with its reason and counts as
+finished.  Any other exception on a rank is a failure of the machinery: the
+traceback is printed and the whole job aborted (``comm.Abort``), since the
+other ranks would otherwise wait for ever at the end.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.errors import SceneError
+from rawehelix.studies import writers
+
+HEADER = "study.json"
+
+
+@dataclass(frozen=True)
+class Task:
+    id: str  # the record's file name
+    overrides: dict  # dotted scene keys of this point
+    kind: str = "design"
+
+
+class Store:
+    """The finished tasks of one study in ``outdir`` (see the module docstring)."""
+
+    def __init__(self, outdir, header: dict):
+        self.outdir, self.header = Path(outdir), header
+        self.points = self.outdir / "points"
+
+    def open(self, comm):
+        """Refuse a directory that holds another study, then create it (collective)."""
+        error = None
+        if comm.rank == 0:
+            path = self.outdir / HEADER
+            if path.exists() and json.loads(path.read_text()) != writers._jsonable(self.header):
+                error = (f"holds another study ({path} differs: scene, discretisation, keys, "
+                         f"sample or quantities); use another -o directory or delete it")
+            else:
+                self.points.mkdir(parents=True, exist_ok=True)
+                writers.write_json(path, self.header)
+        error = comm.bcast(error, root=0)
+        if error:
+            raise SceneError("-o", str(self.outdir), error)
+        return self
+
+    def finished(self, task_id: str) -> dict | None:
+        path = self.points / f"{task_id}.json"
+        return json.loads(path.read_text()) if path.exists() else None
+
+    def save(self, record: dict):
+        writers.write_json(self.points / f"{record['id']}.json", record)
+        with open(self.outdir / "computed.log", "a") as fh:
+            fh.write(f"{record['id']} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}\n")
+
+
+def computed(outdir) -> list[str]:
+    """The ids of ``DIR/computed.log``: one per task computed, by any run."""
+    path = Path(outdir) / "computed.log"
+    return [line.split()[0] for line in path.read_text().splitlines()] if path.exists() else []
+
+
+class _Counter:
+    """The next task's index: an integer on rank 0 taken atomically by any rank."""
+
+    def __init__(self, comm):
+        self.comm = comm
+        self.win = MPI.Win.Allocate(8 if comm.rank == 0 else 0, 8, comm=comm)
+        if comm.rank == 0:
+            self.win.Lock(0)
+            self.win.Put(np.zeros(1, dtype="i8"), 0)
+            self.win.Unlock(0)
+        comm.Barrier()
+
+    def next(self) -> int:
+        got = np.zeros(1, dtype="i8")
+        self.win.Lock(0)
+        self.win.Fetch_and_op(np.ones(1, dtype="i8"), got, 0, 0, MPI.SUM)
+        self.win.Unlock(0)
+        return int(got[0])
+
+    def free(self):
+        idle_barrier(self.comm)
+        self.win.Free()
+
+
+def idle_barrier(comm, poll_s: float = 0.01):
+    """A barrier that sleeps while it waits: Open MPI's blocking one spins, and
+    on a machine with as many cores as ranks it would take the core of the rank
+    still computing its last point."""
+    request = comm.Ibarrier()
+    while not request.Test():
+        time.sleep(poll_s)
+
+
+def _evaluate(task: Task, load, wanted: list[str]) -> dict:
+    from rawehelix.studies import quantities
+    c0, w0 = time.process_time(), time.perf_counter()
+    record = {"id": task.id, "kind": task.kind, "overrides": task.overrides}
+    try:
+        params = load(task.overrides)
+    except quantities.POINT_ERRORS as err:  # validated before the run: not expected
+        out = {"values": dict.fromkeys(wanted), "errors": dict.fromkeys(wanted, str(err)),
+               "cpu_s": {}, "wall_s": {}}
+    else:
+        out = quantities.evaluate(params, wanted)
+    record.update(out)
+    record["status"] = "failed" if out["errors"] else "ok"
+    record["point_cpu_s"] = time.process_time() - c0
+    record["point_wall_s"] = time.perf_counter() - w0
+    record["rank"] = MPI.COMM_WORLD.rank
+    return record
+
+
+def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_WORLD,
+        log=None) -> dict:
+    """Evaluate the unfinished ``tasks`` on the ranks of ``comm`` (collective);
+    ``load(overrides) -> Parameters`` builds a task's scene.  Returns
+    ``{"records": {id: record} (every task in order, on every rank), "computed": n,
+    "loop_wall_s", "loop_cpu_s" (this rank)}``."""
+    done = None
+    if comm.rank == 0:
+        done = {t.id: r for t in tasks if (r := store.finished(t.id)) is not None}
+    done = comm.bcast(done, root=0)
+    todo = [k for k, t in enumerate(tasks) if t.id not in done]
+    mine = []
+    c0, w0 = time.process_time(), time.perf_counter()
+    try:
+        counter = _Counter(comm) if comm.size > 1 else None
+        k = 0
+        while True:
+            k = counter.next() if counter else k
+            if k >= len(todo):
+                break
+            task = tasks[todo[k]]
+            record = _evaluate(task, load, wanted)
+            store.save(record)
+            mine.append(record)
+            if log:
+                shown = ", ".join(f"{q} = {v:.6g}" for q, v in record["values"].items()
+                                  if v is not None)
+                log(f"[rank {comm.rank}] {task.id} ({k + 1}/{len(todo)}): "
+                    f"{shown or record['status']} ({record['point_wall_s']:.1f} s)")
+            k += 0 if counter else 1
+        loop = {"loop_wall_s": time.perf_counter() - w0, "loop_cpu_s": time.process_time() - c0}
+        if counter:
+            counter.free()
+    except Exception:  # the machinery failed on this rank: stop every rank
+        if comm.size == 1:
+            raise
+        traceback.print_exc()
+        sys.stderr.flush()
+        comm.Abort(1)
+    idle_barrier(comm)
+    new = [r for part in comm.allgather(mine) for r in part]
+    records = {**done, **{r["id"]: r for r in new}}
+    return {"records": {t.id: records[t.id] for t in tasks}, "computed": len(new), **loop}

@@ -1,0 +1,226 @@
+"""The named quantities of parameter studies and calibrations: a scene -> floats.
+
+Each quantity belongs to one *stage*, the least computation that gives it:
+
+    stationary   Newton on the stationary state alone (no shooting reference)
+    modes        the stationary state and its modes (never a time integration)
+    spin_up      the dynamics from the stationary state to ``time.until_s``
+    sweep        the brute-force sweep over the scene's [sweep] list (Fig. 8)
+    sweep@F1     the sweep at the one frequency F1 [Hz]
+    orbits       the branch of periodic orbits over the scene's [sweep] window
+
+:func:`evaluate` runs every stage the asked quantities need once, on
+MPI.COMM_SELF (a study runs one scene per rank), and returns the values and,
+for the quantities it could not give, the reason.  Each stage calls the same
+code as the single-run command of the same name (rawehelix.api), so a study's
+value is the command's number.
+
+``tension_max_N@F1`` is a family: the maximum tension at s = 0 of the
+periodic response at f1 = F1 Hz, e.g. ``tension_max_N@10``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+from rawehelix.errors import SceneError, SolverError
+from rawehelix.families import VIBRATIONS
+from rawehelix.parameters import ParameterError, Parameters
+
+AT = "@"  # tension_max_N@F1: the quantity at one forcing frequency
+LATERAL = ("lateral_in_plane", "lateral_out_of_plane")
+
+
+@dataclass(frozen=True)
+class Quantity:
+    name: str
+    unit: str
+    stage: str  # a key of STAGES, or "sweep@F1"
+    pick: Callable  # stage result -> float (raises QuantityError if the result has none)
+    doc: str
+
+
+class QuantityError(ValueError):
+    """The stage ran but does not give the quantity (no fold, not settled, ...)."""
+
+
+#: what a failed point is (recorded with its reason); anything else is a
+#: failure of the machinery and stops the whole study
+POINT_ERRORS = (SolverError, SceneError, ParameterError, QuantityError, ArithmeticError,
+                ValueError, RuntimeError)
+
+
+# -- the stages ----------------------------------------------------------------------------
+def _comm():
+    from mpi4py import MPI
+    return MPI.COMM_SELF
+
+
+def _stationary(params: Parameters, f1=None):
+    from rawehelix.studies import stationary
+    _, result, _ = stationary.solve(params, _comm())
+    q = params.normalised()
+    return {"tension_s0_N": float(q.tension_N(result.tension)[0]),
+            "sag_m": stationary.sag_m(params, result)}
+
+
+def _modes(params: Parameters, f1=None):
+    from rawehelix.studies import modes
+    return modes.compute(params, comm=_comm())
+
+
+def _spin_up(params: Parameters, f1=None):
+    from rawehelix.studies import simulate
+    return simulate.compute(params, comm=_comm(), progress=False).summary
+
+
+def _sweep(params: Parameters, f1=None):
+    from rawehelix.studies import sweep
+    return sweep.compute(params, None if f1 is None else [f1], comm=_comm(),
+                         log=lambda m: None).summary
+
+
+def _orbits(params: Parameters, f1=None):
+    from rawehelix.studies import orbits
+    s = params.sweep
+    return orbits.compute(params, s.f1_start_Hz, s.f1_stop_Hz, comm=_comm()).summary
+
+
+STAGES = {"stationary": _stationary, "modes": _modes, "spin_up": _spin_up, "sweep": _sweep,
+          "orbits": _orbits}
+
+
+# -- the picks -----------------------------------------------------------------------------
+def _lowest(modes, families):
+    """The slowest mode (smallest |eigenvalue|) of ``families``."""
+    found = [m for m in modes if m.family in families]
+    if not found:
+        raise QuantityError(f"no mode of the families {', '.join(families)} was found")
+    return min(found, key=lambda m: abs(m.eigenvalue))
+
+
+def _given(value, what: str) -> float:
+    if value is None or not math.isfinite(value):
+        raise QuantityError(what)
+    return float(value)
+
+
+def _settling(summary):
+    return _given(summary.get("settling_time_s"),
+                  f"the spins did not settle within 2 % by t = {summary['simulated_s']:g} s")
+
+
+def _resonance(summary):
+    return _given(summary.get("resonance_Hz"), "no periodic point of the sweep has a T max")
+
+
+def _fold(summary):
+    if not summary["folds"]:
+        f = [p["f1_Hz"] for p in summary["branch"]]
+        raise QuantityError(f"the branch has no fold in f1 = {min(f):g}-{max(f):g} Hz")
+    return float(summary["folds"][0]["f1_Hz"])
+
+
+def _tension_max(summary):
+    point = summary["points"][0]
+    return _given(point.get("tension_max_N"),
+                  f"the sweep point f1 = {point['f1_Hz']:g} Hz failed or went slack")
+
+
+def _modal(family: str, field: str):
+    return lambda modes: float(getattr(_lowest(modes, (family,)), field))
+
+
+QUANTITIES = {q.name: q for q in [
+    Quantity("tension_s0_N", "N", "stationary", lambda r: r["tension_s0_N"],
+             "tension at the ground end s = 0 of the stationary state"),
+    Quantity("sag_m", "m", "stationary", lambda r: r["sag_m"],
+             "largest distance of the stationary centre line from the chord"),
+    Quantity("lateral_frequency_Hz", "Hz", "modes",
+             lambda m: min(_lowest(m, (f,)).frequency_Hz for f in LATERAL),
+             "the lower frequency of the lowest lateral modes of the two planes"),
+    *[Quantity(f"{f}_{field}", unit, "modes", _modal(f, field),
+               f"{what} of the lowest {f.replace('_', ' ')} mode")
+      for f in VIBRATIONS
+      for field, unit, what in (("frequency_Hz", "Hz", "frequency"),
+                                ("decay_per_s", "1/s", "decay rate"))],
+    Quantity("settling_time_s", "s", "spin_up", _settling,
+             "time after which the spins stay within 2 % of the target (Sec. 5.2)"),
+    Quantity("resonance_Hz", "Hz", "sweep", _resonance,
+             "f1 of the largest T max of the sweep over the scene's [sweep] list (Fig. 8)"),
+    Quantity("fold_Hz", "Hz", "orbits", _fold,
+             "f1 of the first fold of the periodic orbits over the [sweep] window"),
+    Quantity(f"tension_max_N{AT}F1", "N", "sweep@F1", _tension_max,
+             "largest tension at s = 0 of the periodic response at f1 = F1 Hz"),
+]}
+
+
+def names() -> list[str]:
+    return list(QUANTITIES)
+
+
+def parse(name: str, where: str = "--quantity") -> tuple[Quantity, float | None]:
+    """The quantity of a name (``tension_max_N@10`` -> the family at f1 = 10 Hz)."""
+    base, sep, f1_text = name.partition(AT)
+    key = f"{base}{AT}F1" if sep else base
+    if key not in QUANTITIES or (key.endswith(f"{AT}F1") and not sep):
+        raise SceneError(where, name, "unknown quantity; known are " + ", ".join(QUANTITIES))
+    if not sep:
+        return QUANTITIES[key], None
+    try:
+        f1 = float(f1_text)
+    except ValueError:
+        f1 = -1.0
+    if not (f1 > 0 and math.isfinite(f1)):
+        raise SceneError(where, name, f"F1 in {base}{AT}F1 must be a frequency > 0 in Hz")
+    return QUANTITIES[key], f1
+
+
+def parse_list(text: str, where: str = "--quantity") -> list[str]:
+    """``Q[,Q...]`` -> the names, each checked (:func:`parse`)."""
+    items = [t.strip() for t in str(text).split(",") if t.strip()]
+    if not items:
+        raise SceneError(where, text, "give at least one quantity: " + ", ".join(QUANTITIES))
+    for item in items:
+        parse(item, where)
+    return items
+
+
+def evaluate(params: Parameters, wanted: list[str]) -> dict:
+    """Every quantity of ``wanted`` for one scene, each stage computed once on
+    COMM_SELF: ``{"values": {name: float | None}, "errors": {name: reason},
+    "cpu_s": {stage: s}, "wall_s": {stage: s}}``.  A stage that fails leaves
+    its quantities None with the reason; exceptions other than POINT_ERRORS
+    (a failure of the machinery) propagate."""
+    stages: dict[tuple, list] = {}
+    for name in wanted:
+        quantity, f1 = parse(name)
+        stage = ("sweep", f1) if quantity.stage == f"sweep{AT}F1" else (quantity.stage, None)
+        stages.setdefault(stage, []).append((name, quantity))
+    values, errors, cpu, wall = {}, {}, {}, {}
+    for (stage, f1), members in stages.items():
+        label = stage if f1 is None else f"{stage}{AT}{f1:g}"
+        c0, w0 = time.process_time(), time.perf_counter()
+        try:
+            result, failure = STAGES[stage](params, f1), None
+        except POINT_ERRORS as err:
+            result, failure = None, f"{label}: {type(err).__name__}: {err}"
+        cpu[label], wall[label] = time.process_time() - c0, time.perf_counter() - w0
+        for name, quantity in members:
+            values[name] = None
+            if failure:
+                errors[name] = failure
+                continue
+            try:
+                values[name] = float(quantity.pick(result))
+            except QuantityError as err:
+                errors[name] = f"{label}: {err}"
+    return {"values": values, "errors": errors, "cpu_s": cpu, "wall_s": wall}
+
+
+def table() -> str:
+    """The quantities, one a line (for --help and docs/study.md)."""
+    return "\n".join(f"  {q.name:<36} [{q.unit}] ({q.stage}) {q.doc}" for q in QUANTITIES.values())

@@ -1,0 +1,396 @@
+"""`rawehelix study`: named quantities over a design of scene keys, on MPI ranks.
+
+    rawehelix study SCENE --vary KEY=START:STOP:COUNT [--vary ...]
+                    [--sample grid|lhs|sobol --points N] --quantity Q[,Q...] [-o DIR]
+
+``KEY`` is any dotted scene key (``helix.EI_Nm2``, ``damping.bending_s``);
+every point's scene is validated like a scene file before anything runs (a
+bad key or value: the scene loader's message, exit status 2).  The design:
+
+* ``grid``: the Cartesian product of ``numpy.linspace(START, STOP, COUNT)``
+  over the keys (the first key varies slowest);
+* ``lhs``: N points of a Latin hypercube (``scipy.stats.qmc.LatinHypercube``)
+  in the box [START, STOP]^d (COUNT is not used);
+* ``sobol``: Saltelli's design for Sobol' indices from SALib
+  (``SALib.sample.sobol``, built on ``scipy.stats.qmc.Sobol``): N base points,
+  N (d + 2) scenes (first-order and total indices, no second-order ones).
+
+Besides the design, the base point (the scene's own values) and, for each key,
+two points p0 (1 -+ h) (``fd_step`` h, default 1e-2) give the normalised
+sensitivities at the base point by central differences,
+
+    d ln Q / d ln p ~ (Q(p0 (1 + h)) - Q(p0 (1 - h))) / (Q(p0) ln((1 + h) / (1 - h))),
+
+exact for Q ~ p^a; none for a key whose base value is 0 or an integer.  When
+sampled, the variance-based indices come from SALib: Sobol' S1 and ST
+(``SALib.analyze.sobol``) for ``sobol``, S1 by RBD-FAST
+(``SALib.analyze.rbd_fast``, any sample) for ``lhs``.
+
+Every point is one evaluation (:mod:`rawehelix.studies.quantities`) on
+COMM_SELF, taken by the ranks from a shared counter and stored as it ends
+(:mod:`rawehelix.studies.pool`: resumable, failures recorded).  Outputs in
+``DIR``: ``study.csv`` (one row per point in point order: the keys, the
+quantities, then id, kind, status and the reason of a failure; the same
+bytes for any number of ranks), ``summary.json``, ``study.png`` (each
+quantity against each key) and ``tornado.png`` (the sensitivities).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import itertools
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.errors import SceneError
+from rawehelix.parameters import Parameters
+from rawehelix.studies import pool, quantities, scene, writers
+
+SAMPLES = ("grid", "lhs", "sobol")
+FD_STEP = 1e-2  # relative step of the central differences at the base point
+SEED = 0  # of the LHS and Sobol' designs and SALib's bootstrap
+
+
+@dataclass(frozen=True)
+class Variable:
+    key: str
+    start: float
+    stop: float
+    count: int | None = None
+
+
+def parse_vary(text: str) -> Variable:
+    """``KEY=START:STOP[:COUNT]`` (COUNT: grid points, >= 2)."""
+    key, sep, spec = str(text).partition("=")
+    parts = spec.split(":")
+    try:
+        if not sep or not key.strip() or len(parts) not in (2, 3):
+            raise ValueError
+        start, stop = float(parts[0]), float(parts[1])
+        count = int(parts[2]) if len(parts) == 3 else None
+    except ValueError:
+        raise SceneError("--vary", text, "must be KEY=START:STOP:COUNT, e.g. "
+                         "helix.EI_Nm2=3000:6000:4") from None
+    if count is not None and count < 1:
+        raise SceneError("--vary", text, "COUNT must be an integer >= 1")
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise SceneError("--vary", text, "START and STOP must be finite numbers")
+    return Variable(key.strip(), start, stop, count)
+
+
+@dataclass(frozen=True)
+class Source:
+    """How every point's scene is made: the scene file (or shipped name), the
+    discretisation and the base overrides (``--set``), plus the point's keys."""
+
+    path: str
+    elements: int | None = None
+    degree: int | None = None
+    scheme: str | None = None
+    overrides: dict = field(default_factory=dict)
+
+    def load(self, extra: dict | None = None) -> Parameters:
+        return scene.load(self.path, elements=self.elements, degree=self.degree,
+                          scheme=self.scheme, overrides={**self.overrides, **(extra or {})})
+
+
+def key_type(key: str) -> str:
+    """The scene key's type name ('float', 'int', ...), or 'float' if unknown
+    (the loader then names the key)."""
+    section, _, name = key.partition(".")
+    cls = scene.SECTIONS.get(section)
+    types = {f.name: f.type for f in dataclasses.fields(cls)} if cls else {}
+    return types.get(name, "float")
+
+
+def cast(key: str, value: float):
+    """A design value for the key: an integer key gets the nearest integer."""
+    return int(round(value)) if key_type(key) == "int" else float(value)
+
+
+def base_value(params: Parameters, key: str):
+    """The scene's value of a dotted key (``damping.*`` lives in ``params.model``)."""
+    section, _, name = key.partition(".")
+    holder = params.model.damping if section == "damping" else getattr(params, section)
+    return getattr(holder, name)
+
+
+def design(variables: list[Variable], sample: str, points: int | None, seed: int = SEED):
+    """The design's points, (n, d), in the box of the variables."""
+    lo = np.array([v.start for v in variables])
+    hi = np.array([v.stop for v in variables])
+    d = len(variables)
+    if sample == "grid":
+        missing = [v.key for v in variables if v.count is None]
+        if missing:
+            raise SceneError("--vary", missing[0], "a grid needs KEY=START:STOP:COUNT")
+        axes = [np.linspace(v.start, v.stop, v.count) for v in variables]
+        return np.array(list(itertools.product(*axes)), dtype=float).reshape(-1, d)
+    if points is None or points < 1:
+        raise SceneError("--points", points, f"--sample {sample} needs --points N >= 1")
+    if sample == "lhs":
+        from scipy.stats import qmc
+        return qmc.scale(qmc.LatinHypercube(d=d, seed=seed).random(points), lo, hi)
+    if sample == "sobol":
+        from SALib.sample import sobol
+        if np.any(hi <= lo):
+            raise SceneError("--vary", variables[int(np.argmax(hi <= lo))].key,
+                             "--sample sobol needs START < STOP")
+        return sobol.sample(problem(variables), points, calc_second_order=False, seed=seed)
+    raise SceneError("--sample", sample, f"must be one of {', '.join(SAMPLES)}")
+
+
+def problem(variables: list[Variable]) -> dict:
+    """SALib's description of the box."""
+    return {"num_vars": len(variables), "names": [v.key for v in variables],
+            "bounds": [[v.start, v.stop] for v in variables]}
+
+
+def fd_points(base: dict, fd_step: float) -> tuple[list, dict]:
+    """The tasks of the sensitivities at the base point, and why a key has none."""
+    tasks, skipped = [pool.Task("base", {}, "base")], {}
+    if fd_step <= 0:
+        return [], {k: "fd_step = 0" for k in base}
+    for key, p0 in base.items():
+        if isinstance(p0, bool) or not isinstance(p0, (int, float)) or key_type(key) == "int":
+            skipped[key] = "not a real-valued key"
+        elif p0 == 0:
+            skipped[key] = "base value 0 (no logarithmic derivative)"
+        else:
+            tasks += [pool.Task(f"fd_{key}_{side}", {key: p0 * (1 + sign * fd_step)}, "fd")
+                      for side, sign in (("minus", -1), ("plus", 1))]
+    return tasks, skipped
+
+
+def make_tasks(source: Source, variables: list[Variable], sample: str, points, fd_step: float):
+    """(tasks, design (n, d), base values, skipped keys), every scene validated."""
+    keys = [v.key for v in variables]
+    if len(set(keys)) != len(keys):
+        raise SceneError("--vary", ", ".join(keys), "each key once")
+    base_params = source.load()
+    base = {}
+    for v in variables:
+        source.load({v.key: cast(v.key, v.start)})  # an unknown key: the loader's message
+        base[v.key] = base_value(base_params, v.key)
+    X = design(variables, sample, points)
+    tasks = [pool.Task(f"p{k:05d}", {key: cast(key, x) for key, x in zip(keys, row)})
+             for k, row in enumerate(X)]
+    extra, skipped = fd_points(base, fd_step)
+    tasks += extra
+    for task in tasks:  # every point's scene, validated before anything runs
+        source.load(task.overrides)
+    return tasks, X, base, skipped
+
+
+def sensitivities(records: dict, base: dict, wanted: list[str], fd_step: float) -> dict:
+    """d ln Q / d ln p at the base point: {Q: {key: value or None}}."""
+    out = {}
+    step = math.log((1 + fd_step) / (1 - fd_step)) if 0 < fd_step < 1 else None
+    for name in wanted:
+        row = {}
+        q0 = records.get("base", {}).get("values", {}).get(name)
+        for key in base:
+            minus = records.get(f"fd_{key}_minus", {}).get("values", {}).get(name)
+            plus = records.get(f"fd_{key}_plus", {}).get("values", {}).get(name)
+            ok = None not in (q0, minus, plus, step) and q0 != 0
+            row[key] = (plus - minus) / (q0 * step) if ok else None
+        out[name] = row
+    return out
+
+
+def variance_indices(sample: str, variables, X, Y, seed: int = SEED) -> dict | None:
+    """SALib's indices of one quantity's values Y on the design X, or the reason there are none."""
+    if sample == "grid":
+        return None
+    if not np.all(np.isfinite(Y)):
+        return {"note": f"{int(np.sum(~np.isfinite(Y)))} failed points: no indices"}
+    prob = problem(variables)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)  # SALib's call of pandas.unique
+            r, keys, method = _salib(sample, prob, X, Y, seed)
+    except (ValueError, ZeroDivisionError, IndexError) as err:
+        return {"note": f"SALib: {err}"}
+    return {"method": method, **{v.key: {k: float(r[k][i]) for k in keys}
+                                 for i, v in enumerate(variables)}}
+
+
+def _salib(sample: str, prob: dict, X, Y, seed: int):
+    if sample == "sobol":
+        from SALib.analyze import sobol
+        return (sobol.analyze(prob, Y, calc_second_order=False, seed=seed),
+                ("S1", "S1_conf", "ST", "ST_conf"), "Sobol' (Saltelli design, SALib.analyze.sobol)")
+    from SALib.analyze import rbd_fast
+    return (rbd_fast.analyze(prob, X, Y, seed=seed), ("S1", "S1_conf"),
+            "RBD-FAST first-order (SALib.analyze.rbd_fast)")
+
+
+@dataclass
+class StudyResult:
+    scene: str
+    title: str
+    variables: list
+    wanted: list
+    sample: str
+    records: dict  # id -> record, in point order
+    summary: dict
+
+    def column(self, name: str, kind: str = "design") -> np.ndarray:
+        return np.array([np.nan if r["values"][name] is None else r["values"][name]
+                         for r in self.records.values() if r["kind"] == kind])
+
+    def keys_of(self, kind: str = "design") -> np.ndarray:
+        return np.array([[r["overrides"][v.key] for v in self.variables]
+                         for r in self.records.values() if r["kind"] == kind], dtype=float)
+
+    def csv_text(self) -> str:
+        """study.csv: the same bytes for the same points, whichever rank computed them."""
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        keys = [v.key for v in self.variables]
+        w.writerow([*keys, *self.wanted, "id", "kind", "status", "error"])
+        for r in self.records.values():
+            over = r["overrides"]
+            w.writerow([repr(over[k]) if k in over else repr(self.summary["base"][k])
+                        for k in keys]
+                       + ["" if r["values"][q] is None else repr(r["values"][q])
+                          for q in self.wanted]
+                       + [r["id"], r["kind"], r["status"], "; ".join(r["errors"].values())])
+        return buf.getvalue()
+
+    def write(self, outdir) -> Path:
+        outdir = Path(outdir)
+        outdir.mkdir(parents=True, exist_ok=True)
+        writers.write_text(outdir / "study.csv", self.csv_text())
+        writers.write_json(outdir / "summary.json", self.summary)
+        scatter_png(outdir / "study.png", self)
+        tornado_png(outdir / "tornado.png", self.summary["sensitivities"],
+                    f"{self.title}: d ln Q / d ln p at the base point "
+                    f"(h = {self.summary['fd_step']:g})")
+        return outdir
+
+
+def scatter_png(path: Path, result: StudyResult):
+    """Each quantity (rows) against each key (columns), the base point marked."""
+    plt = writers._pyplot()
+    nq, nv = len(result.wanted), len(result.variables)
+    fig, axes = plt.subplots(nq, nv, figsize=(3.4 * nv + 0.6, 2.6 * nq + 0.6), squeeze=False)
+    X = result.keys_of()
+    base = result.records.get("base")
+    for i, name in enumerate(result.wanted):
+        Y = result.column(name)
+        for j, v in enumerate(result.variables):
+            ax = axes[i, j]
+            if len(X):
+                order = np.argsort(X[:, j], kind="stable")
+                ax.plot(X[order, j], Y[order], "o", ms=3.5, color="C0")
+            if base and base["values"][name] is not None:
+                ax.plot(result.summary["base"][v.key], base["values"][name], "*", ms=10,
+                        color="C3", label="base point")
+            ax.grid(alpha=0.3)
+            if i == nq - 1:
+                ax.set_xlabel(v.key)
+            if j == 0:
+                ax.set_ylabel(f"{name}")
+    if base:
+        axes[0, 0].legend(fontsize=8)
+    return writers._finish(fig, path, f"{result.title}: {result.sample} design, "
+                           f"{len(X)} points")
+
+
+def tornado_png(path: Path, sens: dict, title: str):
+    """Horizontal bars of d ln Q / d ln p, one panel per quantity, largest on top."""
+    plt = writers._pyplot()
+    fig, axes = plt.subplots(1, len(sens), figsize=(4.2 * len(sens) + 0.8, 0.5 * max(
+        len(next(iter(sens.values()))), 2) + 1.6), squeeze=False)
+    for ax, (name, row) in zip(axes[0], sens.items()):
+        items = sorted(((k, v) for k, v in row.items() if v is not None), key=lambda kv: abs(kv[1]))
+        y = np.arange(len(items))
+        ax.barh(y, [v for _, v in items], color=["C3" if v < 0 else "C0" for _, v in items])
+        ax.set_yticks(y, [k for k, _ in items], fontsize=8)
+        ax.axvline(0, color="k", lw=0.8)
+        ax.set_title(name, fontsize=9)
+        ax.grid(axis="x", alpha=0.3)
+    return writers._finish(fig, path, title)
+
+
+def header(source: Source, params: Parameters, variables, sample, points, wanted, fd_step):
+    disc = params.discretisation
+    return {"scene": params.name, "fingerprint": writers.digest(params.as_dict()),
+            "scheme": disc.scheme, "elements": disc.elements, "degree": disc.degree,
+            "variables": [dataclasses.asdict(v) for v in variables], "sample": sample,
+            "points": points, "seed": SEED, "quantities": list(wanted), "fd_step": fd_step}
+
+
+def compute(source: Source, variables: list[Variable], wanted: list[str], outdir,
+            sample: str = "grid", points: int | None = None, fd_step: float | None = None,
+            comm=MPI.COMM_WORLD, log=None) -> StudyResult:
+    """Run (or resume) the study in ``outdir`` on the ranks of ``comm``
+    (collective); the result on every rank.  ``fd_step``: None is FD_STEP, 0
+    no sensitivities.  Raises SceneError for bad input before anything is
+    computed or written."""
+    start = time.perf_counter()
+    fd_step = FD_STEP if fd_step is None else fd_step
+    if sample not in SAMPLES:
+        raise SceneError("--sample", sample, f"must be one of {', '.join(SAMPLES)}")
+    if not variables:
+        raise SceneError("--vary", "", "give at least one KEY=START:STOP:COUNT")
+    wanted = [q for q in wanted]
+    for name in wanted:
+        quantities.parse(name)
+    if not 0 <= fd_step < 1:
+        raise SceneError("--fd-step", fd_step, "must be in [0, 1)")
+    tasks, X, base, skipped = make_tasks(source, variables, sample, points, fd_step)
+    params = source.load()
+    store = pool.Store(outdir, header(source, params, variables, sample, points, wanted,
+                                      fd_step)).open(comm)
+    out = pool.run(tasks, source.load, wanted, store, comm=comm, log=log)
+    records = out["records"]
+    loops = comm.allgather({"rank": comm.rank, "loop_wall_s": out.get("loop_wall_s"),
+                            "loop_cpu_s": out.get("loop_cpu_s")})
+    sens = sensitivities(records, base, wanted, fd_step)
+    design_records = [r for r in records.values() if r["kind"] == "design"]
+    indices = {}
+    for name in wanted:
+        Y = np.array([np.nan if r["values"][name] is None else r["values"][name]
+                      for r in design_records])
+        indices[name] = variance_indices(sample, variables, X, Y)
+    cost = {}
+    for r in records.values():
+        for stage, c in r["cpu_s"].items():
+            cost.setdefault(stage, []).append(c)
+    summary = {**store.header, "base": base, "design_points": len(X),
+               "points_total": len(tasks),
+               "sensitivity": "d ln Q / d ln p = (Q(p0 (1 + h)) - Q(p0 (1 - h))) / "
+                              "(Q(p0) ln((1 + h) / (1 - h))), h = fd_step",
+               "sensitivities": sens, "sensitivities_skipped": skipped,
+               "variance_indices": indices if sample != "grid" else None,
+               "failed": {r["id"]: r["errors"] for r in records.values()
+                          if r["status"] == "failed"},
+               "cpu_s_per_point_by_stage": {s: float(np.median(c)) for s, c in cost.items()},
+               "computed_now": out["computed"], "ranks": comm.size, "loops": loops,
+               "wall_s": time.perf_counter() - start}
+    return StudyResult(params.name, params.title or params.name, variables, wanted, sample,
+                       records, summary)
+
+
+def report(result: StudyResult) -> str:
+    s = result.summary
+    lines = [f"{result.title}: {s['design_points']} design points + {s['points_total'] - s['design_points']} "
+             f"for the sensitivities ({s['computed_now']} computed now, {s['ranks']} rank(s), "
+             f"{s['wall_s']:.1f} s); {len(s['failed'])} failed"]
+    for name, row in s["sensitivities"].items():
+        shown = ", ".join(f"{k} {v:+.3f}" for k, v in row.items() if v is not None)
+        if shown:
+            lines.append(f"  d ln {name} / d ln p: {shown}")
+    for pid, errors in list(s["failed"].items())[:5]:
+        lines.append(f"  failed {pid}: {'; '.join(errors.values())}")
+    return "\n".join(lines)
