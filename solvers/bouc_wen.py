@@ -75,5 +75,8 @@ def cycle_energies(times, theta, M, period_s: float, cycles: int) -> np.ndarray:
 
 
 def secant(theta, M, length_m: float):
-    """M L0 / theta [Nm^2], the ratio of the paper's Fig. 5 (Eq. 65 solved for GJ)."""
-    return np.asarray(M) * length_m / np.asarray(theta)
+    """M L0 / theta [Nm^2], the ratio of the paper's Fig. 5 (Eq. 65 solved for GJ);
+    NaN where theta = 0."""
+    theta = np.asarray(theta, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(theta != 0, np.asarray(M) * length_m / theta, np.nan)

@@ -24,53 +24,15 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat
 from rawehelix.errors import SceneError
-from rawehelix.parameters import (Discretisation, Ends, Environment, Helix, Model, ParameterError,
-                                  Parameters, Time, TorsionHysteresis)
+from rawehelix.parameters import ParameterError, TorsionHysteresis
 from rawehelix.solvers import bouc_wen
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.studies import scene
+from rawehelix.studies.torsion_test import GJ_NM2, LENGTH_M, reference, run, segment
 
-LAB_LENGTH_M = 6.76  # the segment of Sec. 4
-TABLE2_MASS_PER_M = 0.51 / 16.12  # Table 2: M / L0 [kg/m]
-GJ = 140.0
-THETA_MAX = math.radians(50.0)  # Sec. 4: "a maximum torsion angle of about 50 degrees"
 LAW = TorsionHysteresis(rho=0.5, A=1.0, beta_m_n=10.0, gamma_m_n=10.0, n=1.0)
-
-
-def segment(law: TorsionHysteresis = LAW, elements: int = 2) -> Parameters:
-    """The torsion test's segment at T_e = 200 N, horizontal, no wind."""
-    return Parameters(
-        helix=Helix(LAB_LENGTH_M, TABLE2_MASS_PER_M * LAB_LENGTH_M, 3.64e4, 1.28e4, GJ),
-        ends=Ends(200.0 / 3.64e4, 0.0), environment=Environment(wind_speed_m_s=0.0),
-        model=Model(torsion_hysteresis=law), discretisation=Discretisation(elements=elements),
-        time=Time(dt_s=0.1), name="torsion_test")
-
-
-def fe_cycle(params: Parameters, period_s: float, cycles: int, steps_per_cycle: int):
-    """(times [s], theta [rad], end moment [Nm]) of the FE torsion test, alpha2 at fixed steps."""
-    q = params.normalised()
-    theta, _ = bouc_wen.torsion_cycle(THETA_MAX, period_s)
-    solver = DynamicsSolver.from_stationary(
-        params, MPI.COMM_WORLD, options={"ts_adapt_type": "none"},
-        end_twist=lambda t: float(theta(q.time_s(t))))
-    dt = period_s / steps_per_cycle / q.t_scale
-    solver.ts.setTimeStep(dt)
-    times, moments = [], []
-
-    def record(s):
-        times.append(float(q.time_s(s.t)))
-        moments.append(float(q.torque_Nm(s.end_moment())))
-
-    solver.advance(cycles * period_s / q.t_scale, on_output=record, output_every=dt)
-    times, moments = np.array(times), np.array(moments)
-    return times, theta(times), moments
-
-
-def reference(law, times, period_s):
-    theta, theta_t = bouc_wen.torsion_cycle(THETA_MAX, period_s)
-    return bouc_wen.moment(law, GJ, LAB_LENGTH_M, theta, theta_t, times)
 
 
 def test_torsion_cycle_dissipates_as_the_scipy_bouc_wen():
@@ -79,7 +41,7 @@ def test_torsion_cycle_dissipates_as_the_scipy_bouc_wen():
     cycle equals the scipy reference's within 1 % (measured 0.1 %), and a
     reference with rho 0.05 off misses it by more than 1 %."""
     period, cycles = 20.0, 4
-    t, theta, M = fe_cycle(segment(), period, cycles, 100)
+    t, theta, M = run(segment(LAW), period, cycles, 100)
     E = bouc_wen.cycle_energies(t, theta, M, period, cycles)
     E_ref = bouc_wen.cycle_energies(t, theta, reference(LAW, t, period), period, cycles)
     error = np.abs(E / E_ref - 1)
@@ -91,7 +53,7 @@ def test_torsion_cycle_dissipates_as_the_scipy_bouc_wen():
     E_other = bouc_wen.cycle_energies(t, theta, reference(other, t, period), period, cycles)
     assert np.all(np.abs(E / E_other - 1) > 0.01)
     # the elastic rod (Eq. 65) dissipates nothing over the same cycle
-    elastic = GJ * theta / LAB_LENGTH_M
+    elastic = GJ_NM2 * theta / LENGTH_M
     assert np.all(np.abs(bouc_wen.cycle_energies(t, theta, elastic, period, cycles))
                   < 1e-3 * E_ref)
 
@@ -103,7 +65,7 @@ def test_alpha2_integrates_the_internal_twist_to_second_order():
     period = 200.0
     errors = []
     for steps in (25, 50, 100):
-        t, _, M = fe_cycle(segment(), period, 1, steps)
+        t, _, M = run(segment(LAW), period, 1, steps)
         errors.append(np.max(np.abs(M - reference(LAW, t, period))))
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     print("max |M - M_ref| [Nm]:", errors, "orders", orders)
@@ -158,11 +120,11 @@ def test_default_is_the_paper_model_and_its_fingerprint():
     assert "torsion_hysteresis" not in p.as_dict()["model"]
     assert not p.normalised().hysteretic and "hysteresis" not in p.model.describe()
     rod_off = RodDiscretisation(p, MPI.COMM_WORLD)
-    rod_on = RodDiscretisation(segment(), MPI.COMM_WORLD)
+    rod_on = RodDiscretisation(segment(LAW), MPI.COMM_WORLD)
     N, deg = p.discretisation.elements, p.discretisation.degree
     assert rod_on.dof_count() - rod_off.dof_count() == N * deg  # DG_(p-1): p dofs a cell
-    assert "torsion hysteresis: Bouc-Wen rho = 0.5" in segment().model.describe()
-    assert "torsion_hysteresis" in segment().as_dict()["model"]
+    assert "torsion hysteresis: Bouc-Wen rho = 0.5" in segment(LAW).model.describe()
+    assert "torsion_hysteresis" in segment(LAW).as_dict()["model"]
 
 
 def test_scene_section_and_refusals(tmp_path):
@@ -181,7 +143,7 @@ def test_scene_section_and_refusals(tmp_path):
                                    name="nominal_operation"))
     with pytest.raises(ParameterError, match="torsion_hysteresis"):
         p.replace(discretisation={"bending": "mixed"})
-    small = segment()
+    small = segment(LAW)
     with pytest.raises(SceneError, match="second-order integrator"):
         DynamicsSolver(small, MPI.COMM_WORLD, options={"ts_type": "beuler"})
     with pytest.raises(SceneError, match="modal solver"):
