@@ -148,3 +148,12 @@ def test_scene_section_and_refusals(tmp_path):
         DynamicsSolver(small, MPI.COMM_WORLD, options={"ts_type": "beuler"})
     with pytest.raises(SceneError, match="modal solver"):
         ModalSolver(small, MPI.COMM_WORLD)
+
+
+@pytest.mark.mpi
+def test_same_torsion_loop_on_one_and_two_ranks():
+    """z's DG dofs and their error tolerances are per rank: the loop (one cycle of
+    20 s, N = 4, 50 steps) on COMM_WORLD equals the serial one."""
+    params = segment(LAW, elements=4)
+    loops = [run(params, 20.0, 1, 50, comm=comm)[2] for comm in (MPI.COMM_SELF, MPI.COMM_WORLD)]
+    assert np.max(np.abs(loops[0] - loops[1])) < 1e-9 * np.max(np.abs(loops[0]))
