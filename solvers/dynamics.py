@@ -127,6 +127,9 @@ class DynamicsSolver:
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
+            if end_twist is not None and ts_type != "alpha2":
+                raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
+                                 "(the first-order form sets its own end conditions)")
             self.form = SecondOrder(self.rod, bcs) if ts_type == "alpha2" else FirstOrder(self.rod, bcs)
             if end_twist is not None:
                 self.form.time_data.append(

@@ -72,11 +72,14 @@ def test_alpha2_integrates_the_internal_twist_to_second_order():
     assert np.all(orders > 1.8)
 
 
-def test_tangent_is_the_derivative_of_the_residual():
+@pytest.mark.parametrize("gamma", ["off", "regularised"])
+def test_tangent_is_the_derivative_of_the_residual(gamma):
     """J = dF/dU + v_shift dF/dV + a_shift dF/dA against the central difference of F
     along (U + e dU, V + v_shift e dU, A + a_shift e dU), at a twisted, moving
-    state with z on the loop (no kink of |tau_t| or |z| at the quadrature points)."""
+    state with z on the loop (no kink of |tau_t| or |z| at the quadrature points);
+    with the Frenet torsion on, tau_t has its rate too."""
     params = segment(TorsionHysteresis(rho=0.4, A=1.3, beta_m_n=8.0, gamma_m_n=-3.0, n=1.5))
+    params = params.replace(model={"gamma": gamma})
     solver = DynamicsSolver.from_stationary(params, MPI.COMM_WORLD)
     form = solver.form
     rng = np.random.default_rng(3)
@@ -86,6 +89,8 @@ def test_tangent_is_the_derivative_of_the_residual():
     form.v.sub(1).interpolate(lambda x: 0.7 * x[0] ** 2 + 0.1 * x[0])
     form.v.sub(2).interpolate(lambda x: 0.3 - 0.2 * x[0])
     form.v.sub(0).interpolate(lambda x: np.vstack([0.01 * x[0], 0.02 * x[0] ** 2, 0 * x[0]]))
+    form.u.sub(0).interpolate(  # out of plane: a centre line with curvature and torsion
+        lambda x: np.vstack([-x[0], 0.01 * np.sin(np.pi * x[0]), 0.02 * np.sin(2 * np.pi * x[0])]))
     form.a.x.array[:] = rng.normal(0, 0.1, form.a.x.array.size)
     base = [f.x.array.copy() for f in (form.u, form.v, form.a)]
     du = rng.normal(0, 1, u0.size) * 1e-3
@@ -148,6 +153,9 @@ def test_scene_section_and_refusals(tmp_path):
         DynamicsSolver(small, MPI.COMM_WORLD, options={"ts_type": "beuler"})
     with pytest.raises(SceneError, match="modal solver"):
         ModalSolver(small, MPI.COMM_WORLD)
+    with pytest.raises(ValueError, match="alpha2 only"):
+        DynamicsSolver(segment(TorsionHysteresis()), MPI.COMM_WORLD,
+                       options={"ts_type": "beuler"}, end_twist=lambda t: 0.0)
 
 
 @pytest.mark.mpi
