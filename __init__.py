@@ -23,8 +23,8 @@ Subpackages:
 
 __version__ = "0.2.0"
 
-from rawehelix.api import (Parameters, SceneError, SolverError, load_scene, modes,  # noqa: E402
-                           orbits, response, simulate, stationary, sweep)
+from rawehelix.api import (Parameters, SceneError, SolverError, labtest, load_scene,  # noqa: E402
+                           modes, orbits, response, simulate, stationary, sweep)
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "SceneError", "SolverError", "Parameters", "__version__"]
+           "labtest", "SceneError", "SolverError", "Parameters", "__version__"]

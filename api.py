@@ -23,7 +23,7 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "SceneError", "SolverError", "Parameters"]
+           "labtest", "SceneError", "SolverError", "Parameters"]
 
 
 def _world(comm):
@@ -108,12 +108,14 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
 
 
 def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None,
-           outdir=None, tension_step=None, max_points: int = 400):
+           outdir=None, tension_step=None, max_points: int = 400, superharmonics=None):
     """The branch of periodic orbits of Sec. 5.3 from f1_start towards f1_stop [Hz]:
     shooting on the period map of the generalised-alpha integrator, Floquet
     multipliers from its tangent, pseudo-arclength continuation through folds,
     the step held so that T max changes by at most ``tension_step`` (relative)
-    between points.  An :class:`~rawehelix.studies.orbits.OrbitsResult` with
+    between points, and closing in on the k:1 superharmonic sites f_n / k of the
+    lateral natural frequencies (k in ``superharmonics``, default (2, 3); () for
+    none), reported in ``peaks``.  An :class:`~rawehelix.studies.orbits.OrbitsResult` with
     ``branch`` (``f1_Hz``, ``tension_max_N``, ``tension_min_N``, ``stable``,
     ``max_multiplier``, ``newton_iterations``), ``folds``, ``bifurcations``,
     ``peaks`` and ``summary``.  ``progress(orbit)`` is called at every point.
@@ -121,5 +123,25 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     ``outdir`` every point is stored as found and a rerun resumes after the last."""
     from rawehelix.studies import orbits as study
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
-                         outdir=outdir, tension_step=tension_step, max_points=max_points)
+                         outdir=outdir, tension_step=tension_step, max_points=max_points,
+                         superharmonics=superharmonics)
 
+
+
+def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=None,
+            fit: bool = False, rod_EI_Nm2: float | None = None, elements: int | None = None,
+            degree: int | None = None, gravity: bool = True, comm=None):
+    """The paper's lab test ``test`` ("axial", "bending" or "torsion", Sec. 4,
+    Fig. 2 a-c) run on a 6.76 m segment of ``scene``'s helix (default the
+    Table 2 helix) clamped at a wall, with the tension T_e [N] (``tensions_N``)
+    a dead load along its axis; ``loads`` are F_N [N] (bending) or M_t [Nm]
+    (torsion).  A :class:`~rawehelix.studies.labtest.LabTest` whose ``summary``
+    has the apparent EA, EI or GJ that Eqs. (62), (63), (65) infer.
+    ``fit`` (bending): the intrinsic law EI = a T + b whose simulated test
+    reproduces Eq. (64) (``summary["law"]``); ``rod_EI_Nm2``: the rod's constant
+    EI (default Eq. (64) at each T_e)."""
+    from rawehelix.studies import labtest as study
+    scene = scene if scene is not None else load_scene("stationary_table2")
+    return study.compute(scene, test, tensions_N=tensions_N, loads=loads, fit=fit,
+                         rod_EI_Nm2=rod_EI_Nm2, elements=elements, degree=degree,
+                         gravity=gravity, comm=_world(comm))

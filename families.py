@@ -7,6 +7,9 @@ numpy-free on purpose: the spline and shooting references import it too.
 #: free rotation alpha = const (the zero eigenvalue of torque-free ends)
 FAMILIES = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional", "rigid")
 
+#: the families the upper end's circular motion drives (Sec. 5.3)
+LATERAL = FAMILIES[1:3]
+
 #: the families of vibrations, with a classical model each (solvers.analytic)
 VIBRATIONS = FAMILIES[:-1]
 

@@ -48,8 +48,36 @@ def _non_negative(section: str, obj, *names: str) -> None:
 
 
 @dataclass(frozen=True)
+class EILaw:
+    """Tension-dependent bending stiffness, EI = a T + b at the local tension
+    T = EA eps (Eq. 64 and Fig. 4 of the paper: a = 52.4 Nm^2/N, b = 2290 Nm^2
+    from the lab's bending tests at T_e = 90, 181, 259 N); forms/extensible.py.
+    a >= 0 and b > 0, so EI > 0 at every tension T > -b/a."""
+
+    a_Nm2_per_N: float  # a = dEI/dT [N m^2 / N]
+    b_Nm2: float  # b = EI at zero tension [N m^2]
+
+    def __post_init__(self):
+        _non_negative("helix.EI_law", self, "a_Nm2_per_N")
+        _positive("helix.EI_law", self, "b_Nm2")
+
+    def EI_Nm2(self, tension_N):
+        """EI = a T + b [N m^2] at the tension T [N]."""
+        return self.a_Nm2_per_N * tension_N + self.b_Nm2
+
+    def describe(self) -> str:
+        return f"EI law: EI = {self.a_Nm2_per_N:g} Nm^2/N x T + {self.b_Nm2:g} Nm^2"
+
+
+@dataclass(frozen=True)
 class Helix:
-    """The rod: Tables 1, 2 and 4 of the paper."""
+    """The rod: Tables 1, 2 and 4 of the paper.
+
+    ``EI_law`` (None: off) makes the bending stiffness a function of the local
+    tension (:class:`EILaw`; a scene's ``EI_law = {a_Nm2_per_N = .., b_Nm2 = ..}``).
+    EI_Nm2 then still sets the sections' rotational inertia (delta, Eq. 27,
+    2 rho I = 2 M EI / (EA L0)) and the normalisation mu of Eq. (26); the
+    bending stiffness is the law's."""
 
     length_m: float  # L0, unstretched length [m]
     mass_kg: float  # M, total mass [kg]
@@ -59,10 +87,25 @@ class Helix:
     radius_m: float = 0.19  # R, helix radius [m]: drawing only (delta uses Eq. 27)
     drag_length_m: float = 0.012  # l_a, sum of the bar diameters [m], Eq. (14)
     drag_coefficient: float = 1.0  # C_D, Eq. (14)
+    EI_law: EILaw | None = None  # EI = a T + b (Eq. 64); None: EI = EI_Nm2
 
     def __post_init__(self):
         _positive("helix", self, "length_m", "mass_kg", "EA_N", "EI_Nm2", "GJ_Nm2", "radius_m")
         _non_negative("helix", self, "drag_length_m", "drag_coefficient")
+        law = self.EI_law
+        if isinstance(law, dict):  # {a_Nm2_per_N, b_Nm2}, as in a scene
+            names = [f.name for f in dataclasses.fields(EILaw)]
+            unknown = sorted(set(law) - set(names))
+            missing = [n for n in names if n not in law]
+            if unknown or missing:
+                raise ParameterError("helix.EI_law", law, f"must have exactly the keys {names}")
+            for name in names:
+                if isinstance(law[name], bool) or not isinstance(law[name], (int, float)):
+                    raise ParameterError(f"helix.EI_law.{name}", law[name], "must be a number")
+            object.__setattr__(self, "EI_law", EILaw(**{n: float(law[n]) for n in names}))
+        elif law is not None and not isinstance(law, EILaw):
+            raise ParameterError("helix.EI_law", law,
+                                 "must be None or {a_Nm2_per_N = .., b_Nm2 = ..}")
 
 
 @dataclass(frozen=True)
@@ -260,6 +303,8 @@ class Model:
 #: defaults, so that those results keep their fingerprints
 LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Damping()),
                         "torsion_hysteresis": dataclasses.asdict(TorsionHysteresis())}
+#: the same for the helix section
+LATER_HELIX_SWITCHES = {"EI_law": None}
 
 SCHEMES = ("fe", "spline")
 MESHES = ("uniform", "graded")
@@ -389,6 +434,13 @@ class Parameters:
             raise ParameterError("model.kinematics", "extensible",
                                  "is implemented by the FE scheme with discretisation.bending "
                                  "= 'ip' only (forms/extensible.py)")
+        if self.helix.EI_law is not None and self.model.kinematics != "extensible":
+            raise ParameterError(
+                "helix.EI_law", self.helix.EI_law,
+                "needs model.kinematics = 'extensible': the law is built from the stored "
+                "energy 1/2 EI(eps) kappa^2, whose variation gives the axial force its "
+                "1/2 EI'(eps) kappa^2; the paper's forces (Eqs. 32-33) are not the "
+                "variation of an energy and act with EI on axial motion (forms/extensible.py)")
         if self.model.damping.active and (
                 self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"):
             raise ParameterError("damping", self.model.damping,
@@ -423,13 +475,20 @@ class Parameters:
         data = dataclasses.asdict(self)
         data.pop("name")
         data.pop("title")
-        for key, default in LATER_MODEL_SWITCHES.items():  # fingerprints stored before them
-            if data["model"][key] == default:
-                data["model"].pop(key)
+        for section, switches in (("model", LATER_MODEL_SWITCHES),
+                                  ("helix", LATER_HELIX_SWITCHES)):
+            for key, default in switches.items():  # fingerprints stored before them
+                if data[section][key] == default:
+                    data[section].pop(key)
         return data
 
     def normalised(self) -> "Normalised":
         return Normalised.from_parameters(self)
+
+    def describe_model(self, planar: bool = False) -> str:
+        """:meth:`Model.describe` and the helix's EI law when it has one: summary.json's "model"."""
+        text = self.model.describe(planar)
+        return text if self.helix.EI_law is None else f"{text}; {self.helix.EI_law.describe()}"
 
 
 @dataclass(frozen=True)
@@ -468,6 +527,11 @@ class Normalised:
     tau_axial: float = 0.0
     tau_bending: float = 0.0
     tau_torsion: float = 0.0
+    # the EI law (helix.EI_law): mu = mu_per_tension T~ + mu_at_zero_tension at the
+    # local normalised tension T~ = sigma eps, i.e. a / L0^2 and b / (M g L0^2)
+    bending_law: bool = False
+    mu_per_tension: float = 0.0
+    mu_at_zero_tension: float = 0.0
     # hysteretic torsion (forms/hysteresis.py): tau~ = tau L0 and z~ = z L0, so
     # beta~ = beta / L0^n and gamma~ = gamma / L0^n; rho = 1: off
     bw_rho: float = 1.0
@@ -487,6 +551,7 @@ class Normalised:
     @classmethod
     def from_parameters(cls, p: Parameters) -> "Normalised":
         h, e, env = p.helix, p.ends, p.environment
+        law = h.EI_law
         L0, M, g = h.length_m, h.mass_kg, env.g_m_s2
         t_scale = math.sqrt(L0 / g)  # (25)
         mu = h.EI_Nm2 / (M * g * L0**2)  # (26)
@@ -510,6 +575,9 @@ class Normalised:
             tau_axial=p.model.damping.axial_s / t_scale,
             tau_bending=p.model.damping.bending_s / t_scale,
             tau_torsion=p.model.damping.torsion_s / t_scale,
+            bending_law=law is not None,
+            mu_per_tension=0.0 if law is None else law.a_Nm2_per_N / L0**2,
+            mu_at_zero_tension=0.0 if law is None else law.b_Nm2 / (M * g * L0**2),
             bw_rho=bw.rho, bw_A=bw.A, bw_beta=bw.beta_m_n / L0**bw.n,
             bw_gamma=bw.gamma_m_n / L0**bw.n, bw_n=bw.n,
         )

@@ -35,6 +35,10 @@ the rate; in this model that is alpha_t, and with it the steady spin of a
 sagging rod would be damped (the rotating damping of a bent shaft), which the
 switch is specified not to do (tests/test_damping.py measures both).
 
+With the EI law (helix.EI_law, forms/extensible.py) the bending modulus in D
+is the local mu(eps) of the state (EI(T) tau_b: "the elastic modulus x the
+retardation time"), at the nodes as {{mu b}} and {{mu}}.
+
 Discretisation (C0 Lagrange, interior penalty): D_b is the IP energy of the
 rate, as the elastic bending form is that of r (forms/rod.py::bending) or of t
 (forms/extensible.py),
@@ -96,14 +100,26 @@ def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
     return eps_t, tau_t, b, jb
 
 
-def _bilinear(x, y, c: Coefficients, degree: int, penalty, measures):
-    """The symmetric form B(x, y) of D = 1/2 B(x, x), x = :func:`strain_rates`."""
+def _bilinear(x, y, r, c: Coefficients, degree: int, penalty, measures):
+    """The symmetric form B(x, y) of D = 1/2 B(x, x), x = :func:`strain_rates` at the
+    state r (which sets the bending modulus under the EI law)."""
     dx, dS, _ = measures
     (ea, ta, ba, ja), (eb, tb, bb, jb) = x, y
-    B_b = (ufl.dot(ba, bb) * dx
-           + (-ufl.dot(0.5 * (ba("+") + ba("-")), jb) - ufl.dot(0.5 * (bb("+") + bb("-")), ja)
-              + ip_penalty(degree, penalty, dS) * ufl.dot(ja, jb)) * dS)
-    B = c.sigma * c.tau_a * ea * eb * dx + c.bending * c.mu * c.tau_b * B_b
+    alpha_ip = ip_penalty(degree, penalty, dS)
+    if c.bending_law:  # m_v = EI(T) tau_b b: the modulus at the nodes as in forms/extensible.py
+        mu = extensible.bending_modulus(r, c)
+
+        def avg(f):
+            return 0.5 * (f("+") + f("-"))
+        B_b = (mu * ufl.dot(ba, bb) * dx
+               + (-ufl.dot(avg(mu * ba), jb) - ufl.dot(avg(mu * bb), ja)
+                  + alpha_ip * avg(mu) * ufl.dot(ja, jb)) * dS)
+        B = c.sigma * c.tau_a * ea * eb * dx + c.tau_b * B_b
+    else:
+        B_b = (ufl.dot(ba, bb) * dx
+               + (-ufl.dot(0.5 * (ba("+") + ba("-")), jb) - ufl.dot(0.5 * (bb("+") + bb("-")), ja)
+                  + alpha_ip * ufl.dot(ja, jb)) * dS)
+        B = c.sigma * c.tau_a * ea * eb * dx + c.bending * c.mu * c.tau_b * B_b
     if ta is not None:
         B += c.beta * c.tau_t * ta * tb * dx
     return B
@@ -113,7 +129,7 @@ def dissipation(r, r_t, alpha_t, c: Coefficients, degree: int, penalty, measures
     """D of the module docstring at the state r and the rates (r_t, alpha_t);
     ``alpha_t`` None (the planar model) drops the torsion term."""
     x = strain_rates(r, r_t, alpha_t, c, ufl.FacetNormal(measures[0].ufl_domain()))
-    return 0.5 * _bilinear(x, x, c, degree, penalty, measures)
+    return 0.5 * _bilinear(x, x, r, c, degree, penalty, measures)
 
 
 def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, penalty, measures):
@@ -127,4 +143,4 @@ def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, pena
     planar = psi is None
     x = strain_rates(r, r_t, None if planar else alpha_t, c, n)
     y = strain_rates(r, v, None if planar else c.delta / c.beta * psi, c, n)
-    return _bilinear(x, y, c, degree, penalty, measures)
+    return _bilinear(x, y, r, c, degree, penalty, measures)

@@ -25,7 +25,7 @@ mu/2 int |kappa|^2, and every r'' is the curvature field ``kappa``.
 
 With ``model.kinematics = "extensible"`` the stretch and bending parts of U
 are the stored energy of :mod:`rawehelix.forms.extensible`, whose variation is
-that model's residual; the one non-variational part of its F_NL is then the
+that model's residual (with the EI law's mu(eps) when the helix has one); the one non-variational part of its F_NL is then the
 twist coupling beta tau (r' x r'').
 
 All normalised: energies in units of M g L0.
@@ -52,8 +52,7 @@ def potential(r, alpha, c: Coefficients, degree: int, penalty, measures, kappa=N
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
     if c.kinematics == "extensible":
         return ((0.5 * c.beta * tau**2 - c.gravity * ufl.dot(K_E, r)) * dx
-                + extensible.stored_energy(r, c.sigma, c.bending * c.mu,
-                                           ip_penalty(degree, penalty, dS), dx, dS))
+                + extensible.rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS))
     lam = stretch(r)
     bend = (0.5 * bending(r, r, degree, penalty, dx, dS) if kappa is None
             else mixed.energy(kappa, dx))

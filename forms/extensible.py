@@ -51,6 +51,31 @@ in the paper's form.  The mixed form (forms/mixed.py) would need a Lagrange
 multiplier for kappa = r'' under a nonlinear energy; it is not offered
 (parameters.py refuses ``discretisation.bending = "mixed"``).
 
+Tension-dependent bending (``helix.EI_law``, EI = a T + b at the local
+tension T = EA eps, Eq. 64 and Fig. 4).  Normalised (parameters.Normalised:
+mu_a = a / L0^2, mu_b = b / (M g L0^2)) the bending modulus is a field of
+the strain,
+
+    mu(eps) = mu_a sigma eps + mu_b,    U = int sigma/2 eps^2 + mu(eps)/2 |t'|^2 ds,
+
+and the variation of U (no other change) gives the moment m = mu(eps) t'
+and the axial force
+
+    N.t = dW/d eps = sigma eps + 1/2 mu'(eps) |t'|^2 = T + 1/2 mu_a sigma kappa^2,
+
+the consistent term 1/2 EI'(eps) kappa^2 (in SI: 1/2 a EA kappa^2).  The
+"tension" reported everywhere stays T = sigma eps (Eq. 29), the quantity the
+law is written in.  The interior-penalty terms carry the modulus at the
+nodes, where eps jumps: -{{mu t'}}.[[t]] (the average of the moment, so the
+form stays consistent: the exact solution has [[t]] = 0 and a continuous
+moment mu t') and alpha_ip/2 {{mu}} |[[t]]|^2 (coercive while mu > 0, i.e.
+T > -b/a).  The energy is convex in (eps, kappa) while mu(eps) > mu_a^2
+sigma kappa^2 (the determinant of its Hessian); for Eq. (64) on Table 2 the
+right side is 2e-3 of the left.  The law is refused with the paper's
+kinematics (parameters.py): its forces are not the variation of an energy
+(the -mu kappa^2 r' of Eq. 32) and its bending acts on axial motion, so
+"the consistent axial term" has no meaning there.
+
 The residual is the Gateaux derivative d/de U(r + e v) at e = 0, taken by UFL
 (:func:`variation`), so it is the exact variation of U on the discrete space
 and its Jacobian (ufl.derivative of the residual, as everywhere) the exact
@@ -78,16 +103,37 @@ def strain(r):
     return stretch(r) - 1
 
 
-def stored_energy(r, sigma, mu, alpha_ip, dx, dS):
+def bending_modulus(r, c):
+    """The bending modulus of the stored energy, times the bending switch: mu,
+    or with the EI law (``c.bending_law``) mu(eps) = mu_a sigma eps + mu_b (see above)."""
+    if not c.bending_law:
+        return c.bending * c.mu
+    return c.bending * (c.mu_a * c.sigma * strain(r) + c.mu_b)
+
+
+def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
     """U = int sigma/2 eps^2 + mu U_b(t), U_b the interior-penalty energy of
     1/2 int |t'|^2 on the unit tangent (see above); ``alpha_ip`` the penalty
-    eta p^2 / h_avg (forms/rod.py::ip_penalty), ``mu`` includes the bending switch."""
+    eta p^2 / h_avg (forms/rod.py::ip_penalty), ``mu`` includes the bending switch.
+    ``field``: mu is a field (the EI law), taken at the nodes as {{mu t'}} and {{mu}}."""
     n = ufl.FacetNormal(dS.ufl_domain())
     t = unit_tangent(r)
     jump_t = t("+") * n("+")[0] + t("-") * n("-")[0]  # [[t]] at a node
+    cells = (0.5 * sigma * strain(r)**2 + 0.5 * mu * ufl.dot(d(t), d(t))) * dx
+    if field:
+        avg_m = 0.5 * (mu("+") * d(t)("+") + mu("-") * d(t)("-"))  # {{mu t'}}
+        avg_mu = 0.5 * (mu("+") + mu("-"))  # {{mu}}
+        return cells + (-ufl.dot(avg_m, jump_t)
+                        + 0.5 * alpha_ip * avg_mu * ufl.dot(jump_t, jump_t)) * dS
     avg_dt = 0.5 * (d(t)("+") + d(t)("-"))  # {{t'}}
-    return ((0.5 * sigma * strain(r)**2 + 0.5 * mu * ufl.dot(d(t), d(t))) * dx
-            + mu * (-ufl.dot(avg_dt, jump_t) + 0.5 * alpha_ip * ufl.dot(jump_t, jump_t)) * dS)
+    return cells + mu * (-ufl.dot(avg_dt, jump_t) + 0.5 * alpha_ip * ufl.dot(jump_t, jump_t)) * dS
+
+
+def rod_energy(r, c, alpha_ip, dx, dS):
+    """:func:`stored_energy` with the coefficients ``c`` (forms/rod.py::Coefficients):
+    the bending modulus of :func:`bending_modulus`, built from ``r`` itself, so
+    that its variation carries 1/2 mu'(eps) kappa^2."""
+    return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS, field=c.bending_law)
 
 
 def variation(energy, r, v, domain):
@@ -116,5 +162,5 @@ def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS):
     """delta U(r; v) + int beta tau (r' x r'').v': the elastic forces of the
     centre-line equation (30) with extensible kinematics."""
     def energy(x):
-        return stored_energy(x, c.sigma, c.bending * c.mu, alpha_ip, dx, dS)
+        return rod_energy(x, c, alpha_ip, dx, dS)
     return variation(energy, r, v, dx.ufl_domain()) + ufl.inner(twist_coupling(r, tau, c.beta), d(v)) * dx

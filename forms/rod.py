@@ -73,6 +73,11 @@ class Coefficients:
     tau_b: Any = 0.0
     tau_t: Any = 0.0
     damped: bool = False
+    # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
+    # mu_a sigma eps + mu_b; ``bending_law`` False: mu
+    mu_a: Any = 0.0
+    mu_b: Any = 0.0
+    bending_law: bool = False
     # hysteretic torsion (forms/hysteresis.py): Bouc-Wen rho, A, beta, gamma
     # (normalised) and the exponent n (a number: it chooses the form's shape);
     # ``hysteretic`` False: no z field, the elastic moment
@@ -96,6 +101,8 @@ class Coefficients:
             kinematics=model.kinematics,
             tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
             damped=q.damped,
+            mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
+            bending_law=q.bending_law,
             bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),
             bw_gamma=make(q.bw_gamma), bw_n=q.bw_n, hysteretic=q.hysteretic,
         )

@@ -78,3 +78,60 @@ def count_below(q, tension: float, omega: float, twist: bool = True) -> int:
     if twist:
         total += int(omega / (math.pi * math.sqrt(q.delta)))
     return total
+
+
+# -- the lab tests' cantilever (Sec. 4, solvers/cantilever.py), SI --------------------
+#
+# A segment of length L clamped at s = 0, a dead tension T along the axis and a
+# small force F normal to it at s = L.  Linearised about the stretched straight
+# state, the deflection w(s) obeys EI w'''' - T w'' = 0 with w(0) = w'(0) = 0,
+# w''(L) = 0 and the end's shear T w'(L) - EI w'''(L) = F (Timoshenko & Gere,
+# *Theory of Elastic Stability*, 1961, Sec. 1.11, the tie-beam), so that
+#     w(L) = F/T (L - tanh(kL)/k),  k^2 = T/EI,
+# and F L^3 / (3 EI) at T = 0.  The paper's Eq. (63), EI = F L^3 / (3 w(L)),
+# then infers EI T L^2 / (3 EI (1 - tanh(kL)/(kL))) = EI + 2 T L^2 / 5 + O(T^2 L^4 / EI).
+# The end's tension T_e sets T and EI of the transverse equation through the
+# kinematics (:func:`cantilever_transverse`): the paper's (forms/rod.py) carry
+# it as T r', |r'| = 1 + eps, so that T_e = EA eps (1 + eps), T = EA eps =
+# T_e / (1 + eps) and EI stays; the extensible rod (forms/extensible.py) as T t,
+# T = T_e, eps = T_e / EA, whose energy per unstretched length, linearised about
+# r' = (1 + eps) e, has T_e / (1 + eps) w'^2 / 2 + EI / (1 + eps)^2 w''^2 / 2.
+
+def cantilever_tip_deflection(force, tension, EI, length):
+    """w(L) of the clamped segment under the end force F and the tension T (above)."""
+    T = np.asarray(tension, dtype=float)
+    kl2 = T * length**2 / EI
+    small = kl2 < 1e-6  # tanh(x)/x = 1 - x^2/3 + 2 x^4/15: the T = 0 limit without round-off
+    k = np.sqrt(np.where(small, 1.0, T) / EI)
+    exact = np.where(small, 0.0, length - np.tanh(k * length) / k) / np.where(small, 1.0, T)
+    series = length**3 / (3 * EI) * (1 - 2 * kl2 / 5)
+    return force * np.where(small, series, exact)
+
+
+def cantilever_apparent_EI(EI, tension, length):
+    """The EI that Eq. (63) infers from the tensioned cantilever: F L^3 / (3 w(L))."""
+    return length**3 / (3 * cantilever_tip_deflection(1.0, tension, EI, length))
+
+
+def cantilever_transverse(tension, EI, EA, kinematics: str = "paper"):
+    """(T, EI) of the transverse equation under the end tension T_e (above)."""
+    if kinematics == "extensible":
+        stretch = 1 + np.asarray(tension, dtype=float) / EA
+        return tension / stretch, EI / stretch**2
+    return tension / (1 + paper_axial_strain(tension, EA)), EI
+
+
+def cantilever_intrinsic_EI(apparent_EI, tension, length):
+    """The EI whose tensioned cantilever Eq. (63) reads as ``apparent_EI`` (the
+    inverse of :func:`cantilever_apparent_EI`; None if T L^2 / 3, the apparent EI of
+    a string, already exceeds it)."""
+    from scipy.optimize import brentq
+    if apparent_EI <= tension * length**2 / 3:
+        return None
+    return brentq(lambda e: cantilever_apparent_EI(e, tension, length) - apparent_EI,
+                  1e-9 * apparent_EI, apparent_EI, xtol=1e-12 * apparent_EI)
+
+
+def paper_axial_strain(tension, EA):
+    """eps with EA eps (1 + eps) = T_e: the end strain of the paper's kinematics."""
+    return (np.sqrt(1 + 4 * np.asarray(tension, dtype=float) / EA) - 1) / 2

@@ -28,6 +28,29 @@ through the unit circle) are flagged where the count of multipliers of that
 kind outside the unit circle changes, and located by bisection in arclength
 between the two points (:func:`bisect_crossing`): each probe is a corrector
 from the earlier point with a shorter step and a Floquet period.
+
+Superharmonic resonances k:1 (k f1 = f_n of a driven natural frequency) are
+where a Floquet multiplier mu = exp(lambda T1) of that mode passes the
+positive real axis: its angle is 2 pi f_n / f1 (mod 2 pi), its distance
+|mu - 1| (about the modal damping over a period there, 1 - |mu|) sets the
+resonance's width, and the resolvent (M - I)^-1 its height.  A narrow one
+lies between two points of the T max step unseen, so the caller names the
+``sites`` (:class:`Site`: f_n / k with f_n from the linearisation) and, within
+``SITE_WINDOW`` of a site, the step moves the site's multiplier's angle
+(d theta / d f1 = 2 pi f_n / f1^2) by at most ``angle_step`` |mu - 1| (the
+multiplier's distance to +1 at the last point), so the points close in
+geometrically on the crossing; a step that would jump a window is cut to
+land at its edge.  The site's multiplier is tracked from point to point
+(:func:`track`): the lightly damped one (|mu| >= ``LIGHT``) nearest the
+predicted angle 2 pi (f_n / f1 - k) where a run in the window begins, then
+the one nearest the last one's angle moved by the predicted rotation, so
+that the many other lightly damped multipliers (70 of 156 at N = 4), which
+rotate at other rates, are not taken for it.
+Where |mu - 1| has a minimum at a point of a window (the points before and
+after it farther), the resonance is located by the vertex of the parabola
+through |mu - 1|^2 of the three in f1 (|mu - 1|^2 ~ (1 - |mu|)^2 + theta^2,
+theta linear in f1) and reported in ``peaks`` with kind ``superharmonic``,
+its f1, |mu - 1| there and T max and T max - T min interpolated to it.
 """
 
 from __future__ import annotations
@@ -49,6 +72,73 @@ BISECTION_HZ = 1e-4  # PD / NS located to this width in f1 [Hz]
 BISECTION_MAX = 12  # probes per bisection
 PEAK_PROBES = 5  # correctors per peak refinement
 PEAK_TOL = 1e-5  # a peak's T max located to this relative change between two vertices
+SITE_WINDOW = 0.05  # the step control acts within this relative distance of a site's f1
+ANGLE_STEP = 0.3  # within a window: the angle's change per step over |mu - 1|
+LIGHT = 0.5  # multipliers of modulus below this are not a site's (damped over a period)
+SITE_ANGLE = 0.5  # a site's multiplier: within this of its predicted angle [rad]
+RUN = 200  # the points a site's multiplier is tracked over (the last of the branch)
+SUPERHARMONIC_ORDERS = (2, 3)  # k of the k:1 resonances the sites are made for
+
+
+@dataclasses.dataclass(frozen=True)
+class Site:
+    """Where a k:1 superharmonic resonance of the natural frequency f_n is expected."""
+
+    f_n_Hz: float
+    k: int
+
+    @property
+    def f1_Hz(self) -> float:
+        return self.f_n_Hz / self.k
+
+    def angle(self, f1: float) -> float:
+        """The mode's multiplier's predicted angle at f1, in (-pi, pi]."""
+        return float(np.angle(np.exp(2j * np.pi * (self.f_n_Hz / f1 - self.k))))
+
+    def near(self, f1: float) -> bool:
+        return abs(f1 / self.f1_Hz - 1.0) <= SITE_WINDOW
+
+
+def sites_for(frequencies_Hz, f1_lo: float, f1_hi: float,
+              orders=SUPERHARMONIC_ORDERS) -> list[Site]:
+    """The k:1 sites f_n / k of the natural frequencies f_n inside [f1_lo, f1_hi];
+    sites closer than a tenth of the window (a lateral pair) are one."""
+    out = []
+    for site in sorted((Site(float(f), int(k)) for f in frequencies_Hz for k in orders
+                        if f1_lo <= f / k <= f1_hi), key=lambda x: x.f1_Hz):
+        if not out or site.f1_Hz / out[-1].f1_Hz - 1.0 > 0.1 * SITE_WINDOW:
+            out.append(site)
+    return out
+
+
+def track(site: Site, points) -> list:
+    """The site's multiplier at each of ``points`` (None outside its window): at the
+    first point of a run inside the window, the lightly damped one (|mu| >= LIGHT)
+    nearest the predicted angle 2 pi (f_n / f1 - k); at each next point, the one
+    nearest the last one's angle moved by the predicted 2 pi f_n (1/f1 - 1/f1_last),
+    so that other modes passing by are not taken for it.  A run restarts where
+    none is within SITE_ANGLE of the prediction."""
+    out, last = [], None
+    for o in points:
+        mu = np.asarray(o.multipliers)
+        mu = mu[np.abs(mu) >= LIGHT]
+        if not site.near(o.f1_Hz) or mu.size == 0:
+            out.append(None)
+            last = None
+            continue
+        if last is None:
+            want = site.angle(o.f1_Hz)
+        else:
+            want = np.angle(last[0]) + 2 * np.pi * site.f_n_Hz * (1 / o.f1_Hz - 1 / last[1])
+        miss = np.abs(np.angle(mu * np.exp(-1j * want)))
+        k = int(np.argmin(miss))
+        if miss[k] > SITE_ANGLE:
+            out.append(None)
+            last = None
+            continue
+        out.append(complex(mu[k]))
+        last = (out[-1], o.f1_Hz)
+    return out
 
 
 def _unstable(mu) -> dict:
@@ -105,7 +195,7 @@ class Branch:
 
     def __init__(self, alpha_map: PeriodMap, ds: float = 0.1, ds_min: float = 1e-4,
                  ds_max: float = 0.5, tol: float = 1e-7, max_it: int = 8,
-                 tension_step: float = TENSION_STEP):
+                 tension_step: float = TENSION_STEP, sites=(), angle_step: float = ANGLE_STEP):
         if not alpha_map.controller:
             raise SolverError("continuation: a scene without the controller's integral action "
                               "(k1 = 0) has a free twist rotation; continue it at fixed f1 steps "
@@ -115,6 +205,7 @@ class Branch:
         self.m = alpha_map
         self.ds, self.ds_min, self.ds_max, self.tol, self.max_it = ds, ds_min, ds_max, tol, max_it
         self.tension_step = tension_step
+        self.sites, self.angle_step = tuple(sites), angle_step  # superharmonic sites
         self.points: list[Orbit] = []
         self.folds: list[dict] = []
         self.bifurcations: list[dict] = []
@@ -183,7 +274,8 @@ class Branch:
         self.w[:n] = abs(tau[-1]) / max(np.linalg.norm(tau[:n]), 1e-300)
         tau, A, gf = self._tangent(first, tau, steps)
         self.points = [first]
-        self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=self.ds)
+        ds = max(self.ds_min, self._site_step(self.points, tau[-1], self.ds))
+        self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=ds)
 
     def resume(self, points: list[Orbit], state: State, folds=(), bifurcations=(), peaks=()):
         """Continue from stored points and the state after the last of them."""
@@ -232,6 +324,7 @@ class Branch:
                 ds = max(self.ds_min, ds / 1.5)
             if change > 0:  # the next change of T max, predicted linearly, within the bound
                 ds = max(self.ds_min, min(ds, st.ds * 0.8 * self.tension_step / change))
+            ds = max(self.ds_min, self._site_step(self.points + [orbit], tau_new[-1], ds))
             self.state = State(tau=tau_new, A=A, gf=gf, w=self.w.copy(), ds=ds)
             self.points.append(orbit)
             if on_point:
@@ -241,6 +334,26 @@ class Branch:
             if not (lo <= f1 <= hi):
                 break
         return self.points
+
+    def _site_step(self, points, f1_s: float, ds: float) -> float:
+        """The next step from the last of ``points`` cut by the superharmonic sites
+        (module docstring): within a window, the site's multiplier's angle moves by
+        at most angle_step |mu - 1|; a window ahead is not jumped (the step lands
+        just inside its edge)."""
+        if not self.sites or abs(f1_s) < 1e-12:
+            return ds
+        f1, ahead = points[-1].f1_Hz, float(np.sign(f1_s))
+        for site in self.sites:
+            if site.near(f1):
+                mu = track(site, points[-RUN:])[-1]
+                if mu is not None:
+                    rate = 2 * np.pi * site.f_n_Hz / f1**2  # |d theta / d f1| [rad/Hz]
+                    ds = min(ds, self.angle_step * abs(mu - 1.0) / rate / abs(f1_s))
+                continue
+            edge = site.f1_Hz * (1.0 - ahead * 0.9 * SITE_WINDOW)  # just inside the window
+            if ahead * (edge - f1) > 0 and ahead * (f1 + ds * f1_s - edge) > 0:
+                ds = min(ds, abs(edge - f1) / abs(f1_s))
+        return ds
 
     # -- events -------------------------------------------------------------------------
     def _detect(self, a: Orbit, b: Orbit, st: State, tau_b, steps) -> list[dict]:
@@ -261,6 +374,11 @@ class Branch:
             if a.tension_max_N > z.tension_max_N and a.tension_max_N >= b.tension_max_N:
                 events.append(self._peak(z, a, b, st, steps))
                 self.peaks.append(events[-1])
+            for site in self.sites:
+                found = superharmonic_between(site, (self.points + [b])[-RUN:])
+                if found:
+                    events.append(found)
+                    self.peaks.append(found)
         return events
 
     def _peak(self, z: Orbit, a: Orbit, b: Orbit, st: State, steps) -> dict:
@@ -317,6 +435,34 @@ class Branch:
         return {"f1_Hz": 0.5 * (f_lo + f_hi), "tension_max_N": o.tension_max_N, "kind": kind,
                 "f1_error_Hz": 0.5 * abs(f_hi - f_lo), "probes": probes,
                 "multiplier": _crossing(o.multipliers, kind)}
+
+
+def superharmonic_between(site: Site, points) -> dict | None:
+    """The site's resonance at the middle one a of the last three ``points`` (z, a,
+    b), if |mu - 1| of the site's tracked multiplier is least at a: located by the
+    vertex of the parabola through |mu - 1|^2 in f1, with T max and T max - T min
+    interpolated by the parabolas through the three."""
+    if len(points) < 3:
+        return None
+    z, a, b = points[-3:]
+    mus = track(site, points)[-3:]
+    if any(m is None for m in mus):
+        return None
+    d = np.abs(np.array(mus) - 1.0)
+    if not (d[1] < d[0] and d[1] <= d[2]):
+        return None
+    f = np.array([z.f1_Hz, a.f1_Hz, b.f1_Hz])
+    c2, c1, c0 = np.polyfit(f - f[1], d**2, 2)
+    fv = f[1] - c1 / (2 * c2) if c2 > 0 else f[1]
+    if not min(f) <= fv <= max(f):
+        fv = f[1]
+    at = lambda values: float(np.polyval(np.polyfit(f - f[1], values, 2), fv - f[1]))  # noqa: E731
+    return {"f1_Hz": float(fv), "kind": "superharmonic", "order": site.k,
+            "f_n_Hz": site.f_n_Hz,
+            "distance": float(np.sqrt(max(at(d**2), 0.0))),
+            "tension_max_N": at([o.tension_max_N for o in (z, a, b)]),
+            "oscillation_N": at([o.tension_max_N - o.tension_min_N for o in (z, a, b)]),
+            "multiplier": [mus[1].real, mus[1].imag], "bracket_Hz": [z.f1_Hz, b.f1_Hz]}
 
 
 def _crossing(mu, kind) -> list[float]:

@@ -24,7 +24,8 @@ the plain shooting of the paper.
 
 With ``model.kinematics = "extensible"`` (forms/extensible.py) the rod is
 Antman's extensible elastica instead; :func:`solve_extensible` shoots its
-planar equilibrium (see there).
+planar equilibrium (see there), with the tension-dependent bending stiffness
+of ``helix.EI_law`` (EI = a T + b, Eq. 64) when the scene has one.
 
 This module deliberately shares no code with the finite-element path: it uses
 numpy, scipy and the (numpy-only) parameter module, nothing else.  Everything
@@ -43,7 +44,7 @@ from scipy.optimize import root
 from rawehelix.parameters import Normalised
 
 __all__ = ["ShootingSolution", "solve", "rhs", "load_vector", "default_segments",
-           "ExtensibleSolution", "solve_extensible"]
+           "ExtensibleSolution", "solve_extensible", "bending_law"]
 
 
 def load_vector(normalised: Normalised) -> np.ndarray:
@@ -241,55 +242,88 @@ class ExtensibleSolution:
     normalised: Normalised
     resultant0: np.ndarray  # N(0), the (x, z) force at s~ = 0
     boundary_residual: float
-    _dense: object = field(repr=False, default=None)  # OdeSolution of (x, z, theta, m)
+    _dense: object = field(repr=False, default=None)  # OdeSolution of (x, z, theta, kappa)
 
     def centre_line(self, s) -> np.ndarray:
         """Normalised positions [x, 0, z], shape (n, 3)."""
         y = self._dense(np.atleast_1d(np.asarray(s, dtype=float)))
         return np.column_stack([y[0], 0 * y[0], y[1]])
 
-    def tension(self, s) -> np.ndarray:
-        """T = N.t = sigma (|r'| - 1), normalised."""
+    def curvature(self, s) -> np.ndarray:
+        """kappa = theta' (per unstretched length), normalised."""
+        return self._dense(np.atleast_1d(np.asarray(s, dtype=float)))[3]
+
+    def axial_force(self, s) -> np.ndarray:
+        """N.t, the force along the tangent: the tension T plus the EI law's 1/2 mu' kappa^2."""
         s = np.atleast_1d(np.asarray(s, dtype=float))
         theta = self._dense(s)[2]
         N = self.resultant0[:, None] - np.outer(load_vector(self.normalised), s)
         return N[0] * np.cos(theta) + N[1] * np.sin(theta)
 
+    def tension(self, s) -> np.ndarray:
+        """T = sigma (|r'| - 1) = N.t - 1/2 mu' kappa^2, normalised (= N.t without the EI law)."""
+        a, _ = bending_law(self.normalised)
+        return self.axial_force(s) - 0.5 * a * self.normalised.sigma * self.curvature(s)**2
+
+
+def bending_law(normalised: Normalised) -> tuple[float, float]:
+    """(a, b) of the normalised bending modulus mu(T) = a T + b at the tension T:
+    the EI law (helix.EI_law, a = a_SI / L0^2, b = b_SI / (M g L0^2)) or (0, mu)."""
+    q = normalised
+    mu = _bending_modulus(q)  # (raises without bending)
+    if q.bending_law:
+        return q.mu_per_tension, q.mu_at_zero_tension
+    return 0.0, mu
+
 
 def extensible_rhs(normalised: Normalised, resultant0):
-    """The planar extensible elastica as f(s, y), y = (x, z, theta, m).
+    """The planar extensible elastica as f(s, y), y = (x, z, theta, kappa).
 
-    With r' = lambda (cos theta, sin theta) = lambda t, the stored energy
-    sigma/2 (lambda - 1)^2 + mu/2 theta'^2 per unstretched length (kappa =
-    |t'| = |theta'|, forms/extensible.py) and the load q (:func:`load_vector`),
-    the stationarity of int [W - q.r + N.(r' - lambda t)] gives
+    With r' = lambda (cos theta, sin theta) = lambda t, eps = lambda - 1, the
+    stored energy W = sigma/2 eps^2 + mu(eps)/2 kappa^2 per unstretched length
+    (kappa = theta' = |t'|, forms/extensible.py), mu(eps) = a sigma eps + b
+    (:func:`bending_law`; a = 0 and b = mu without the EI law) and the load q
+    (:func:`load_vector`), the stationarity of int [W - q.r + N.(r' - lambda t)]
+    in r, lambda and theta gives
 
-        N' = -q                      (so N = N(0) - q s: the force resultant)
-        sigma (lambda - 1) = N.t     (the tension law, Eq. 29)
-        mu theta'' = -lambda N.n,    n = (-sin theta, cos theta)  (moment balance)
+        N' = -q                                   (so N = N(0) - q s)
+        dW/d eps = sigma eps + a sigma kappa^2/2 = N.t   (the axial force)
+        (mu kappa)' = -lambda N.n,  n = (-sin theta, cos theta)   (moment balance)
 
-    and the natural end conditions m = mu theta' = 0 (zero moment) at s = 0, 1."""
-    sigma, mu = normalised.sigma, _bending_modulus(normalised)
+    The second is explicit in eps.  Written out with mu' = a sigma eps' and
+    eps' = (N.t)'/sigma - a kappa kappa', (N.t)' = -q.t + kappa N.n, the third is
+
+        kappa' (mu - a^2 sigma kappa^2) = -lambda N.n - a kappa (-q.t + kappa N.n),
+
+    regular while W is convex (mu > a^2 sigma kappa^2).  The natural end
+    conditions are the zero moment mu kappa = 0, i.e. kappa = 0, at s = 0, 1."""
+    sigma = normalised.sigma
+    a, b = bending_law(normalised)
     q = load_vector(normalised)
     N0 = np.asarray(resultant0, dtype=float)
 
     def f(s, y):
-        theta, m = y[2], y[3]
+        theta, kappa = y[2], y[3]
         c, sn = np.cos(theta), np.sin(theta)
         Nx, Nz = N0[0] - q[0] * s, N0[1] - q[1] * s
-        lam = 1.0 + (Nx * c + Nz * sn) / sigma
-        return np.array([lam * c, lam * sn, m / mu, -lam * (-Nx * sn + Nz * c)])
+        Nt, Nn = Nx * c + Nz * sn, -Nx * sn + Nz * c
+        eps = Nt / sigma - 0.5 * a * kappa**2
+        lam, mu = 1.0 + eps, a * sigma * eps + b
+        qt = q[0] * c + q[1] * sn
+        dkappa = (-lam * Nn - a * kappa * (-qt + kappa * Nn)) / (mu - a**2 * sigma * kappa**2)
+        return np.array([lam * c, lam * sn, kappa, dkappa])
 
     return f
 
 
 def solve_extensible(normalised: Normalised, rtol: float = 1e-11, atol: float = 1e-13,
                      tol: float = 1e-10) -> ExtensibleSolution:
-    """Shoot the planar extensible elastica (:func:`extensible_rhs`) from s~ = 0,
-    where r = 0 (35) and m = 0, for the unknowns (N(0), theta(0)), to r(1) =
-    the top of Eq. (66) and m(1) = 0.  One segment suffices: with the stretch
-    algebraic there is no axial mode, and the bending boundary layers grow only
-    like exp(sqrt(T/mu) s~) (e^2 for Table 2).
+    """Shoot the planar extensible elastica (:func:`extensible_rhs`, with the EI
+    law if the scene has one) from s~ = 0, where r = 0 (35) and kappa = 0, for
+    the unknowns (N(0), theta(0)), to r(1) = the top of Eq. (66) and kappa(1) =
+    0.  One segment suffices: with the stretch algebraic there is no axial mode,
+    and the bending boundary layers grow only like exp(sqrt(T/mu) s~) (e^2 for
+    Table 2).
 
     Raises RuntimeError if the conditions at s~ = 1 are not met to ``tol``."""
     q = normalised

@@ -7,6 +7,8 @@
     rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
     rawehelix converge SCENE --quantity Q [-o DIR]
     rawehelix extremes [CASE ...] [-o DIR]
+    rawehelix labtest axial|bending|torsion [--tension T1,T2,...] [--loads X1,...] [--fit]
+                      [--EI VALUE] [--scene SCENE] [--no-gravity] [--elements N] [-o DIR]
 
 SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
 ``nominal_operation``, ``mobile_end``).  ``--set KEY=VALUE`` sets any dotted
@@ -29,7 +31,7 @@ from pathlib import Path
 from rawehelix.studies.scene import SceneError
 
 COMMANDS = ("stationary", "modes", "simulate", "sweep", "response", "orbits", "converge",
-            "extremes")
+            "extremes", "labtest")
 log = logging.getLogger("rawehelix")
 
 
@@ -76,6 +78,10 @@ def _parser() -> argparse.ArgumentParser:
             p.add_argument("--max-points", type=int, default=400,
                            help="stop each rank's window after this many points (a rerun "
                                 "with the same -o resumes)")
+            p.add_argument("--superharmonics", default="2,3", metavar="K[,K...]",
+                           help="orders k of the k:1 resonances f_n / k of the lateral natural "
+                                "frequencies where the step closes in on a multiplier's "
+                                "crossing of +1 ('none': the T max step only)")
         if name in ("sweep", "response"):
             p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
                            help="frequencies in Hz (default: the scene's [sweep] section)")
@@ -87,6 +93,27 @@ def _parser() -> argparse.ArgumentParser:
                    help="output directory (default results/extremes)")
     p.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
     p.add_argument("cases", nargs="*", help="case names (default: all)")
+    p = sub.add_parser("labtest", help="the paper's lab tests (Sec. 4, Fig. 2) as virtual tests")
+    p.add_argument("test", choices=("axial", "bending", "torsion"))
+    p.add_argument("--tension", default=None, metavar="T1,T2,...",
+                   help="tensions T_e in N (default: axial 50-250, bending 90,181,259, torsion 200)")
+    p.add_argument("--loads", default=None, metavar="X1,X2,...",
+                   help="bending: F_N in N (default 2.5,5,7.5,10); torsion: M_t in Nm (default 5-25)")
+    p.add_argument("--fit", action="store_true",
+                   help="bending: identify the intrinsic law EI = a T + b that reproduces Eq. (64)")
+    p.add_argument("--EI", type=float, default=None, dest="rod_EI", metavar="NM2",
+                   help="the rod's constant EI in N m^2 (default: Eq. (64) at each T_e for bending, "
+                        "the scene's EI otherwise)")
+    p.add_argument("--scene", default="stationary_table2",
+                   help="the scene whose helix the segment is cut from (default stationary_table2)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="set a dotted key of that scene (repeatable)")
+    p.add_argument("--no-gravity", action="store_true", help="switch gravity off (the lab has it)")
+    p.add_argument("--elements", type=int, default=None, help="number of elements N (default 8)")
+    p.add_argument("--degree", type=int, default=None, help="Lagrange degree p")
+    p.add_argument("-o", "--output", type=Path, default=None,
+                   help="output directory (default results/labtest/<test>)")
+    p.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
     return parser
 
 
@@ -137,6 +164,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "extremes":
             return _extremes(args)
+        if args.command == "labtest":
+            return _labtest(rh, args, comm)
         params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                scheme=args.scheme, overrides=_overrides(args))
         outdir = args.output or Path("results") / params.name / args.command
@@ -213,8 +242,15 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     except ValueError:
         raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
     try:
+        orders = (() if args.superharmonics.strip().lower() == "none"
+                  else tuple(int(k) for k in args.superharmonics.split(",")))
+    except ValueError:
+        raise SceneError("--superharmonics", args.superharmonics,
+                         "must be integers K[,K...] >= 2 or 'none'") from None
+    try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
+                           superharmonics=orders,
                            progress=lambda o: _say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
                                                    f"{o.tension_max_N:.2f} N, |multiplier| "
                                                    f"{o.max_multiplier:.5f}"))
@@ -241,6 +277,29 @@ def _converge(rh, params, args, outdir, comm) -> int:
                          f"is not one of {', '.join(converge.quantities())}")
     converge.run(params, args.quantity, outdir, name=params.name,
                  log=lambda m: _say(comm, m), comm=comm)
+    return 0
+
+
+def _numbers(option: str, text: str | None):
+    """"1,2.5,3" -> (1.0, 2.5, 3.0); None stays None."""
+    if text is None:
+        return None
+    try:
+        return tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise SceneError(option, text, "must be numbers separated by commas, e.g. 90,181,259") from None
+
+
+def _labtest(rh, args, comm) -> int:
+    from rawehelix.studies import labtest
+    scene = rh.load_scene(args.scene, overrides=_overrides(args))
+    result = rh.labtest(args.test, scene, tensions_N=_numbers("--tension", args.tension),
+                        loads=_numbers("--loads", args.loads), fit=args.fit,
+                        rod_EI_Nm2=args.rod_EI, elements=args.elements, degree=args.degree,
+                        gravity=not args.no_gravity, comm=comm)
+    outdir = args.output or Path("results") / "labtest" / (args.test + "_fit" * args.fit)
+    result.write(outdir)
+    _say(comm, labtest.report(result) + f"\n  wrote {outdir}/")
     return 0
 
 

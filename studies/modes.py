@@ -204,7 +204,7 @@ def spline_modes(params: Parameters, count: int | None = None) -> ModesResult:
     found = spectrum.modes(system, stationary.solve(system).x)
     chosen = select(found, count)
     info = {"scheme": "spline", "elements": params.discretisation.elements,
-            "gamma": "off", "model": params.model.describe(),
+            "gamma": "off", "model": params.describe_model(),
             "missing_families": _missing(found, VIBRATIONS) if count is None else {},
             "wall_s": time.perf_counter() - start}
     return ModesResult([ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions, q)
@@ -232,7 +232,7 @@ def fe_modes(params: Parameters, count: int | None = None, comm=None,
     if comm.rank == 0:
         info = {"scheme": "fe", "elements": disc.elements, "degree": disc.degree,
                 "dofs": solver.rod.dof_count(), "ranks": comm.size, "gamma": params.model.gamma,
-                "model": params.model.describe(),
+                "model": params.describe_model(),
                 "mean_tension_N": float(q.tension_N(solver.mean_tension_value)),
                 "missing_families": solver.missing if count is None else {},
                 "wall_s": time.perf_counter() - start}

@@ -23,6 +23,13 @@ Both schemes: the FE generalised-alpha map (:mod:`rawehelix.solvers.orbits`)
 and the paper's spline-Galerkin flow (:mod:`rawehelix.solvers.spline_galerkin.orbits`),
 chosen by ``discretisation.scheme`` (``--scheme spline``).
 
+Superharmonic sites: the lateral natural frequencies f_n of the scene's
+linearisation (the families the end's circle drives; the FE's SLEPc modes or
+the spline scheme's eigenvalues, :func:`driven_frequencies`) give the k:1
+sites f_n / k (k in ``superharmonics``, default 2 and 3) inside the window,
+where the continuation's step closes in on the multiplier's crossing of +1
+(:mod:`rawehelix.solvers.continuation`).
+
 Not yet: the free twist rotation without a controller
 (refused).
 """
@@ -66,6 +73,7 @@ class OrbitsResult:
     junctions: list[dict] = field(default_factory=list)  # T max on both sides of each cut
     tension_step: float = 0.0
     scheme: str = "fe"  # "fe" (generalised-alpha, dt_s) or "spline" (Radau, adaptive)
+    superharmonics: tuple = ()  # the orders k of the sites the step closed in on
 
     @property
     def discretisation(self) -> str:
@@ -79,6 +87,7 @@ class OrbitsResult:
                 "degree": self.degree,
                 "dt_s": self.dt_s, "torque": "the ramp (69) at its final value",
                 "tension_step": self.tension_step,
+                "superharmonic_orders": list(self.superharmonics),
                 "branch": self.branch, "folds": self.folds, "bifurcations": self.bifurcations,
                 "peaks": self.peaks, "windows": self.windows, "junctions": self.junctions,
                 "wall_s": self.wall_s}
@@ -169,7 +178,8 @@ class WindowStore:
                                 residual=e["residual"], steps=e["steps_per_period"],
                                 wall_s=e["wall_s"]))
             for ev in record["events"]:
-                events.get(ev["kind"], events["bifurcation"]).append(ev)
+                kind = "peak" if ev["kind"] == "superharmonic" else ev["kind"]
+                events.get(kind, events["bifurcation"]).append(ev)
         for extra in sorted(self.dir.glob("p*.json"))[last + 1:]:
             extra.unlink()
             extra.with_suffix(".npz").unlink(missing_ok=True)
@@ -210,13 +220,36 @@ def period_map(params: Parameters):
     return AlphaMap(params, comm=MPI.COMM_SELF)
 
 
-def _trace_window(params, window, tension_step, max_points, store, progress, stop):
-    """One window on this rank: (entries, folds, bifurcations, peaks)."""
-    from rawehelix.solvers.continuation import Branch
+def driven_frequencies(params: Parameters, f_max_Hz: float) -> list[float]:
+    """The lateral natural frequencies [Hz] up to f_max of the scene's linearisation
+    about its stationary state, in its scheme, on this rank."""
+    from rawehelix.families import LATERAL
+    if params.discretisation.scheme == "spline":
+        from rawehelix.solvers.spline_galerkin import spectrum
+        m = period_map(params)
+        q = m.q_base
+        return sorted(abs(x.eigenvalue.imag) / (2 * np.pi * q.t_scale)
+                      for x in spectrum.modes(m.system, m.embed(m.X_stationary))
+                      if x.family in LATERAL
+                      and abs(x.eigenvalue.imag) / (2 * np.pi * q.t_scale) <= f_max_Hz)
+    from rawehelix.solvers.response import HarmonicResponse
+    from rawehelix.studies.response import natural_modes
+    solver = HarmonicResponse.from_stationary(params, MPI.COMM_SELF, scene=params.name)
+    return [x["frequency_Hz"] for x in natural_modes(solver, f_max_Hz, margin=1.0)
+            if x["family"] in LATERAL]
 
-    m = period_map(params)
-    branch = Branch(m, tension_step=tension_step)
+
+def _trace_window(params, window, tension_step, max_points, store, progress, stop,
+                  superharmonics=()):
+    """One window on this rank: (entries, folds, bifurcations, peaks)."""
+    from rawehelix.solvers.continuation import Branch, sites_for
+
     start_f1, stop_f1 = window
+    lo, hi = sorted(window)
+    sites = (sites_for(driven_frequencies(params, max(superharmonics) * hi), lo, hi,
+                       superharmonics) if superharmonics else ())
+    m = period_map(params)
+    branch = Branch(m, tension_step=tension_step, sites=sites)
     stored = store.load() if store else None
     if stored:
         branch.resume(*stored)
@@ -241,23 +274,28 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
             progress=None, outdir=None, tension_step: float | None = None,
-            max_points: int = 400) -> OrbitsResult:
+            max_points: int = 400, superharmonics=None) -> OrbitsResult:
     """The branch from f1_start to f1_stop (either order), one window per rank
-    of ``comm``; with ``outdir``, stored point by point and resumed from it."""
-    from rawehelix.solvers.continuation import TENSION_STEP
+    of ``comm``; with ``outdir``, stored point by point and resumed from it.
+    ``superharmonics``: the orders k of the k:1 sites the step closes in on
+    (default SUPERHARMONIC_ORDERS; () for none)."""
+    from rawehelix.solvers.continuation import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
     if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
                           f"different frequencies > 0 [Hz]")
     tension_step = TENSION_STEP if tension_step is None else tension_step
+    superharmonics = tuple(SUPERHARMONIC_ORDERS if superharmonics is None else superharmonics)
+    if any(int(k) != k or k < 2 for k in superharmonics):
+        raise SolverError(f"orbits: superharmonic orders {superharmonics} must be integers >= 2")
     start = time.perf_counter()
     cuts = windows(f1_start_Hz, f1_stop_Hz, comm.size)
     store = None
     if outdir is not None:
         from rawehelix.studies.sweep_store import fingerprint
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
-                  "tension_step": tension_step}
+                  "tension_step": tension_step, "superharmonics": list(superharmonics)}
         open_directory(Path(outdir), header, comm)
         store = WindowStore(Path(outdir) / f"window{comm.rank}")
 
@@ -268,7 +306,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     error, sent, piece = None, [], None
     try:
         piece = _trace_window(params, cuts[comm.rank], tension_step, max_points, store,
-                              progress, stop)
+                              progress, stop, superharmonics)
     except _Stopped:
         error = (False, f"rank {comm.rank}: stopped")
     except Exception as err:  # noqa: BLE001 - reported on every rank below
@@ -291,6 +329,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     result = None
     if comm.rank == 0:
         result = _join(params, cuts, pieces, tension_step, time.perf_counter() - start)
+        result.superharmonics = superharmonics
     return comm.bcast(result, root=0)
 
 
@@ -340,6 +379,9 @@ def report(result: OrbitsResult) -> str:
                         ("peak", s["peaks"])):
         for x in items:
             error = f" (+- {x['f1_error_Hz']:.1e} Hz)" if "f1_error_Hz" in x else ""
+            if x.get("kind") == "superharmonic":
+                error = (f" ({x['order']}:1 of {x['f_n_Hz']:.3f} Hz, |mu - 1| = "
+                         f"{x['distance']:.3g}, T max - T min {x['oscillation_N']:.3f} N)")
             lines.append(f"  {x.get('kind', kind)} at f1 = {x['f1_Hz']:.4f} Hz{error}, "
                          f"T max = {x['tension_max_N']:.2f} N")
     for j in s["junctions"]:

@@ -66,13 +66,8 @@ class ResponseResult:
 
     def write(self, outdir) -> Path:
         """summary.json and response.png (rank 0 writes)."""
-        outdir = Path(outdir)
-        if self.rank != 0:
-            return outdir
-        outdir.mkdir(parents=True, exist_ok=True)
-        writers.write_json(outdir / "summary.json", self.summary)
-        response_png(outdir / "response.png", self)
-        return outdir
+        return writers.summary_and_figure(outdir, self.rank, self.summary,
+                                          lambda d: response_png(d / "response.png", self))
 
 
 def check(params: Parameters, command: str = "response"):
@@ -123,7 +118,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD) -> ResponseResu
                             "circle (R1 = 0), torque-free ends, at rest (K, C, M of "
                             "solvers.linearise); the rotor torque (69) and the controller "
                             "(40) are not in it",
-        "model": params.model.describe(),
+        "model": params.describe_model(),
         "mean_tension_N": float(q.tension_N(solver.modal.mean_tension_value)),
         "s_mid_m": float(q.length_m(solver.s_mid)),
         "points": [p.entry() for p in points],

@@ -33,7 +33,8 @@ TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"
 
 
-_TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "bool": "true or false"}
+_TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "bool": "true or false",
+               "EILaw | None": "an inline table {a_Nm2_per_N = .., b_Nm2 = ..}"}
 
 
 def _check_type(path, key: str, value, type_name: str):
@@ -42,6 +43,7 @@ def _check_type(path, key: str, value, type_name: str):
         "int": isinstance(value, int) and not isinstance(value, bool),
         "str": isinstance(value, str),
         "bool": isinstance(value, bool),
+        "EILaw | None": isinstance(value, dict),  # helix.EI_law: Helix validates the keys
     }[type_name]
     if not ok:
         raise SceneError(path, key, f"must be {_TYPE_NAMES[type_name]}, got {value!r}")

@@ -227,7 +227,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     summary = {"scene": params.name, "elements": disc.elements, "degree": disc.degree,
                "dofs": solver.rod.dof_count(), "ranks": comm.size,
                "ts_type": solver.ts.getType(), "target_rpm": params.controller.target_rpm,
-               "model": params.model.describe()}
+               "model": params.describe_model()}
     loop_start = time.perf_counter()
 
     def result(complete: bool, error: str | None = None) -> TimeSeries:

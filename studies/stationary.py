@@ -84,7 +84,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
             "degree": disc.degree,
             "mesh": disc.mesh,
             "dofs": solver.rod.dof_count(),
-            "model": params.model.describe(planar),
+            "model": params.describe_model(planar),
             "ranks": comm.size,
             "newton_iterations": result.newton_iterations,
             "tension_N": {"s0": float(T[0]), "s1": float(T[-1]),

@@ -232,7 +232,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
                    "slack_Hz": [p["f1_Hz"] for p in points if p.get("slack")],
                    "failed_Hz": [p["f1_Hz"] for p in points if p.get("failed")],
                    "ranks": comm.size, "computed_now": computed,
-                   "model": params.model.describe(),
+                   "model": params.describe_model(),
                    "wall_s": time.perf_counter() - start}
     result.summary = comm.bcast(summary, root=0)
     return result

@@ -1,7 +1,8 @@
 """The torsion test of Sec. 4 (Fig. 2c, Fig. 5) on the FE rod, with a prescribed end twist.
 
-A 6.76 m segment with the mass per length of the Table 2 helix, stretched to
-T_e = 200 N (the paper's nominal tension), horizontal and without wind; the
+The lab segment of ``rawehelix labtest`` (studies/labtest.py: 6.76 m with the
+mass per length and stiffnesses of the Table 2 helix, no wind or drag), its
+ends held T_e = 200 N apart (the paper's nominal tension), horizontal; the
 end s = 0 is held (alpha = 0), the end s = L0 twisted by theta(t), from 0 to
 about 50 degrees and back, four times (:func:`rawehelix.solvers.bouc_wen.torsion_cycle`).
 Slow cycles make it quasi-static (the segment's torsional period is 0.17 s).
@@ -12,29 +13,30 @@ benchmarks/hysteresis.py compare the two.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix.parameters import (Discretisation, Ends, Environment, Helix, Model, Parameters,
-                                  Time, TorsionHysteresis)
+from rawehelix.parameters import TorsionHysteresis
 from rawehelix.solvers import bouc_wen
+from rawehelix.studies import labtest, scene
 
-LENGTH_M = 6.76  # the segment of Sec. 4
-MASS_PER_M = 0.51 / 16.12  # Table 2: M / L0 [kg/m]
-EA_N, EI_NM2, GJ_NM2 = 3.64e4, 1.28e4, 140.0  # Tables 1 and 2
-TENSION_N = 200.0  # T_e, Sec. 4
+LENGTH_M = labtest.LAB_LENGTH_M  # the segment of Sec. 4
+TENSION_N = 200.0  # T_e, Sec. 4: "around 200 N, the nominal tension"
 THETA_MAX_RAD = math.radians(50.0)  # Sec. 4: "a maximum torsion angle of about 50 degrees"
+HELIX_SCENE = "stationary_table2"  # the Table 2 helix: its mass per length, EA, EI and GJ
 
 
-def segment(law: TorsionHysteresis, elements: int = 2) -> Parameters:
-    """The test's segment at T_e = 200 N with the torsion law ``law``."""
-    return Parameters(
-        helix=Helix(LENGTH_M, MASS_PER_M * LENGTH_M, EA_N, EI_NM2, GJ_NM2),
-        ends=Ends(TENSION_N / EA_N, 0.0), environment=Environment(wind_speed_m_s=0.0),
-        model=Model(torsion_hysteresis=law), discretisation=Discretisation(elements=elements),
-        time=Time(dt_s=0.1), name="torsion_test")
+def segment(law: TorsionHysteresis, elements: int = 2):
+    """The lab segment of :func:`rawehelix.studies.labtest.lab_parameters` (the Table 2
+    helix, no wind or drag), both ends at the wall's height and T_e = 200 N apart
+    (the end s = L0 held in place), with the torsion law ``law``."""
+    params = labtest.lab_parameters(scene.load(HELIX_SCENE), elements)
+    return params.replace(ends={"elongation": TENSION_N / params.helix.EA_N, "elevation_deg": 0.0},
+                          torsion_hysteresis=dataclasses.asdict(law),
+                          time={"dt_s": 0.1}, name="torsion_test")
 
 
 def run(params: Parameters, period_s: float, cycles: int, steps_per_cycle: int,
@@ -64,4 +66,5 @@ def run(params: Parameters, period_s: float, cycles: int, steps_per_cycle: int,
 def reference(law: TorsionHysteresis, times, period_s: float):
     """The scipy Bouc-Wen moment [Nm] of the same segment and twist history."""
     theta, theta_t = bouc_wen.torsion_cycle(THETA_MAX_RAD, period_s)
-    return bouc_wen.moment(law, GJ_NM2, LENGTH_M, theta, theta_t, times)
+    GJ = scene.load(HELIX_SCENE).helix.GJ_Nm2
+    return bouc_wen.moment(law, GJ, LENGTH_M, theta, theta_t, times)

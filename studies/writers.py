@@ -51,6 +51,18 @@ def write_json(path: Path, data: dict) -> Path:
     return write_text(path, json.dumps(_jsonable(data), indent=2) + "\n")
 
 
+def summary_and_figure(outdir, rank: int, summary: dict, figure) -> Path:
+    """On rank 0: ``outdir``/summary.json and ``figure(outdir)`` (a callable that
+    writes the study's figure there); other ranks write nothing.  ``outdir``."""
+    outdir = Path(outdir)
+    if rank != 0:
+        return outdir
+    outdir.mkdir(parents=True, exist_ok=True)
+    write_json(outdir / "summary.json", summary)
+    figure(outdir)
+    return outdir
+
+
 def _finish(fig, path: Path, title: str, dpi: int = 110) -> Path:
     """Title, layout, write the PNG and free the figure."""
     import matplotlib.pyplot as plt

@@ -30,7 +30,7 @@ from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.studies import scene
-from rawehelix.studies.torsion_test import GJ_NM2, LENGTH_M, reference, run, segment
+from rawehelix.studies.torsion_test import LENGTH_M, reference, run, segment
 
 LAW = TorsionHysteresis(rho=0.5, A=1.0, beta_m_n=10.0, gamma_m_n=10.0, n=1.0)
 
@@ -53,7 +53,7 @@ def test_torsion_cycle_dissipates_as_the_scipy_bouc_wen():
     E_other = bouc_wen.cycle_energies(t, theta, reference(other, t, period), period, cycles)
     assert np.all(np.abs(E / E_other - 1) > 0.01)
     # the elastic rod (Eq. 65) dissipates nothing over the same cycle
-    elastic = GJ_NM2 * theta / LENGTH_M
+    elastic = segment(LAW).helix.GJ_Nm2 * theta / LENGTH_M
     assert np.all(np.abs(bouc_wen.cycle_energies(t, theta, elastic, period, cycles))
                   < 1e-3 * E_ref)
 

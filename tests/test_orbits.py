@@ -3,6 +3,7 @@ of the period map, and the orbit against the brute-force periodic response."""
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 import rawehelix as rh
 from rawehelix.solvers.forced import FEBackend
@@ -385,6 +386,10 @@ def test_small_amplitude_orbit_is_the_linear_response():
     assert amplitudes[0] == pytest.approx(linear, rel=1e-3)
 
 
+def _rotation(theta):
+    return np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+
+
 class _LinearMap:
     """A stand-in for AlphaMap with a period map whose fixed point X*(f1) and
     monodromy M(f1) are known: P(X) = X* + M (X - X*).  ``kind`` picks the
@@ -396,16 +401,21 @@ class _LinearMap:
     def __init__(self, kind):
         from types import SimpleNamespace
         self.kind, self.q = kind, SimpleNamespace(tension_N=lambda t: np.asarray(t))
+        self.size = 5 if kind == "superharmonic" else 3
 
     def monodromy(self, f1):
         r = 0.9 + 0.2 * (f1 - 10.0)
+        if self.kind == "superharmonic":  # a mode at 10 Hz, |mu| = 0.95: 2:1 at 5 Hz;
+            # a 14.6 Hz one (not a site), |mu| = 0.97, passes +1 at 4.867 Hz (3:1)
+            return scipy.linalg.block_diag(*(r * _rotation(2 * np.pi * f / f1)
+                                              for r, f in ((0.95, 10.0), (0.97, 14.6))), 0.5)
         if self.kind == "period_doubling":
             return np.diag([-r, 0.5, 0.5])
         c, s = r * np.cos(1.2), r * np.sin(1.2)
         return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 0.5]])
 
     def fixed(self, f1):
-        return np.array([1.0, 2.0, 3.0]) * (f1 - 10.0)
+        return np.arange(1.0, 1.0 + self.size) * (f1 - 10.0)
 
     def rotation(self, f1):
         return 0.0
@@ -415,7 +425,7 @@ class _LinearMap:
 
     def shooting_residual(self, X, f1, delta, tangent=False, steps=None):
         M = self.monodromy(f1)
-        G = (M - np.eye(3)) @ (X - self.fixed(f1))
+        G = (M - np.eye(self.size)) @ (X - self.fixed(f1))
         return G, np.array([100.0 + 10.0 * f1]), (M if tangent else None)
 
     def finish(self, X, f1, delta, its, res, start, steps=None):
@@ -447,3 +457,34 @@ def test_the_branch_locates_period_doubling_and_neimark_sacker(kind):
     assert abs(abs(mu) - 1.0) <= 1e-4
     assert (mu.real < 0 and mu.imag == 0) if kind == "period_doubling" else abs(mu.imag) > 0.5
     assert bif["probes"] <= 12
+
+
+@pytest.mark.parametrize("with_sites", [True, False])
+def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
+    """A stand-in map whose multiplier pair 0.95 exp(+-2 pi i 10 Hz / f1) passes +1
+    at f1 = 5 Hz (2:1 of a 10 Hz mode): with the site named, the steps near it
+    shrink with |mu - 1| and the resonance is located by the vertex of |mu - 1|^2
+    to 1e-3 Hz, |mu - 1| there = 1 - 0.95; another mode's pair passing nearer +1
+    inside the window (at 4.867 Hz) is not taken for the site's (the tracking);
+    without the site the T max step alone (T max is linear here) steps over it
+    and reports nothing."""
+    from rawehelix.solvers.continuation import Branch, Site, sites_for
+
+    m = _LinearMap("superharmonic")
+    first = m.finish(m.fixed(4.6), 4.6, 0.0, 1, 0.0, 0.0)
+    sites = sites_for([10.0], 4.6, 5.4) if with_sites else ()
+    assert list(sites) == ([Site(10.0, 2)] if with_sites else [])
+    assert sites_for([10.0, 10.0002], 4.6, 5.4) == [Site(10.0, 2)]  # a lateral pair: one site
+    branch = Branch(m, ds=0.2, ds_max=0.5, sites=sites)
+    points = branch.trace(first, 5.4)
+    found = [p for p in branch.peaks if p["kind"] == "superharmonic"]
+    f = np.array([p.f1_Hz for p in points])
+    if not with_sites:
+        assert not found and np.max(np.diff(f)) > 0.2
+        return
+    (res,) = found
+    assert res["f1_Hz"] == pytest.approx(5.0, abs=1e-3) and res["order"] == 2
+    assert res["distance"] == pytest.approx(0.05, rel=0.05)
+    near = np.abs(f - 5.0) < 0.01  # the points close in: steps of ~angle_step |mu - 1| there
+    assert near.sum() >= 2 and np.max(np.diff(f)[np.abs(f[:-1] - 5.0) < 0.02]) < 0.01
+    assert len(points) < 60

@@ -1,0 +1,412 @@
+"""The paper's lab tests (Sec. 4, Fig. 2 a-c) run as virtual tests on the rod model.
+
+A 6.76 m segment with the mass per length of the scene's helix (Table 2 by
+default), clamped at a wall (solvers/cantilever.py), gravity on, no wind;
+the tension T_e a dead load along the undeformed (horizontal) axis at the
+free end.  Each test reads the simulated segment as the experimenters read
+theirs:
+
+- axial (Fig. 3): T_e = EA (L - L0) / L0, Eq. (62), L the end's distance
+  from the wall along the axis; one EA from the regression over the tensions;
+- bending (Fig. 4): at each T_e, loads F_N along gravity (normal to the
+  axis), y_e the end's displacement along F_N from the state at F_N = 0;
+  F_N = EI 3 y_e / L0^3, Eq. (63), regressed: the apparent EI per tension;
+- torsion (Fig. 5): at each T_e, end torques M_t, alpha the end's rotation
+  about the tangent (int tau ds); M_t = GJ alpha / L0, Eq. (65), regressed.
+
+Every regression is a least-squares line through the origin, as the
+formulas have no intercept.  ``bending`` with ``fit``: the intrinsic bending
+law EI = a T + b whose simulated test reproduces Eq. (64) at the paper's
+tensions (docs/labtest.md), on the rod with ``helix.EI_law`` (extensible
+kinematics, which the law needs): per tension a 1-D root find of a constant
+EI (secant, from the closed-form inverse of solvers/analytic.py), the line
+through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
+small loads (the law's energy couples the axial force to kappa^2, so its
+test softens with the load: docs/labtest.md).
+
+:func:`compute` returns a :class:`LabTest`; :meth:`LabTest.write` writes
+summary.json and labtest.png.  Computing writes nothing.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.errors import SolverError
+from rawehelix.parameters import Parameters
+from rawehelix.solvers import analytic
+from rawehelix.studies import writers
+from rawehelix.studies.scene import SceneError
+
+log = logging.getLogger("rawehelix")
+
+TESTS = ("axial", "bending", "torsion")
+LAB_LENGTH_M = 6.76  # L0 of the lab segment, Sec. 4
+LAB_ELEMENTS = 8  # N of the segment unless the caller sets it (smooth: N = 8, p = 3 to ~1e-6)
+EQ64 = (52.4, 2290.0)  # Eq. (64): EI [N m^2] = 52.4 T_e [N] + 2290
+PAPER_BENDING_TENSIONS_N = (90.0, 181.0, 259.0)  # Sec. 4, Fig. 4
+DEFAULT_TENSIONS_N = {"axial": (50.0, 100.0, 150.0, 200.0, 250.0),
+                      "bending": PAPER_BENDING_TENSIONS_N,
+                      "torsion": (200.0,)}  # T_e0 ~ 200 N, Fig. 5
+DEFAULT_LOADS = {"bending": (2.5, 5.0, 7.5, 10.0),  # F_N [N]
+                 "fit": (0.1, 0.2, 0.3, 0.4),  # F_N [N]: the small-load limit (docs/labtest.md)
+                 "torsion": (5.0, 10.0, 15.0, 20.0, 25.0)}  # M_t [Nm], up to ~25 Nm (Sec. 4)
+FIT_TOLERANCE = 1e-4  # relative: the per-tension root find of the intrinsic EI
+FIT_TARGET = 0.01  # the law's simulated test reproduces Eq. (64) within 1 %
+
+
+def eq64(tension_N):
+    """EI [N m^2] of Eq. (64) at T_e [N]."""
+    return EQ64[0] * np.asarray(tension_N, dtype=float) + EQ64[1]
+
+
+def lab_parameters(helix_scene: Parameters, elements: int | None = None,
+                   degree: int | None = None, gravity: bool = True, law: bool = False) -> Parameters:
+    """The lab segment: L0 = 6.76 m, the scene helix's mass per length, EA, GJ and
+    EI law (EI is set per test), no wind or drag; ``gravity`` as in the lab.
+    ``law``: a rod with an EI law (Eq. 64 until the caller sets another), which
+    needs the extensible kinematics (parameters.py)."""
+    h = helix_scene.helix
+    disc = {"elements": elements or LAB_ELEMENTS}
+    if degree is not None:
+        disc["degree"] = degree
+    helix = {"length_m": LAB_LENGTH_M, "mass_kg": h.mass_kg / h.length_m * LAB_LENGTH_M}
+    model = {"drag": False, "gravity": gravity}
+    if law:
+        model["kinematics"] = "extensible"
+        if h.EI_law is None:
+            helix["EI_law"] = {"a_Nm2_per_N": EQ64[0], "b_Nm2": EQ64[1]}
+    return helix_scene.replace(helix=helix, environment={"wind_speed_m_s": 0.0}, model=model,
+                               discretisation=disc, name=f"{helix_scene.name}_lab")
+
+
+def slope(x, y) -> float:
+    """The least-squares line through the origin, y = slope x."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    return float(x @ y / (x @ x))
+
+
+# -- the three tests on one solver ------------------------------------------------------
+
+def axial_test(solver, tensions_N) -> dict:
+    """Eq. (62) over the tensions: strains and the apparent EA."""
+    L0 = solver.q.L0
+    strain = []
+    for T in tensions_N:
+        tip = solver.solve(T * solver.axis)
+        strain.append((tip.position_m @ solver.axis - L0) / L0)
+    return {"tension_N": list(tensions_N), "strain": strain,
+            "apparent_EA_N": slope(strain, tensions_N)}
+
+
+def bending_test(solver, tension_N: float, loads_N) -> dict:
+    """Eq. (63) at one tension: end deflections under the loads and the apparent EI."""
+    L0 = solver.q.L0
+    solver.reset()  # each tension's load path from the straight segment, as in the lab
+    zero = solver.solve(tension_N * solver.axis).position_m
+    deflection = []
+    for F in loads_N:
+        try:
+            tip = solver.solve(tension_N * solver.axis + F * NORMAL)
+        except SolverError as err:
+            hint = (" With the EI law in the rod the energy 1/2 EI(eps) kappa^2 stops being "
+                    "convex at kappa^2 = EI / (a^2 EA) (docs/labtest.md): try smaller --loads."
+                    if solver.rod.c.bending_law else "")
+            raise SolverError(f"bending test at T_e = {tension_N:g} N, F_N = {F:g} N: "
+                              f"{err}{hint}") from None
+        deflection.append(float((tip.position_m - zero) @ NORMAL))
+    x = 3 * np.asarray(deflection) / L0**3
+    return {"tension_N": tension_N, "load_N": list(loads_N), "deflection_m": deflection,
+            "apparent_EI_Nm2": slope(x, loads_N)}
+
+
+def torsion_test(solver, tension_N: float, torques_Nm) -> dict:
+    """Eq. (65) at one tension: end rotations under the torques and the apparent GJ;
+    the tension at the wall at each torque (the lab saw it rise, Sec. 4)."""
+    L0 = solver.q.L0
+    angle, wall_tension = [], []
+    for M in torques_Nm:
+        tip = solver.solve(tension_N * solver.axis, torque_Nm=M)
+        angle.append(tip.twist_rad)
+        wall_tension.append(tip.tension_wall_N)
+    solver.solve(tension_N * solver.axis)  # back to no torque for the next tension
+    return {"tension_N": tension_N, "torque_Nm": list(torques_Nm), "angle_rad": angle,
+            "wall_tension_N": wall_tension,
+            "apparent_GJ_Nm2": slope(np.asarray(angle) / L0, torques_Nm)}
+
+
+def intrinsic_EI(solver, tension_N: float, target_Nm2: float, loads_N,
+                 rtol: float = FIT_TOLERANCE, max_iterations: int = 12):
+    """The constant EI of the rod whose simulated bending test at T_e reads
+    ``target_Nm2`` by Eq. (63): secant on log EI from the closed-form inverse."""
+    L0 = solver.q.L0
+
+    def misfit(EI):
+        solver.set_bending_stiffness(EI)
+        return np.log(bending_test(solver, tension_N, loads_N)["apparent_EI_Nm2"] / target_Nm2)
+
+    guess = analytic.cantilever_intrinsic_EI(target_Nm2, tension_N, L0)
+    if guess is None:
+        raise SceneError("labtest --fit", f"T_e = {tension_N:g} N",
+                         f"Eq. (64)'s EI = {target_Nm2:.4g} N m^2 is below the string's "
+                         f"T L0^2 / 3 = {tension_N * L0**2 / 3:.4g} N m^2: no intrinsic EI")
+    x0, x1 = np.log(guess), np.log(guess) + 0.01
+    f0, f1 = misfit(np.exp(x0)), misfit(np.exp(x1))
+    for _ in range(max_iterations):
+        x0, x1, f0 = x1, x1 - f1 * (x1 - x0) / (f1 - f0), f1
+        f1 = misfit(np.exp(x1))
+        if abs(f1) < rtol:
+            return float(np.exp(x1))
+    raise SceneError("labtest --fit", f"T_e = {tension_N:g} N",
+                     f"the root find of the intrinsic EI did not converge (misfit {f1:.2e})")
+
+
+# -- the study ----------------------------------------------------------------------------
+
+NORMAL = np.array([0.0, 0.0, 1.0])  # F_N along k_E: down, with gravity (Fig. 2b's ballast)
+
+
+@dataclass
+class LabTest:
+    """One virtual lab test (arrays and summary on every rank; rank 0 writes)."""
+
+    params: Parameters
+    test: str
+    rows: list  # per tension: the dicts of axial_test / bending_test / torsion_test
+    summary: dict = field(default_factory=dict)
+    rank: int = 0
+
+    def write(self, outdir) -> Path:
+        """summary.json and labtest.png (the paper's Figs. 3-5 axes) into ``outdir``."""
+        return writers.summary_and_figure(outdir, self.rank, self.summary,
+                                          lambda d: labtest_png(d / "labtest.png", self))
+
+
+def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit: bool = False,
+            rod_EI_Nm2: float | None = None, elements: int | None = None,
+            degree: int | None = None, gravity: bool = True, comm=MPI.COMM_WORLD) -> LabTest:
+    """Run one lab test on the lab segment of ``helix_scene`` (see the module doc).
+
+    ``loads``: F_N [N] (bending) or M_t [Nm] (torsion); ``rod_EI_Nm2``: the
+    rod's constant EI (default: Eq. (64) at each test's T_e, the paper's
+    use of it; the axial and torsion tests at the scene's EI if not given).
+    ``fit`` (bending): identify the intrinsic law instead, with the law in the
+    rod (extensible kinematics, which the law needs).  A scene helix with an
+    EI law: the bending test's rod has it (unless ``rod_EI_Nm2``)."""
+    from rawehelix.solvers.cantilever import CantileverSolver
+
+    start = time.perf_counter()
+    if helix_scene.model.torsion_hysteresis.active:  # a static solve holds z = 0
+        raise SceneError(helix_scene.name, "torsion_hysteresis",
+                         "the lab tests are static and hold the Bouc-Wen twist at z = 0 "
+                         "(forms/hysteresis.py); the hysteretic torsion test runs in time: "
+                         "studies/torsion_test.py")
+    _check(test, tensions_N, loads, fit, rod_EI_Nm2)
+    tensions = tuple(float(t) for t in (tensions_N or DEFAULT_TENSIONS_N[test]))
+    loads = tuple(float(x) for x in (loads or DEFAULT_LOADS.get("fit" if fit else test, ())))
+    scene_law = helix_scene.helix.EI_law if rod_EI_Nm2 is None else None
+    params = lab_parameters(helix_scene, elements, degree, gravity,
+                            law=fit or scene_law is not None)
+    solver = CantileverSolver(params, comm)
+    h = params.helix
+    summary = {"test": test, "scene": helix_scene.name, "length_m": LAB_LENGTH_M,
+               "mass_per_length_kg_m": h.mass_kg / h.length_m, "gravity": gravity,
+               "elements": params.discretisation.elements,
+               "degree": params.discretisation.degree,
+               "model": _describe(params),
+               "EA_N": h.EA_N, "GJ_Nm2": h.GJ_Nm2}
+    if scene_law is not None:  # the scene's law, at the local tension
+        solver.set_bending_law(scene_law.a_Nm2_per_N, scene_law.b_Nm2)
+    else:
+        solver.set_bending_stiffness(rod_EI_Nm2 or h.EI_Nm2)
+    rod = ("the scene's EI law at the local tension" if scene_law is not None
+           else rod_EI_Nm2 or h.EI_Nm2)
+    if test == "axial":
+        rows = [axial_test(solver, tensions)]
+        summary.update(rod_EI_Nm2=rod, tension_N=list(tensions),
+                       strain=rows[0]["strain"], apparent_EA_N=rows[0]["apparent_EA_N"])
+    elif test == "torsion":
+        rows = [torsion_test(solver, T, loads) for T in tensions]
+        summary.update(rod_EI_Nm2=rod, tension_N=list(tensions),
+                       torque_Nm=list(loads),
+                       apparent_GJ_Nm2=[r["apparent_GJ_Nm2"] for r in rows])
+    elif fit:
+        rows, law_summary = _fit(solver, tensions, loads)
+        summary.update(law_summary)
+        summary["model"] = _describe(params.replace(helix={"EI_law": law_summary["law"]}))
+    else:
+        rod_EI = [float(scene_law.EI_Nm2(T)) if scene_law is not None
+                  else rod_EI_Nm2 or float(eq64(T)) for T in tensions]
+        rows = []
+        for T, EI in zip(tensions, rod_EI):
+            if scene_law is None:
+                solver.set_bending_stiffness(EI)
+            rows.append(bending_test(solver, T, loads))
+        apparent = [r["apparent_EI_Nm2"] for r in rows]
+        summary.update(rod_EI=("the scene's EI law at the local tension" if scene_law is not None
+                               else "Eq. (64) at T_e" if rod_EI_Nm2 is None else "constant"),
+                       tension_N=list(tensions), load_N=list(loads), rod_EI_Nm2=rod_EI,
+                       apparent_EI_Nm2=apparent, eq64_EI_Nm2=eq64(tensions).tolist(),
+                       closed_form_apparent_EI_Nm2=closed_form_apparent_EI(params, rod_EI, tensions))
+    summary["wall_s"] = time.perf_counter() - start
+    log.debug("labtest %s: %.2f s", test, summary["wall_s"])
+    return LabTest(params, test, rows, summary, comm.rank)
+
+
+def _describe(params) -> str:
+    """summary.json's "model": the rod's terms and law, the clamp and the loads."""
+    return (params.describe_model() + "; clamped at s = 0 (Nitsche slope), dead end loads "
+            "(forms/cantilever.py)")
+
+
+def closed_form_apparent_EI(params, rod_EI, tensions) -> list:
+    """Eq. (63) on the closed-form tensioned cantilever of the scene's kinematics
+    (solvers/analytic.py), linear in F_N and without gravity."""
+    out = []
+    for EI, T_e in zip(rod_EI, tensions):
+        T, EI_t = analytic.cantilever_transverse(T_e, EI, params.helix.EA_N, params.model.kinematics)
+        out.append(float(analytic.cantilever_apparent_EI(EI_t, T, LAB_LENGTH_M)))
+    return out
+
+
+def _fit(solver, tensions, loads):
+    """The intrinsic law EI = a T + b (see the module doc): the roots of a constant
+    EI per tension, the line through them, then (a, b) refined by Gauss-Newton
+    on the law's own simulated tests (the law in the rod at the local tension)."""
+    targets = eq64(tensions)
+    roots = [intrinsic_EI(solver, T, t, loads) for T, t in zip(tensions, targets)]
+    line = np.polyfit(tensions, roots, 1)
+    law, rows, misfit, iterations = _refine_law(solver, tensions, targets, loads, line)
+    a, b = law
+    apparent = np.array([r["apparent_EI_Nm2"] for r in rows])
+    error = apparent / targets - 1
+    intrinsic = a * np.asarray(tensions) + b
+    return rows, {
+        "fit": True, "tension_N": list(tensions), "load_N": list(loads),
+        "law": {"a_Nm2_per_N": float(a), "b_Nm2": float(b)},
+        "law_applied_as": "helix.EI_law in the rod: EI = a T + b at the local tension T = EA eps",
+        "gauss_newton_iterations": iterations,
+        "intrinsic_EI_Nm2": intrinsic.tolist(),
+        "constant_EI_roots_Nm2": roots,
+        "line_through_roots": {"a_Nm2_per_N": float(line[0]), "b_Nm2": float(line[1])},
+        "apparent_EI_Nm2": apparent.tolist(), "eq64_EI_Nm2": targets.tolist(),
+        "relative_error": error.tolist(),
+        "within_1_percent": bool(np.all(np.abs(error) <= FIT_TARGET)),
+        "eq64_over_intrinsic": (targets / intrinsic).tolist(),
+    }
+
+
+def _refine_law(solver, tensions, targets, loads, start, max_iterations: int = 8):
+    """Gauss-Newton on (a, b) for log(apparent EI / Eq. 64) at the tensions, the law
+    in the rod; from ``start``, finite-difference Jacobian.  (law, rows, misfit, its)."""
+    def run(law):
+        solver.set_bending_law(*law)
+        rows = [bending_test(solver, T, loads) for T in tensions]
+        return rows, np.log(np.array([r["apparent_EI_Nm2"] for r in rows]) / targets)
+
+    law = np.asarray(start, dtype=float)
+    rows, misfit = run(law)
+    for iteration in range(max_iterations):
+        if np.abs(misfit).max() < FIT_TOLERANCE:
+            return law, rows, misfit, iteration
+        steps = 1e-3 * np.abs(law)
+        J = np.column_stack([(run(law + h * np.eye(2)[k])[1] - misfit) / h
+                             for k, h in enumerate(steps)])
+        step = np.linalg.lstsq(J, -misfit, rcond=None)[0]
+        law = law + step
+        rows, misfit = run(law)
+        if np.all(np.abs(step) <= 1e-6 * np.abs(law)):  # the least-squares floor
+            return law, rows, misfit, iteration + 1
+    return law, rows, misfit, max_iterations
+
+
+def _check(test, tensions, loads, fit, rod_EI):
+    if test not in TESTS:
+        raise SceneError("labtest", test, f"must be one of {', '.join(TESTS)}")
+    if fit and test != "bending":
+        raise SceneError("labtest --fit", test, "fits the bending law: use 'labtest bending --fit'")
+    if fit and rod_EI is not None:
+        raise SceneError("labtest --EI", rod_EI, "cannot be given with --fit (the fit finds EI)")
+    for name, values, low in (("--tension", tensions, 0.0 if test == "bending" else 1e-300),
+                              ("--loads", loads, 1e-300)):
+        if values is not None and (len(values) == 0 or not all(
+                np.isfinite(v) and v >= low for v in values)):
+            raise SceneError(f"labtest {name}", values,
+                             f"must be a list of finite numbers {'>= 0' if low == 0 else '> 0'}")
+    if loads is not None and test == "axial":
+        raise SceneError("labtest --loads", loads, "the axial test's loads are its --tension list")
+    if rod_EI is not None and not (np.isfinite(rod_EI) and rod_EI > 0):
+        raise SceneError("labtest --EI", rod_EI, "must be a finite number > 0")
+
+
+def report(result: LabTest) -> str:
+    """The short table a user reads after a lab test."""
+    s = result.summary
+    head = (f"labtest {s['test']}: {s['length_m']} m segment of {s['scene']}, N = {s['elements']}, "
+            f"p = {s['degree']}, gravity {'on' if s['gravity'] else 'off'}")
+    if s["test"] == "axial":
+        rows = [f"  {T:8.1f} N   strain {e:.5e}" for T, e in zip(s["tension_N"], s["strain"])]
+        return "\n".join([head, *rows, f"  apparent EA (Eq. 62) = {s['apparent_EA_N']:.5g} N "
+                          f"(rod EA = {s['EA_N']:.5g} N, ratio {s['apparent_EA_N'] / s['EA_N']:.5f})"])
+    if s["test"] == "torsion":
+        rows = [f"  T_e {r['tension_N']:7.1f} N: apparent GJ (Eq. 65) = {r['apparent_GJ_Nm2']:.5g} "
+                f"N m^2 (rod GJ = {s['GJ_Nm2']:.5g}); wall tension {min(r['wall_tension_N']):.2f}"
+                f"-{max(r['wall_tension_N']):.2f} N over the torques" for r in result.rows]
+        return "\n".join([head, *rows])
+    lines = [head, "   T_e [N]   rod EI [N m^2]   apparent EI (Eq. 63)   Eq. (64)   apparent/Eq.64"]
+    rod = s["intrinsic_EI_Nm2"] if s.get("fit") else s["rod_EI_Nm2"]
+    for T, EI, app, e64 in zip(s["tension_N"], rod, s["apparent_EI_Nm2"], s["eq64_EI_Nm2"]):
+        lines.append(f"  {T:8.1f}   {EI:14.1f}   {app:20.1f}   {e64:8.1f}   {app / e64:14.4f}")
+    if s.get("fit"):
+        law = s["law"]
+        lines.append(f"  intrinsic law EI = {law['a_Nm2_per_N']:.3f} T + {law['b_Nm2']:.1f} N m^2 "
+                     f"(Eq. 64: {EQ64[0]} T + {EQ64[1]:.0f}); reproduces Eq. (64) within "
+                     f"{100 * max(abs(e) for e in s['relative_error']):.3f} %")
+    return "\n".join(lines)
+
+
+def labtest_png(path: Path, result: LabTest) -> Path:
+    """The simulated test on the paper's axes: T_e vs strain (Fig. 3), F_N vs
+    3 y_e / L0^3 with the regression and Eq. (64)'s lines (Fig. 4), M_t vs alpha / L0."""
+    plt = writers._pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    s, L0 = result.summary, LAB_LENGTH_M
+    if result.test == "axial":
+        r = result.rows[0]
+        e = np.asarray(r["strain"])
+        ax.plot(e, r["tension_N"], "o", label="simulated test")
+        ax.plot([0, e.max()], [0, r["apparent_EA_N"] * e.max()], "-",
+                label=f"Eq. (62): EA = {r['apparent_EA_N']:.4g} N")
+        ax.set_xlabel("strain (L - L0) / L0")
+        ax.set_ylabel("T_e [N]")
+    elif result.test == "bending":
+        for k, r in enumerate(result.rows):
+            x = 3 * np.asarray(r["deflection_m"]) / L0**3
+            line, = ax.plot(x, r["load_N"], "o", label=f"T_e = {r['tension_N']:g} N: apparent EI "
+                            f"{r['apparent_EI_Nm2']:.0f} N m^2")
+            xs = np.array([0.0, x.max()])
+            ax.plot(xs, r["apparent_EI_Nm2"] * xs, "-", color=line.get_color())
+            ax.plot(xs, s["eq64_EI_Nm2"][k] * xs, ":", color=line.get_color())
+        ax.plot([], [], "k:", label="Eq. (64)")
+        ax.set_xlabel("3 y_e / L0^3 [1/m^2]")
+        ax.set_ylabel("F_N [N]")
+    else:
+        for r in result.rows:
+            x = np.asarray(r["angle_rad"]) / L0
+            line, = ax.plot(x, r["torque_Nm"], "o", label=f"T_e = {r['tension_N']:g} N: "
+                            f"GJ = {r['apparent_GJ_Nm2']:.4g} N m^2")
+            ax.plot([0, x.max()], [0, r["apparent_GJ_Nm2"] * x.max()], "-", color=line.get_color())
+        ax.set_xlabel("alpha / L0 [rad/m]")
+        ax.set_ylabel("M_t [Nm]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    title = f"virtual {result.test} test, {L0} m segment" + (
+        " (intrinsic law fitted)" if s.get("fit") else
+        f" (rod EI: {s['rod_EI']})" if isinstance(s.get("rod_EI"), str) else "")
+    return writers._finish(fig, path, title)
