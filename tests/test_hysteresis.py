@@ -153,6 +153,9 @@ def test_scene_section_and_refusals(tmp_path):
         DynamicsSolver(small, MPI.COMM_WORLD, options={"ts_type": "beuler"})
     with pytest.raises(SceneError, match="modal solver"):
         ModalSolver(small, MPI.COMM_WORLD)
+    from rawehelix.studies import labtest
+    with pytest.raises(SceneError, match="static"):
+        labtest.compute(p, "torsion")
     with pytest.raises(ValueError, match="alpha2 only"):
         DynamicsSolver(segment(TorsionHysteresis()), MPI.COMM_WORLD,
                        options={"ts_type": "beuler"}, end_twist=lambda t: 0.0)
