@@ -41,7 +41,11 @@ is ufl.derivative of the one residual, so the tangent includes z's equation
 and its coupling both ways (the consistent tangent of the implicit update;
 the z block is the identity times v_shift plus the derivative of -rate).
 tests/test_hysteresis.py measures the order of the scheme on z against
-scipy's solve_ivp: second order in dt, as for the rod.  The first-order TS
+scipy's solve_ivp: second order in dt, as for the rod.  alpha2's local error
+estimate is not: the start (A_z = 0 while z_tt != 0) and each reversal of
+tau_t (a kink of z_t) inflate it, so solvers/dynamics.py leaves z's dofs out
+of the step-size control (infinite absolute tolerance); z follows tau, whose
+error is controlled (docs/physics.md measures both).  The first-order TS
 types (FirstOrder in solvers/ts_forms.py) are refused: they would need z
 once more as a first-order unknown.
 
