@@ -69,6 +69,10 @@ class EILaw:
         return f"EI law: EI = {self.a_Nm2_per_N:g} Nm^2/N x T + {self.b_Nm2:g} Nm^2"
 
 
+#: the law the paper measured, Eq. (64) and Fig. 4: EI = 52.4 T + 2290
+PAPER_EI_LAW = EILaw(a_Nm2_per_N=52.4, b_Nm2=2290.0)
+
+
 @dataclass(frozen=True)
 class Helix:
     """The rod: Tables 1, 2 and 4 of the paper.

@@ -52,7 +52,8 @@ class Stationary:
 
 def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
-    allows it), compared with the shooting solution of Sys. (67)."""
+    allows it), compared with the shooting solution of Sys. (67) (of the extensible
+    elastica, solvers/shooting.py::solve_extensible, with model.kinematics = "extensible")."""
     from rawehelix.solvers import shooting
     from rawehelix.solvers.planar import planar_allowed
     from rawehelix.solvers.stationary import StationarySolver, sag
@@ -67,7 +68,9 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     planar = params.model.reduction == "auto" and planar_allowed(params)
     solver = StationarySolver(params, comm, scene=params.name, planar=planar)
     result = solver.solve()
-    reference = shooting.solve(q)  # the independent reference, Sys. (67)
+    # the independent reference: Sys. (67), or the extensible elastica (with the EI law)
+    reference = (shooting.solve_extensible(q) if params.model.kinematics == "extensible"
+                 else shooting.solve(q))
     residual_at_shooting = solver.residual_at(reference.centre_line)  # collective
     out = Stationary(params, None, None, None, None, None, state=result.state, rank=comm.rank)
     summary = None

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from rawehelix.parameters import PAPER_EI_LAW
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import scene, simulate
@@ -174,7 +175,7 @@ def test_without_twist_field(ts_type):
     assert np.max(np.abs(off["r"] - full["r"])) < 1e-12 * lateral
 
 
-@pytest.mark.parametrize("kinematics", ("paper", "extensible"))
+@pytest.mark.parametrize("kinematics", ("paper", "extensible", "extensible+EI_law"))
 def test_energy_is_conserved(kinematics):
     """Undamped, unforced free vibration, alpha2 with spectral radius 1 (the
     trapezoidal rule): the energy above the stationary state stays within 0.1%
@@ -198,8 +199,13 @@ def test_energy_is_conserved(kinematics):
     3.1e-7, asserted < 1e-6 (W with the opposite sign misses by 5.4e-6).
     With model.kinematics = "extensible" (forms/extensible.py) U is the
     extensible rod's stored energy and the only non-variational part is the
-    twist coupling: drift 3.6e-7, work 1.4e-8, balance 3.6e-7."""
-    p = free_scene(elements=8).replace(model={"kinematics": kinematics})
+    twist coupling: drift 3.6e-7, work 1.4e-8, balance 3.6e-7; with the EI law of
+    Eq. (64) as well (helix.EI_law, U with mu(eps)): drift 6.7e-7, work 6.4e-8,
+    balance 7.0e-7."""
+    kinematics, _, law = kinematics.partition("+")
+    p = free_scene(elements=8).replace(  # EI_law: Eq. (64)
+        model={"kinematics": kinematics},
+        helix={"EI_law": PAPER_EI_LAW if law else None})
     q = p.normalised()
     T = q.chord_tension()
     period = 2 * math.pi / math.sqrt(T * math.pi**2 + q.mu * math.pi**4)  # pinned tensioned beam

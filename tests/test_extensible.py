@@ -27,17 +27,14 @@ import math
 
 import numpy as np
 import pytest
-import ufl
-import dolfinx.fem
 from mpi4py import MPI
 
-from rawehelix.forms import energy
 from rawehelix.parameters import ParameterError
 from rawehelix.solvers import shooting
 from rawehelix.solvers.modal import ModalSolver
-from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene
+from tests_util import assert_same_on_one_and_two_ranks, residual_and_energy_derivative
 
 N, P = 8, 3
 KINEMATICS = ("paper", "extensible")
@@ -152,23 +149,8 @@ def test_residual_is_the_variation_of_the_energy():
     stretched state (alpha = 0, no drag: the residual's other parts vanish or
     are the twist's): central differences agree to 1e-7 relative, so the
     potential of forms/energy.py is the extensible one."""
-    params = table2("extensible", N=4, drag=False)
-    rod = RodDiscretisation(params, MPI.COMM_SELF)
-    rod.set_centre_line(lambda s: np.column_stack([-0.8 * s + 0.05 * np.sin(3 * s),
-                                                   0.03 * s**2 * (1 - s), -0.75 * s]))
-    direction = dolfinx.fem.Function(rod.W)
-    direction.sub(0).interpolate(lambda x: np.vstack([np.sin(2 * x[0]), x[0]**2, np.cos(x[0])]))
-    F = dolfinx.fem.form(ufl.replace(rod.stationary_residual(), {rod.test: direction}))
-    r, alpha = ufl.split(rod.w)[:2]
-    U = dolfinx.fem.form(energy.potential(r, alpha, rod.c, rod.degree, rod.penalty, rod.measures))
-    w0 = rod.w.x.array.copy()
-    h, values = 1e-5, []
-    for sign in (1, -1):
-        rod.w.x.array[:] = w0 + sign * h * direction.x.array
-        values.append(dolfinx.fem.assemble_scalar(U))
-    rod.w.x.array[:] = w0
-    dU = (values[0] - values[1]) / (2 * h)
-    assert dolfinx.fem.assemble_scalar(F) == pytest.approx(dU, rel=1e-7)
+    F, dU, _ = residual_and_energy_derivative(table2("extensible", N=4, drag=False))
+    assert F == pytest.approx(dU, rel=1e-7)
 
 
 @pytest.mark.parametrize("sections", [
@@ -185,13 +167,4 @@ def test_refused(sections):
 def test_same_on_one_and_two_ranks():
     """The facet terms on t are assembled across ranks: the distributed
     stationary state and spectrum equal the serial ones (COMM_SELF on each rank)."""
-    params = table2("extensible", reduction="off")
-    serial = StationarySolver(params, MPI.COMM_SELF).solve()
-    world = StationarySolver(params, MPI.COMM_WORLD).solve()
-    lam = [[abs(m.eigenvalue) for m in ModalSolver.from_stationary(params, comm).solve()][:8]
-           for comm in (MPI.COMM_SELF, MPI.COMM_WORLD)]
-    if MPI.COMM_WORLD.rank == 0:
-        assert np.max(np.abs(serial.centre_line - world.centre_line)) < 1e-10
-        # T = sigma (|r'| - 1) with sigma = 7275: 1e-10 in r' is 1e-6 in T
-        assert np.max(np.abs(serial.tension - world.tension)) < 1e-7 * np.max(serial.tension)
-        assert np.allclose(lam[0][1:], lam[1][1:], rtol=1e-8)  # [0]: the rigid rotation
+    assert_same_on_one_and_two_ranks(table2("extensible", reduction="off"))

@@ -28,3 +28,55 @@ def write_scene(path, changes: dict, base: dict | None = None, name="stationary_
             lines += [f"{k} = {_toml_value(v)}" for k, v in values.items()]
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def assert_same_on_one_and_two_ranks(params):
+    """The stationary state and the spectrum of ``params`` on MPI.COMM_WORLD equal
+    the serial ones (COMM_SELF on each rank): state to 1e-10, tension to 1e-7
+    of its maximum (T = sigma (|r'| - 1), sigma ~ 7e3), eigenvalues to 1e-8."""
+    import numpy as np
+    from mpi4py import MPI
+
+    from rawehelix.solvers.modal import ModalSolver
+    from rawehelix.solvers.stationary import StationarySolver
+
+    serial = StationarySolver(params, MPI.COMM_SELF).solve()
+    world = StationarySolver(params, MPI.COMM_WORLD).solve()
+    lam = [[abs(m.eigenvalue) for m in ModalSolver.from_stationary(params, comm).solve()][:8]
+           for comm in (MPI.COMM_SELF, MPI.COMM_WORLD)]
+    if MPI.COMM_WORLD.rank == 0:
+        assert np.max(np.abs(serial.centre_line - world.centre_line)) < 1e-10
+        assert np.max(np.abs(serial.tension - world.tension)) < 1e-7 * np.max(serial.tension)
+        assert np.allclose(lam[0][1:], lam[1][1:], rtol=1e-8)  # [0]: the rigid rotation
+
+
+def residual_and_energy_derivative(params, extra=None):
+    """(F(w; v), central difference d/dh U(w + h v), extra(rod, v)) at a bent,
+    stretched state w (alpha = 0) of ``params`` (serial), for a centre-line
+    direction v, U the potential of forms/energy.py; ``extra`` (optional)
+    returns a UFL form assembled at w."""
+    import numpy as np
+    import ufl
+    import dolfinx.fem
+    from mpi4py import MPI
+
+    from rawehelix.forms import energy
+    from rawehelix.solvers.discrete import RodDiscretisation
+
+    rod = RodDiscretisation(params, MPI.COMM_SELF)
+    rod.set_centre_line(lambda s: np.column_stack([-0.8 * s + 0.05 * np.sin(3 * s),
+                                                   0.03 * s**2 * (1 - s), -0.75 * s]))
+    direction = dolfinx.fem.Function(rod.W)
+    direction.sub(0).interpolate(lambda x: np.vstack([np.sin(2 * x[0]), x[0]**2, np.cos(x[0])]))
+    F = dolfinx.fem.form(ufl.replace(rod.stationary_residual(), {rod.test: direction}))
+    r, alpha = ufl.split(rod.w)[:2]
+    U = dolfinx.fem.form(energy.potential(r, alpha, rod.c, rod.degree, rod.penalty, rod.measures))
+    more = None if extra is None else dolfinx.fem.assemble_scalar(
+        dolfinx.fem.form(extra(rod, ufl.split(direction)[0])))
+    w0 = rod.w.x.array.copy()
+    h, values = 1e-5, []
+    for sign in (1, -1):
+        rod.w.x.array[:] = w0 + sign * h * direction.x.array
+        values.append(dolfinx.fem.assemble_scalar(U))
+    rod.w.x.array[:] = w0
+    return dolfinx.fem.assemble_scalar(F), (values[0] - values[1]) / (2 * h), more
