@@ -31,11 +31,15 @@ done
 cp /etc/resolv.conf "$ROOT/etc/resolv.conf" 2>/dev/null || true
 
 PKGS="python3-dolfinx python3-slepc4py python3-petsc4py python3-scipy python3-pytest
-python3-meshio python3-gmsh python3-matplotlib python3-h5py python3-tqdm openmpi-bin"
+python3-meshio python3-gmsh python3-matplotlib python3-h5py python3-tqdm openmpi-bin
+python3-pandas python3-multiprocess python3-pip"
 stamp="$ROOT/var/lib/rawehelix-packages"
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$PKGS" ]; then
   chroot "$ROOT" /usr/bin/env DEBIAN_FRONTEND=noninteractive bash -c \
     "apt-get update -q && apt-get install -y -q --no-install-recommends $(echo $PKGS)"
+  # SALib (rawehelix study's Sobol' indices) is not packaged by Debian; its
+  # dependencies are, so pip adds SALib alone
+  chroot "$ROOT" pip install -q --break-system-packages --no-deps "SALib==1.5.1"
   echo "$PKGS" > "$stamp"
 fi
 
