@@ -22,6 +22,9 @@ sections and keeps the others' last results.
    with held dense LU) against the TS path in the same process, in CPU time:
    real-time factor and T max error at 10 Hz, dt = 0.5 and 1 ms, and where a
    chord step's CPU time goes.
+9. ``orbits``: the cost of a continuation point of the FE periodic orbits at
+   N = 4 and 8 (benchmarks/orbits.py), the former full-Newton dense map
+   against the chord steps with the sparse tangent, CPU time in one process.
 """
 
 from __future__ import annotations
@@ -385,6 +388,12 @@ TARGETS = {
 }
 
 
+def bench_orbits(elements) -> dict:
+    """Section 9: benchmarks/orbits.py (this script's folder is on sys.path)."""
+    import orbits
+    return orbits.bench_orbits(elements)
+
+
 def _spread(v: dict, fmt: str = ".0f", unit: str = " s") -> str:
     return (f"{v['median']:{fmt}}{unit} ({v['min']:{fmt}}-{v['max']:{fmt}}, "
             f"{v['runs']} run{'s' if v['runs'] > 1 else ''})")
@@ -441,10 +450,16 @@ def markdown(r: dict) -> str:
                      f"{_spread(t['rtf'], '.2f', '')} (x{v['speedup']:.2f}); T max error "
                      f"{c['tension_max_rel_error']:+.2e} (TS {t['tension_max_rel_error']:+.2e}) | "
                      f"{TARGETS['rtf']['sec5.3']} |")
+    for key, v in (r.get("orbits") or {}).items():
+        f, c = v["full"]["point_s"], v["chord"]["point_s"]
+        lines.append(f"| 9. a continuation point of the FE orbits, N = {v['elements']}, "
+                     f"{v['f1_Hz']} Hz, CPU time | {c['median']:.2f} s ({c['min']:.2f}-{c['max']:.2f}) "
+                     f"against the former {f['median']:.2f} s ({f['min']:.2f}-{f['max']:.2f}): "
+                     f"x{v['speedup_point']:.2f} | the whole curve <= 1/5 of the sweep |")
     return "\n".join(lines) + "\n"
 
 
-SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord")
+SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "orbits")
 
 
 def main():
@@ -472,7 +487,8 @@ def main():
                      ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats)),
                      ("levers", lambda: bench_levers(repeats)),
                      ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats)),
-                     ("chord", lambda: bench_chord(repeats))):
+                     ("chord", lambda: bench_chord(repeats)),
+                     ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8)))):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -3,7 +3,9 @@
 The scheme is :class:`~rawehelix.solvers.orbits.AlphaMap`'s, the generalised-alpha
 method of TSALPHA2 (same rho_inf): one step solves R(z) = F(t_n + alpha_f h, z,
 V_a(z), A_a(z)) = 0 for z = U_{n+alpha_f}, with V_a, A_a linear in z
-(``AlphaMap.newmark``, slopes ``AlphaMap.shifts``).  What is new is how:
+(``AlphaMap.newmark``, slopes ``AlphaMap.shifts``).  What is new is how
+(``AlphaMap.solve_stage`` and ``AlphaMap.predict``, which the periodic orbits
+share at a tighter ``tol``):
 
 - chord (modified) Newton: the dense LU of J = F_U + s_V F_V + s_A F_A is held
   across iterations and steps (one per step size and scheme) and refreshed when
@@ -20,7 +22,8 @@ V_a(z), A_a(z)) = 0 for z = U_{n+alpha_f}, with V_a, A_a linear in z
   eta from the last step (one-iteration steps) is not used: right after a
   refresh it measures the round-off, not the chord's rate, and let steps pass
   with errors ~1e-6 (found in testing).  A step that does not meet the test in
-  ``max_it`` iterations, or diverges with a fresh Jacobian, or leaves a
+  ``max_it`` iterations, or diverges with a fresh Jacobian (unless |dz| is within
+  ``orbits.STALL`` round-offs: then z is converged), or leaves a
   non-finite state, raises SolverError;
 - the Dirichlet rows (35)-(36): z = g(t_n + alpha_f h) is put into the
   predictor, so their rows of R are zero and stay zero; J has unit rows and
