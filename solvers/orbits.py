@@ -86,7 +86,12 @@ NEWTON = ("chord", "full")  # the steps' Newton: chord (held LU), or full (the r
 
 
 class AlphaMap(PeriodMap):
-    """The generalised-alpha period map of the FE rod, with its tangent."""
+    """The generalised-alpha period map of the FE rod, with its tangent.
+
+    The steps' chord Newton (module docstring): ``tol`` Hairer's test on the stage
+    value (normalised, max norm), ``rate`` the contraction above which the LU is
+    refreshed, ``max_it`` per step, ``order`` of the predictor's extrapolation;
+    ``newton="full"``: the former full Newton with dense matrices (a reference)."""
 
     def __init__(self, params: Parameters, rho_inf: float = 0.9, comm=MPI.COMM_SELF,
                  solver: DynamicsSolver | None = None, tol: float = TOL, rate: float = 0.03,
