@@ -24,6 +24,9 @@ sections and keeps the others' last results.
    chord step's CPU time goes.
 9. ``study``: a 16-point modal ``rawehelix study`` on 2 ranks against 1, and
    the cost of one study point per stage (benchmarks/study.py).
+10. ``orbits``: the cost of a continuation point of the FE periodic orbits at
+    N = 4 and 8 (benchmarks/orbits.py), the former full-Newton dense map
+    against the chord steps with the sparse tangent, CPU time in one process.
 """
 
 from __future__ import annotations
@@ -389,6 +392,12 @@ TARGETS = {
 }
 
 
+def bench_orbits(elements) -> dict:
+    """Section 9: benchmarks/orbits.py (this script's folder is on sys.path)."""
+    import orbits
+    return orbits.bench_orbits(elements)
+
+
 def _spread(v: dict, fmt: str = ".0f", unit: str = " s") -> str:
     return (f"{v['median']:{fmt}}{unit} ({v['min']:{fmt}}-{v['max']:{fmt}}, "
             f"{v['runs']} run{'s' if v['runs'] > 1 else ''})")
@@ -447,10 +456,17 @@ def markdown(r: dict) -> str:
                      f"{TARGETS['rtf']['sec5.3']} |")
     if r.get("study"):
         lines.append(study_bench.markdown(r["study"]).replace("| ", "| 9. ", 1))
+    for key, v in (r.get("orbits") or {}).items():
+        f, c = v["full"]["point_s"], v["chord"]["point_s"]
+        lines.append(f"| 10. a continuation point of the FE orbits, N = {v['elements']}, "
+                     f"{v['f1_Hz']} Hz, CPU time | {c['median']:.2f} s ({c['min']:.2f}-{c['max']:.2f}) "
+                     f"against the former {f['median']:.2f} s ({f['min']:.2f}-{f['max']:.2f}): "
+                     f"x{v['speedup_point']:.2f} | the whole curve <= 1/5 of the sweep |")
     return "\n".join(lines) + "\n"
 
 
-SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study")
+SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
+            "orbits")
 
 
 def main():
@@ -479,7 +495,8 @@ def main():
                      ("levers", lambda: bench_levers(repeats)),
                      ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats)),
                      ("chord", lambda: bench_chord(repeats)),
-                     ("study", lambda: study_bench.bench_study(repeats))):
+                     ("study", lambda: study_bench.bench_study(repeats)),
+                     ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8)))):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -3,7 +3,9 @@
 The scheme is :class:`~rawehelix.solvers.orbits.AlphaMap`'s, the generalised-alpha
 method of TSALPHA2 (same rho_inf): one step solves R(z) = F(t_n + alpha_f h, z,
 V_a(z), A_a(z)) = 0 for z = U_{n+alpha_f}, with V_a, A_a linear in z
-(``AlphaMap.newmark``, slopes ``AlphaMap.shifts``).  What is new is how:
+(``AlphaMap.newmark``, slopes ``AlphaMap.shifts``).  What is new is how
+(``AlphaMap.solve_stage`` and ``AlphaMap.predict``, which the periodic orbits
+share at a tighter ``tol``):
 
 - chord (modified) Newton: the dense LU of J = F_U + s_V F_V + s_A F_A is held
   across iterations and steps (one per step size and scheme) and refreshed when
@@ -20,7 +22,8 @@ V_a(z), A_a(z)) = 0 for z = U_{n+alpha_f}, with V_a, A_a linear in z
   eta from the last step (one-iteration steps) is not used: right after a
   refresh it measures the round-off, not the chord's rate, and let steps pass
   with errors ~1e-6 (found in testing).  A step that does not meet the test in
-  ``max_it`` iterations, or diverges with a fresh Jacobian, or leaves a
+  ``max_it`` iterations, or diverges with a fresh Jacobian (unless |dz| is within
+  ``orbits.STALL`` round-offs: then z is converged), or leaves a
   non-finite state, raises SolverError;
 - the Dirichlet rows (35)-(36): z = g(t_n + alpha_f h) is put into the
   predictor, so their rows of R are zero and stay zero; J has unit rows and
@@ -41,7 +44,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.linalg
 
 import dolfinx.fem
 import ufl
@@ -49,12 +51,8 @@ import ufl
 from rawehelix import compat
 from rawehelix.forms import kinematics
 from rawehelix.solvers.orbits import AlphaMap
-from rawehelix.solvers.snes import SolverError
 
 BACKWARD_EULER = (1.0, 1.0, 1.0, 0.5)  # (alpha_m, alpha_f, gamma, beta) of TSAlpha_Restart
-ROUNDOFF = 1e-14  # |dz| / max(1, |z|) at which an iterate is round-off, not a correction
-#: weights of the newest-first stage values in the extrapolation of order k
-EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0), 3: (4.0, -6.0, 4.0, -1.0)}
 
 
 class ChordAlpha(AlphaMap):
@@ -65,87 +63,9 @@ class ChordAlpha(AlphaMap):
 
     def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
                  rate: float = 0.03, max_it: int = 8, order: int = 2):
-        super().__init__(params, rho_inf, solver=solver)
-        self.tol, self.rate, self.max_it, self.order = tol, rate, max_it, order
-        self._lu = {}  # (scheme, h) -> LU factors of J
-        self.iterations = self.factorisations = self.steps = 0
+        super().__init__(params, rho_inf, solver=solver, tol=tol, rate=rate, max_it=max_it,
+                         order=order)
         self._tension_map()
-        self._J = compat.create_matrix(self.form.J)
-        self._getrs = scipy.linalg.get_lapack_funcs("getrs", (np.zeros(1),))
-
-    def _factor(self, key, h, scheme):
-        """LU of J = F_U + s_V F_V + s_A F_A at the loaded stage (the formulation's
-        TSALPHA2 Jacobian form, one assembly; Dirichlet rows and columns unit)."""
-        form = self.form
-        form.shift_v.value, form.shift_a.value = self.shifts(h, scheme)
-        form.assemble_jacobian(self._J)
-        self._lu[key] = lu = scipy.linalg.lu_factor(self._dense(self._J, "J"), check_finite=False)
-        self.factorisations += 1
-        return lu
-
-    def solve_stage(self, t, h, u, v, a, z, scheme=None):
-        """One step from (u, v, a) at t with the predictor z: (U, V, A)_{n+1} and z."""
-        scheme = scheme or self.scheme
-        sv, sa = self.shifts(h, scheme)
-        ta = t + scheme[1] * h
-        form = self.form
-        form.set_time(ta)
-        z = z.copy()
-        z[self.bc_dofs] = self._g = form.bc_values()  # so R's Dirichlet rows stay 0
-        _, _, _, va, aa = self.newmark(z, u, v, a, h, scheme)
-        key = (scheme, h)
-        lu = self._lu.get(key)
-        fresh, last = False, None
-        noise = ROUNDOFF * max(1.0, abs(z).max())
-        x_u, x_v, x_a = form.u.x.array, form.v.x.array, form.a.x.array
-        for it in range(1, self.max_it + 1):
-            x_u[:] = z
-            x_v[:] = va
-            x_a[:] = aa
-            if lu is None:
-                lu, fresh, last = self._factor(key, h, scheme), True, None
-            R = compat.assemble_vector_array(self._b, self._F)
-            R[self.bc_dofs] = 0.0
-            dz, info = self._getrs(lu[0], lu[1], R)
-            size = abs(dz).max()
-            if not size < math.inf:  # NaN or Inf
-                raise SolverError(f"chord alpha2: the state became NaN or Inf at t = {t:.6g} "
-                                  f"(normalised)")
-            at_floor = size <= noise  # at round-off: R(z) is at its floor
-            theta = None if at_floor or last is None else size / last
-            if theta is not None and theta >= 1.0:  # diverging: back, and a fresh Jacobian
-                if fresh:
-                    raise SolverError(
-                        f"chord alpha2: Newton diverges with a fresh Jacobian at t = {t:.6g} "
-                        f"(normalised; contraction {theta:.2g}); try a smaller step (time.dt_s)")
-                lu = None
-                self._lu.pop(key, None)
-                continue
-            z -= dz
-            va -= sv * dz
-            aa -= sa * dz
-            self.iterations += 1
-            if at_floor:
-                break
-            if theta is not None:
-                eta = theta / (1.0 - theta)  # |z - z*| <= eta |dz| while theta holds
-                if eta * size <= self.tol:
-                    if theta > self.rate:  # slow: a fresh LU at the next step
-                        self._lu.pop(key, None)
-                    break
-                if theta > self.rate:  # slow: a fresh LU now
-                    self._lu.pop(key, None)
-                    lu, fresh = None, False
-                    continue
-            last = size
-        else:
-            raise SolverError(
-                f"chord alpha2: no convergence in {self.max_it} iterations at t = {t:.6g} "
-                f"(normalised; last |dz| = {size:.3g}, tol {self.tol:g}); try a smaller step "
-                f"(time.dt_s)")
-        self.steps += 1
-        am, af = scheme[:2]  # newmark's U_a, V_a, A_a solved for the step's end
-        return u + (z - u) / af, v + (va - v) / af, a + (aa - a) / am, z
 
     def start(self, t, h, u, v):
         """A_0 as TSALPHA2's restart: two half steps of the scheme (1, 1, 1, 1/2)."""
@@ -180,14 +100,9 @@ class ChordAlpha(AlphaMap):
         tension = np.empty(steps + 1)
         tension[0] = self.tension0(u)
         a = self.start(t0, h, u, v)
-        af = self.alpha_f
         history = []  # the last stage values, newest first
         for k in range(steps):
-            if len(history) < self.order + 1:  # constant acceleration (AlphaMap's)
-                z = u + af * (h * v + 0.5 * h * h * a)
-            else:  # the last order + 1 stage values, a polynomial in t
-                z = sum(c * zk for c, zk in zip(EXTRAPOLATION[self.order], history))
-            u, v, a, z = self.solve_stage(t0 + k * h, h, u, v, a, z)
+            u, v, a, z = self.solve_stage(t0 + k * h, h, u, v, a, self.predict(history, u, v, a, h))
             history = [z] + history[:self.order]
             tension[k + 1] = self.tension0(u)
         return u, v, tension

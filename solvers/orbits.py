@@ -21,13 +21,35 @@ propagation through the steps: at a converged step
 
     J dz = -(F_V dV_a + F_A dA_a)|_{z fixed},  J = F_U + s_V F_V + s_A F_A,
 
-with the step's own factored Jacobian J (NLvib does this for Newmark).
-Dirichlet rows (35)-(37) read z - g(t), so their rows of J are unit rows
-and they do not depend on X_n.  The Floquet multipliers are the
+with the step's own Jacobian J at the converged stage (NLvib does this for
+Newmark).  Dirichlet rows (35)-(37) read z - g(t), so their rows of J are
+unit rows and they do not depend on X_n.  The Floquet multipliers are the
 eigenvalues of the monodromy at the orbit; the n spurious roots of the
 scheme (about -rho_inf per step) give multipliers near 0.
 
-Dense linear algebra on one rank: the state has 3 n entries (n dofs), the
+How a step is solved (docs/orbits.md, "Cost of a point"):
+
+- chord Newton (:meth:`AlphaMap.solve_stage`, shared with the chord step loop
+  of solvers/chord.py, whose docstring describes it): the dense LU of J (the
+  formulation's Jacobian form, one assembly) held across iterations and
+  steps of one period, refreshed when an iteration contracts by less than
+  ``rate``; the predictor extrapolates the last three stage values; Hairer's
+  stopping test at ``tol`` = 1e-14 (against 1e-11 for plain stepping),
+  which puts P(X) within 2.4e-10 of the steps solved to round-off (the
+  former full Newton: 4.6e-11; 1e-13: 3e-9, as A = (z - u) / (alpha_f beta
+  h^2) magnifies z's error);
+- every period starts with no LU held, so P is a function of (X, f1, M)
+  (the branch store's resume is bit for bit);
+- the tangent (:meth:`AlphaMap._tangent`) only in a tangent period: F_U, F_V,
+  F_A assembled once at the converged stage into scipy CSR matrices on their
+  fixed patterns, J = F_U + s_V F_V + s_A F_A on F_U's pattern, SuperLU, the
+  3n right-hand sides by sparse products, newmark's map as axpys; a tangent
+  period from the (X, f1, M) of the last plain period (the Floquet period
+  after the last residual) propagates along its kept steps;
+- ``newton="full"``: the former step, full Newton with three dense matrices
+  and a dense LU per iteration and a dense tangent (the tests' reference).
+
+Dense monodromy on one rank: the state has 3 n entries (n dofs), the
 monodromy (3n)^2; refused past ``MAX_STATE`` (N = 8, p = 3: 3n = 300).
 """
 
@@ -38,6 +60,9 @@ import time
 
 import numpy as np
 import scipy.linalg
+import scipy.linalg.blas
+import scipy.sparse
+import scipy.sparse.linalg
 import ufl
 from mpi4py import MPI
 
@@ -50,14 +75,29 @@ from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.floquet import Orbit, PeriodMap  # noqa: F401  (Orbit re-exported)
 from rawehelix.solvers.snes import SolverError
 
+AXPY = scipy.linalg.blas.get_blas_funcs("axpy", (np.zeros(1),))
 MAX_STATE = 3000  # dense monodromy: (3n)^2 doubles, an LU of n per step
+TOL = 1e-14  # the steps' chord Newton (max norm of z, normalised): see docs/orbits.md
+ROUNDOFF = 1e-14  # |dz| / max(1, |z|) at which an iterate is round-off, not a correction
+#: weights of the newest-first stage values in the extrapolation of order k
+EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0), 3: (4.0, -6.0, 4.0, -1.0)}
+STALL = 100.0  # |dz| within STALL round-offs that stops contracting: at R's floor
+NEWTON = ("chord", "full")  # the steps' Newton: chord (held LU), or full (the reference)
 
 
 class AlphaMap(PeriodMap):
-    """The generalised-alpha period map of the FE rod, with its tangent."""
+    """The generalised-alpha period map of the FE rod, with its tangent.
+
+    The steps' chord Newton (module docstring): ``tol`` Hairer's test on the stage
+    value (normalised, max norm), ``rate`` the contraction above which the LU is
+    refreshed, ``max_it`` per step, ``order`` of the predictor's extrapolation;
+    ``newton="full"``: the former full Newton with dense matrices (a reference)."""
 
     def __init__(self, params: Parameters, rho_inf: float = 0.9, comm=MPI.COMM_SELF,
-                 solver: DynamicsSolver | None = None):
+                 solver: DynamicsSolver | None = None, tol: float = TOL, rate: float = 0.03,
+                 max_it: int = 12, order: int = 2, newton: str = "chord"):
+        if newton not in NEWTON:
+            raise SolverError(f"orbits: newton {newton!r} is not one of {NEWTON}")
         if comm.size > 1:
             raise SolverError("orbits: the shooting solver runs on one rank (dense monodromy); "
                               "run separate frequency windows on separate ranks")
@@ -89,6 +129,19 @@ class AlphaMap(PeriodMap):
         self.controller = self.q_base.k1 != 0.0
         self.floor = self.solver.residual_floor()
         self.newton_iterations = 0  # of the steps, since the last orbit() began
+        # the steps' chord Newton (module docstring): tol, rate, max_it per step, order
+        # of the predictor's extrapolation; LU factors of J by (scheme, h)
+        self.newton, self.tol, self.rate, self.max_it, self.order = newton, tol, rate, max_it, order
+        self._lu = {}
+        self.iterations = self.factorisations = self.steps = 0
+        self._J = compat.create_matrix(form.J)
+        self._getrs = scipy.linalg.get_lapack_funcs("getrs", (np.zeros(1),))
+        interior = np.ones(n)
+        interior[self.bc_dofs] = 0.0  # the tangent's J: unit Dirichlet rows
+        self._interior, self._unit = scipy.sparse.diags(interior), scipy.sparse.diags(1.0 - interior)
+        self.stage = None  # the last step's stage value z
+        self._sparse, self._newmark_matrix = {}, {}  # the tangent's CSR matrices, newmark's
+        self._kept = None  # the steps of the last period without tangent (period())
         stationary = self.solver.state()
         self.offset = stationary.offset
         w_t = stationary.w_t if stationary.w_t is not None else np.zeros(n)
@@ -118,6 +171,198 @@ class AlphaMap(PeriodMap):
         self.form.offset.value = self.offset
         self.q = q
 
+    # -- one step -------------------------------------------------------------------
+    def predict(self, history, u, v, a, h):
+        """The stage value's predictor: the last ``order`` + 1 stage values
+        (``history``, newest first) extrapolated in t, or, with fewer, constant
+        acceleration from (u, v, a)."""
+        if len(history) < self.order + 1:
+            return u + self.alpha_f * (h * v + 0.5 * h * h * a)
+        return sum(c * zk for c, zk in zip(EXTRAPOLATION[self.order], history))
+
+    def _factor(self, key, h, scheme):
+        """LU of J = F_U + s_V F_V + s_A F_A at the loaded stage (the formulation's
+        TSALPHA2 Jacobian form, one assembly; Dirichlet rows and columns unit)."""
+        form = self.form
+        form.shift_v.value, form.shift_a.value = self.shifts(h, scheme)
+        form.assemble_jacobian(self._J)
+        self._lu[key] = lu = scipy.linalg.lu_factor(self._dense(self._J, "J"), check_finite=False)
+        self.factorisations += 1
+        return lu
+
+    def solve_stage(self, t, h, u, v, a, z, scheme=None):
+        """One step from (u, v, a) at t with the predictor z, by chord Newton
+        (module docstring): (U, V, A)_{n+1} and z."""
+        scheme = scheme or self.scheme
+        sv, sa = self.shifts(h, scheme)
+        ta = t + scheme[1] * h
+        form = self.form
+        form.set_time(ta)
+        z = z.copy()
+        z[self.bc_dofs] = self._g = form.bc_values()  # so R's Dirichlet rows stay 0
+        _, _, _, va, aa = self.newmark(z, u, v, a, h, scheme)
+        key = (scheme, h)
+        lu = self._lu.get(key)
+        fresh, last = False, None
+        noise = ROUNDOFF * max(1.0, abs(z).max())
+        x_u, x_v, x_a = form.u.x.array, form.v.x.array, form.a.x.array
+        for it in range(1, self.max_it + 1):
+            x_u[:] = z
+            x_v[:] = va
+            x_a[:] = aa
+            if lu is None:
+                lu, fresh, last = self._factor(key, h, scheme), True, None
+            R = compat.assemble_vector_array(self._b, self._F)
+            R[self.bc_dofs] = 0.0
+            dz, info = self._getrs(lu[0], lu[1], R)
+            size = abs(dz).max()
+            if not size < math.inf:  # NaN or Inf
+                raise SolverError(f"chord alpha2: the state became NaN or Inf at t = {t:.6g} "
+                                  f"(normalised)")
+            at_floor = size <= noise  # at round-off: R(z) is at its floor
+            theta = None if at_floor or last is None else size / last
+            if theta is not None and theta >= 1.0:  # diverging: back, and a fresh Jacobian
+                if size <= STALL * noise:  # no: stalled at R's round-off, z is converged
+                    break
+                if fresh:
+                    raise SolverError(
+                        f"chord alpha2: Newton diverges with a fresh Jacobian at t = {t:.6g} "
+                        f"(normalised; contraction {theta:.2g}); try a smaller step (time.dt_s)")
+                lu = None
+                self._lu.pop(key, None)
+                continue
+            z -= dz
+            va -= sv * dz
+            aa -= sa * dz
+            self.iterations += 1
+            if at_floor:
+                break
+            if theta is not None:
+                eta = theta / (1.0 - theta)  # |z - z*| <= eta |dz| while theta holds
+                if eta * size <= self.tol:
+                    if theta > self.rate:  # slow: a fresh LU at the next step
+                        self._lu.pop(key, None)
+                    break
+                if theta > self.rate:  # slow: a fresh LU now
+                    self._lu.pop(key, None)
+                    lu, fresh = None, False
+                    continue
+            last = size
+        else:
+            raise SolverError(
+                f"chord alpha2: no convergence in {self.max_it} iterations at t = {t:.6g} "
+                f"(normalised; last |dz| = {size:.3g}, tol {self.tol:g}); try a smaller step "
+                f"(time.dt_s)")
+        self.steps += 1
+        am, af = scheme[:2]  # newmark's U_a, V_a, A_a solved for the step's end
+        return u + (z - u) / af, v + (va - v) / af, a + (aa - a) / am, z
+
+    def step(self, t, h, X, Phi=None, z=None):
+        """One step from X at t (``z``: the stage value's predictor, constant
+        acceleration if None); with Phi (3n x k): the tangent d X_{n+1} = S Phi.
+        The converged stage value is left in :attr:`stage`."""
+        n = self.n
+        u, v, a = X[:n], X[n:2 * n], X[2 * n:]
+        if z is None:
+            z = self.predict((), u, v, a, h)
+        if self.newton == "full":
+            return self._step_full(t, h, u, v, a, z, Phi)
+        before = self.iterations
+        u1, v1, a1, self.stage = self.solve_stage(t, h, u, v, a, z)
+        self.newton_iterations += self.iterations - before
+        X1 = np.concatenate([u1, v1, a1])
+        if Phi is None:
+            return X1, None
+        return X1, self._tangent(self.stage, u, v, a, h, Phi)
+
+    def _csr(self):
+        """F_U, F_V, F_A at the loaded stage as scipy CSR matrices on their fixed
+        patterns (Dirichlet rows included: the callers overwrite them); J's
+        pattern is F_U's, which holds F_V's and F_A's."""
+        out = []
+        for k, (A, a) in enumerate(zip(self._mats, self._dF)):
+            A.zeroEntries()
+            dolfinx.fem.petsc.assemble_matrix(A, a)
+            A.assemble()
+            indptr, indices, data = A.getValuesCSR()
+            S = self._sparse.get(k)
+            if S is None or S.nnz != data.size:  # the first assembly: the pattern
+                S = self._sparse[k] = scipy.sparse.csr_matrix((data, indices, indptr),
+                                                              shape=(self.n, self.n))
+            else:
+                S.data[:] = data
+            out.append(S)
+        if "J" not in self._sparse:  # J = F_U + s_V F_V + s_A F_A on F_U's pattern
+            Fu = out[0]
+            rows = np.repeat(np.arange(self.n), np.diff(Fu.indptr))
+            keys = rows * self.n + Fu.indices
+            order = np.argsort(keys)
+            self._into_J = []
+            for S in out[1:]:
+                r = np.repeat(np.arange(self.n), np.diff(S.indptr))
+                pos = order[np.searchsorted(keys, r * self.n + S.indices, sorter=order)]
+                if not np.array_equal(keys[pos], r * self.n + S.indices):
+                    raise SolverError("orbits: F_V or F_A has an entry outside F_U's pattern")
+                self._into_J.append(pos)
+            bc = np.isin(rows, self.bc_dofs)
+            self._bc_entries = np.flatnonzero(bc)
+            self._bc_diagonal = np.flatnonzero(bc & (rows == Fu.indices))
+            # J^T in CSC is J in CSR: SuperLU factors it, and solves with trans="T"
+            self._sparse["J"] = scipy.sparse.csc_matrix((Fu.data.copy(), Fu.indices, Fu.indptr),
+                                                        shape=(self.n, self.n))
+        return out
+
+    def _coefficients(self, h) -> np.ndarray:
+        """:meth:`newmark` as a 5 x 4 matrix: (U_{n+1}, V_{n+1}, A_{n+1}, V_a, A_a)
+        against (z, U_n, V_n, A_n), exact zeros where an output does not depend on
+        an input."""
+        C = self._newmark_matrix.get(h)
+        if C is None:
+            C = self._newmark_matrix[h] = np.array(
+                [self.newmark(*np.eye(4)[j], h) for j in range(4)]).T
+        return C
+
+    @staticmethod
+    def _combine(coefficients, blocks, out):
+        """out = sum c_j blocks_j in place (BLAS axpy on contiguous blocks),
+        skipping exact zero coefficients."""
+        flat = out.reshape(-1)
+        flat[:] = 0.0
+        for c, B in zip(coefficients, blocks):
+            if c != 0.0:
+                AXPY(B.reshape(-1), flat, a=c)
+        return out
+
+    def _tangent(self, z, u, v, a, h, Phi):
+        """S Phi at the converged step (module docstring), sparse: J dz = -(F_V dV_a
+        + F_A dA_a) with J's Dirichlet rows unit, J by SuperLU."""
+        n = self.n
+        form = self.form
+        _, _, _, va, aa = self.newmark(z, u, v, a, h)
+        form.u.x.array[:], form.v.x.array[:], form.a.x.array[:] = z, va, aa  # time: the step's
+        Fu, Fv, Fa = self._csr()
+        sv, sa = self.shifts(h)
+        J = self._sparse["J"]
+        J.data[:] = Fu.data
+        J.data[self._into_J[0]] += sv * Fv.data
+        J.data[self._into_J[1]] += sa * Fa.data
+        J.data[self._bc_entries] = 0.0
+        J.data[self._bc_diagonal] = 1.0
+        lu = scipy.sparse.linalg.splu(J, permc_spec="MMD_AT_PLUS_A")
+        C = self._coefficients(h)
+        P = (Phi[:n], Phi[n:2 * n], Phi[2 * n:])
+        work = np.empty_like(P[0])
+        rhs = Fv @ self._combine(C[3, 1:], P, work)  # dV_a and dA_a with z held
+        rhs += Fa @ self._combine(C[4, 1:], P, work)
+        rhs[self.bc_dofs] = 0.0
+        dz = lu.solve(rhs, trans="T")
+        dz *= -1.0
+        out = np.empty_like(Phi)
+        for k in range(3):  # d(U, V, A)_{n+1}
+            self._combine(C[k], (dz, *P), out[k * n:(k + 1) * n])
+        return out
+
+    # -- the former step (newton="full"): the reference of the tests -----------------
     def _load(self, z, va, aa, t):
         form = self.form
         form.set_time(t)
@@ -161,12 +406,11 @@ class AlphaMap(PeriodMap):
         J[self.bc_dofs, self.bc_dofs] = 1.0
         return scipy.linalg.lu_factor(J)
 
-    def step(self, t, h, X, Phi=None):
-        """One step from X at t; with Phi (3n x k): the tangent d X_{n+1} = S Phi."""
+    def _step_full(self, t, h, u, v, a, z, Phi):
+        """Full Newton, three dense matrices and a dense LU per iteration, the
+        tangent by dense products (the solver before the chord)."""
         n = self.n
-        u, v, a = X[:n], X[n:2 * n], X[2 * n:]
         ta = t + self.alpha_f * h
-        z = u + self.alpha_f * (h * v + 0.5 * h * h * a)  # predictor: constant acceleration
         self.form.set_time(ta)
         self._g = self.form.bc_values()
         lu = None
@@ -185,6 +429,7 @@ class AlphaMap(PeriodMap):
             raise SolverError(f"orbits: Newton did not converge in a step at t = {t:.6g} "
                               f"(|R| = {norm:.3g}, floor {self.floor:.3g}); try a smaller step")
         self.newton_iterations += it
+        self.stage = z
         X1 = np.concatenate([u1, v1, a1])
         if Phi is None:
             return X1, None
@@ -207,19 +452,46 @@ class AlphaMap(PeriodMap):
         """P(X) over one period at f1 (phase 0 at t = 0), the tension at s = 0 at
         every step (normalised) and, with ``tangent``, the monodromy dP/dX.
         ``on_step(probes)`` is called after every step with the rod's probes
-        (:class:`~rawehelix.solvers.probes.Probes`) at the new state."""
+        (:class:`~rawehelix.solvers.probes.Probes`) at the new state.  The
+        steps of the last period without tangent are kept: a tangent period
+        from the same (X, f1, M) (the shooting's and the continuation's
+        Floquet period after their last residual) propagates the tangent along
+        them instead of solving them again (the same numbers: the steps start
+        from no held LU, so they are a function of (X, f1, M))."""
         self.set_frequency(f1_Hz)
         M = steps or self.steps_per_period(f1_Hz)
         T1 = 2 * math.pi / self.q.omega1
         h = T1 / M
+        key = (f1_Hz, M)
+        kept = self._kept
+        if (tangent and on_step is None and kept is not None and kept[0] == key  # chord only
+                and np.array_equal(kept[1][0], X)):
+            return self._replay(kept, h)
         Phi = np.eye(3 * self.n) if tangent else None
-        tension = []
+        self._lu = {}  # no LU held from another period: P is a function of (X, f1, M)
+        tension, history, n = [], [], self.n
+        trajectory = [X]  # X_k, then each step's stage value and X_{k+1}
         for k in range(M):
-            X, Phi = self.step(k * h, h, X, Phi)
+            z = self.predict(history, X[:n], X[n:2 * n], X[2 * n:], h)
+            X, Phi = self.step(k * h, h, X, Phi, z)
+            history = [self.stage] + history[:self.order]
             if not np.all(np.isfinite(X)):
                 raise SolverError(f"orbits: the state became NaN or Inf at f1 = {f1_Hz} Hz")
             compat.petsc_vec(self.form.u).setArray(X[:self.n])
             tension.append(self.solver.probes.value("tension0"))
             if on_step:
                 on_step(self.solver.probes)
-        return X, np.array(tension), Phi
+            trajectory += [self.stage, X]
+        tension = np.array(tension)
+        self._kept = (key, trajectory, tension) if not tangent and self.newton == "chord" else None
+        return X, tension, Phi
+
+    def _replay(self, kept, h):
+        """The tangent period along the kept steps (:meth:`period`)."""
+        _, trajectory, tension = kept
+        n, Phi = self.n, np.eye(3 * self.n)
+        for k in range(len(trajectory) // 2):
+            X, z = trajectory[2 * k], trajectory[2 * k + 1]
+            self.form.set_time((k + self.alpha_f) * h)
+            Phi = self._tangent(z, X[:n], X[n:2 * n], X[2 * n:], h, Phi)
+        return trajectory[-1].copy(), tension.copy(), Phi

@@ -38,6 +38,51 @@ def test_monodromy_equals_finite_differences_of_the_period_map(alpha_map):
         assert np.linalg.norm(Phi @ d - fd) <= 1e-5 * np.linalg.norm(fd)
 
 
+@pytest.fixture(scope="module")
+def full_newton(alpha_map):
+    """The former period map: full Newton in every step, dense F_U, F_V, F_A and
+    LU per iteration, the tangent by dense products (the same rod and form)."""
+    return AlphaMap(alpha_map.params, newton="full", solver=alpha_map.solver)
+
+
+def test_chord_steps_and_sparse_tangent_are_the_full_newton_map(alpha_map, full_newton):
+    """One period at 10 Hz from a state in motion: the chord steps (tol 1e-14)
+    and the sparse tangent against the former full Newton and dense tangent.
+    P(X) and the tension to 1e-9 (measured 2.4e-10 / 4.6e-10 at 12 Hz); the
+    monodromy to 1e-7 (measured 1.4e-8: the former's own spread, which a 1e-15
+    perturbation of X moves by 1.7e-8, while it moves the new one by 1e-13)
+    and its leading multipliers to 1e-8; the tangent period after a plain one
+    (along the kept steps) is bit for bit the one that solves the steps again."""
+    m, ref = alpha_map, full_newton
+    X, _, _ = m.period(m.X_stationary, 10.0)
+    P0, T0, M0 = ref.period(X, 10.0, tangent=True)
+    P1, T1, _ = m.period(X, 10.0)
+    P2, T2, M2 = m.period(X, 10.0, tangent=True)  # along the kept steps
+    m._kept = None
+    P3, T3, M3 = m.period(X, 10.0, tangent=True)  # the steps solved again
+    assert np.array_equal(P2, P3) and np.array_equal(T2, T3) and np.array_equal(M2, M3)
+    assert np.array_equal(P1, P2) and np.array_equal(T1, T2)
+    assert np.linalg.norm(P1 - P0) <= 1e-9 * np.linalg.norm(P0)
+    assert np.abs(T1 - T0).max() <= 1e-9 * np.abs(T0).max()
+    assert np.linalg.norm(M2 - M0) <= 1e-7 * np.linalg.norm(M0)
+    lead = lambda M: np.sort(np.abs(np.linalg.eigvals(M)))[::-1][:6]  # noqa: E731
+    assert np.allclose(lead(M2), lead(M0), rtol=1e-8, atol=0)
+    Xp = X * (1 + 1e-15 * np.random.default_rng(0).standard_normal(X.size))
+    _, _, Mp = m.period(Xp, 10.0, tangent=True)
+    assert np.linalg.norm(Mp - M2) <= 1e-11 * np.linalg.norm(M2)
+
+
+def test_the_orbit_is_the_full_newton_orbit(alpha_map, full_newton):
+    """The shooting orbit at 10 Hz (5 periods' lead-in) with the chord steps and
+    the sparse tangent against the former full Newton: T max, T min and the
+    largest multiplier to 1e-8 (measured 4.8e-11, 5.8e-12, 3e-14)."""
+    new = alpha_map.orbit(alpha_map.X_stationary, 10.0, lead_in=5)
+    old = full_newton.orbit(full_newton.X_stationary, 10.0, lead_in=5)
+    assert new.tension_max_N == pytest.approx(old.tension_max_N, rel=1e-8)
+    assert new.tension_min_N == pytest.approx(old.tension_min_N, rel=1e-8)
+    assert new.max_multiplier == pytest.approx(old.max_multiplier, rel=1e-8)
+
+
 def test_orbit_is_the_brute_force_periodic_response(alpha_map):
     """Issue 13 test 1 at N = 4, 10 Hz: T max and T min of the shooting orbit
     equal those of the brute-force integration to periodicity within 1e-3
