@@ -1,0 +1,309 @@
+"""The fidelity table of issue 14: what each option beyond the paper changes.
+
+For the paper's model and each option (``OPTIONS``: a dict of dotted scene
+overrides, as ``--set`` takes them) it measures, through the public API only
+(``rh.load_scene``, ``rh.modes``, ``rh.simulate``, ``rh.orbits``):
+
+* ``modes``: Table 3 (``stationary_table2``, the scene ``rawehelix modes``
+  reproduces Table 3 with), the first mode of each family: frequency and
+  decay rate;
+* ``simulate``: Sec. 5.2 (``nominal_operation``): the settling time into the
+  2 % band (the summary's ``settling_time_s``, studies/metrics.py) and the
+  peak |ground torque|;
+* ``orbits``: the Fig. 8 resonance (``mobile_end``): the branch from
+  ``F1_START`` upward without superharmonic sites (as docs/orbits.md "Issue
+  test 4"), stopped at the first point after the first fold; the fold's f1
+  and T max and the peak (the first local maximum of T max that the branch
+  locates, the vertex of its parabola; else the largest T max on the branch);
+
+and the cost of each as the CPU time (time.process_time) of the same part
+for the paper's model in the same process (orbits: CPU time per point).
+
+    .venv/bin/python benchmarks/fidelity.py run modes simulate orbits [--only NAME ...]
+    .venv/bin/python benchmarks/fidelity.py table
+
+``run`` stores each (part, option) in benchmarks/fidelity/<part>.json as it
+finishes (a rerun skips what is stored unless ``--again``); ``table`` prints
+the markdown of docs/physics.md ("fidelity table").  Serial; a benchmark.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import shutil
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import rawehelix as rh
+from rawehelix.families import FAMILY_LABELS, VIBRATIONS
+
+HERE = Path(__file__).resolve().parent / "fidelity"
+
+#: the intrinsic law identified by `rawehelix labtest bending --fit` (docs/labtest.md)
+EI_LAW = {"a_Nm2_per_N": 34.88, "b_Nm2": 2303.0}
+#: retardation times [s]: round values that give each family's first Table 3
+#: mode a damping ratio of about 1 % (the paper measures no decay rate; see
+#: docs/physics.md "fidelity table" for the ratios they give)
+DAMPING = {"damping.axial_s": 1e-4, "damping.bending_s": 1e-3, "damping.torsion_s": 1e-3}
+EXTENSIBLE = {"model.kinematics": "extensible"}
+LAW = {**EXTENSIBLE, "helix.EI_law": EI_LAW}
+
+OPTIONS = {
+    "paper": {},
+    "extensible": EXTENSIBLE,
+    "extensible + EI law": LAW,
+    "damping": DAMPING,
+    "EI law + damping": {**LAW, **DAMPING},
+}
+HYSTERESIS = "torsion hysteresis"
+
+
+def _hysteresis_law():
+    """The Bouc-Wen law FIG5 of benchmarks/hysteresis.py as overrides, or None
+    where the [torsion_hysteresis] switch is not in this tree."""
+    import importlib.util
+    path = Path(__file__).resolve().parent / "hysteresis.py"
+    if not path.exists():
+        return None
+    spec = importlib.util.spec_from_file_location("hysteresis_benchmark", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return {f"torsion_hysteresis.{k}": v for k, v in module.FIG5.items()}
+
+
+#: options whose row stays "pending" until measured (the hysteresis: until its branch is in)
+PENDING = (HYSTERESIS,)
+
+PARTS = ("modes", "simulate", "orbits")
+ELEMENTS = {"modes": 16, "simulate": 16, "orbits": 4}
+REPEATS = 3  # modes: the median CPU time of REPEATS runs after one that compiles
+F1_START = 11.5  # Hz, the start of docs/orbits.md's fold window
+F1_STOP = {"paper": 12.9, "extensible": 12.9, "damping": 12.9}  # else F1_STOP_WIDE
+F1_STOP_WIDE = 14.5  # the EI law stiffens the Sec. 5.3 helix (+10 % EI at 73 N)
+MAX_POINTS = 60
+
+
+class _FoldPassed(Exception):
+    """The branch turned back in f1: the first fold is behind the last point."""
+
+
+def modes_row(name: str, overrides: dict, N: int) -> dict:
+    scene = rh.load_scene("stationary_table2", elements=N, degree=3, overrides=overrides)
+    rh.modes(scene)  # compiles the forms
+    cpus = []
+    for _ in range(REPEATS):
+        start = time.process_time()
+        result = rh.modes(scene)
+        cpus.append(time.process_time() - start)
+    cpu = statistics.median(cpus)
+    first = {}
+    for m in sorted(result, key=lambda m: m.frequency_Hz):
+        if m.family in VIBRATIONS:
+            first.setdefault(m.family, {"frequency_Hz": m.frequency_Hz,
+                                        "decay_per_s": m.decay_per_s})
+    return {"elements": N, "cpu_s": cpu, "first": first}
+
+
+def simulate_row(name: str, overrides: dict, N: int) -> dict:
+    scene = rh.load_scene("nominal_operation", elements=N, degree=3, overrides=overrides)
+    start = time.process_time()
+    ts = rh.simulate(scene, progress=False)
+    cpu = time.process_time() - start
+    return {"elements": N, "cpu_s": cpu, "until_s": float(ts.t_s[-1]),
+            "settling_time_s": ts.summary["settling_time_s"],
+            "peak_ground_torque_Nm": float(abs(ts.ground_torque_Nm).max()),
+            "tension_range_N": ts.summary["tension_range_N"],
+            "max_spin_lag_rpm": float((ts.spin_rpm[:, 2] - ts.spin_rpm[:, 0]).max()),
+            "steps": ts.summary["steps"]}
+
+
+def orbits_row(name: str, overrides: dict, N: int) -> dict:
+    scene = rh.load_scene("mobile_end", elements=N, degree=3, overrides=overrides)
+    stop = F1_STOP.get(name, F1_STOP_WIDE)
+    store = HERE / "orbits" / name.replace(" ", "_").replace("+", "and")
+    shutil.rmtree(store, ignore_errors=True)
+    seen = []
+
+    def progress(orbit):
+        seen.append(orbit.f1_Hz)
+        if len(seen) > 2 and seen[-1] < seen[-2]:
+            raise _FoldPassed()
+
+    start = time.process_time()
+    try:
+        result = rh.orbits(scene, F1_START, stop, progress=progress, outdir=store,
+                           superharmonics=(), max_points=MAX_POINTS)
+    except _FoldPassed:  # the stored branch up to here, with its events
+        result = rh.orbits(scene, F1_START, stop, outdir=store, superharmonics=(),
+                           max_points=len(seen))
+    cpu = time.process_time() - start
+    f1 = [b["f1_Hz"] for b in result.branch]
+    tmax = [b["tension_max_N"] for b in result.branch]
+    k = max(range(len(tmax)), key=lambda i: tmax[i])
+    located = [x for x in result.peaks if x["kind"] == "peak"]  # the branch's parabola vertex
+    peak = ({"f1_Hz": located[0]["f1_Hz"], "tension_max_N": located[0]["tension_max_N"],
+             "at_end": False} if located else
+            {"f1_Hz": f1[k], "tension_max_N": tmax[k], "at_end": k == len(f1) - 1})
+    fold = result.folds[0] if result.folds else None
+    return {"elements": N, "cpu_s": cpu, "points": len(f1), "window_Hz": [F1_START, stop],
+            "cpu_per_point_s": cpu / max(1, len(f1)),
+            "fold": None if fold is None else {"f1_Hz": fold["f1_Hz"],
+                                               "tension_max_N": fold["tension_max_N"],
+                                               "f1_error_Hz": fold.get("f1_error_Hz")},
+            "peak": peak, "f1_last_Hz": f1[-1], "folds": result.folds, "peaks": result.peaks,
+            "branch": result.branch}
+
+
+ROWS = {"modes": modes_row, "simulate": simulate_row, "orbits": orbits_row}
+
+
+def load(part: str) -> dict:
+    path = HERE / f"{part}.json"
+    return json.loads(path.read_text()) if path.exists() else {}
+
+
+def run(parts, only, again: bool):
+    HERE.mkdir(parents=True, exist_ok=True)
+    options = dict(OPTIONS)
+    law = _hysteresis_law()
+    if law is not None:
+        options[HYSTERESIS] = law
+    for part in parts:
+        stored = load(part)
+        for name, overrides in options.items():
+            if (only and name not in only and name != "paper") or (name in stored and not again
+                                                                    and name != "paper"):
+                continue
+            print(f"[{time.strftime('%H:%M:%S')}] {part}: {name} ...", flush=True)
+            try:
+                row = ROWS[part](name, overrides, ELEMENTS[part])
+            except (rh.SceneError, rh.SolverError) as err:  # an option this part refuses
+                if name == "paper":
+                    raise
+                row = {"refused": str(err).splitlines()[0]}
+            row["overrides"] = overrides
+            stored[name] = row
+            (HERE / f"{part}.json").write_text(json.dumps(stored, indent=1))
+            print(f"  {json.dumps(row)}", flush=True)
+
+
+def _pct(x, ref):
+    if x is None or ref is None:
+        return "n/a"
+    return f"{100 * (x / ref - 1):+.2f} %"
+
+
+def _missing(name, row, columns: int) -> str:
+    """The row of an option not measured ("pending") or refused by the part."""
+    cells = ["pending"] * columns if row is None else [f"refused: {row['refused']}"] + \
+        ["-"] * (columns - 1)
+    return f"| {name} | " + " | ".join(cells) + " |"
+
+
+def _n(ref):
+    return f", N = {ref['elements']}, p = 3" if ref and "elements" in ref else ""
+
+
+def _cost(row, ref, key="cpu_s"):
+    return f"x{row[key] / ref[key]:.2f}" if row and ref else "pending"
+
+
+def build_table(results: dict) -> str:
+    """The markdown fidelity table from ``{part: {option: row}}`` (rows as
+    :func:`run` stores them); options without a row say "pending"."""
+    names = list(dict.fromkeys([*OPTIONS, *PENDING]))
+    out = []
+    modes = results.get("modes", {})
+    ref = modes.get("paper")
+    fams = [f for f in VIBRATIONS if ref and f in ref["first"]]
+    head = ["option"] + [f"{FAMILY_LABELS[f]} 1: f [Hz], decay [1/s]" for f in fams] + ["CPU"]
+    out += [f"**Table 3** (`stationary_table2`{_n(ref)}, first mode of each family; change "
+            "against the paper's model)", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for name in names:
+        row = modes.get(name)
+        if row is None or "refused" in row:
+            out.append(_missing(name, row, len(head) - 1))
+            continue
+        cells = []
+        for f in fams:
+            m, r = row["first"][f], ref["first"][f]
+            c = f"{m['frequency_Hz']:.4f}, {m['decay_per_s']:.4f}"
+            if name != "paper":
+                c += f" ({_pct(m['frequency_Hz'], r['frequency_Hz'])}, " \
+                     f"{m['decay_per_s'] - r['decay_per_s']:+.4f})"
+            cells.append(c)
+        out.append(f"| {name} | " + " | ".join(cells) + f" | {_cost(row, ref)} |")
+    sim = results.get("simulate", {})
+    ref = sim.get("paper")
+    out += ["", f"**Sec. 5.2** (`nominal_operation`{_n(ref)}, 30 s)", "",
+            "| option | settling time (2 %) [s] | peak ground torque [Nm] | max spin(L0) - "
+            "spin(0) [rpm] | tension range [N] | CPU |", "|---|---|---|---|---|---|"]
+    for name in names:
+        row = sim.get(name)
+        if row is None or "refused" in row:
+            out.append(_missing(name, row, 5))
+            continue
+        st, tq = row["settling_time_s"], row["peak_ground_torque_Nm"]
+        lag, (t_lo, t_hi) = row["max_spin_lag_rpm"], row["tension_range_N"]
+        cells = [("not settled" if st is None else f"{st:.4f}"), f"{tq:.3f}"]
+        if name != "paper":
+            cells = [f"{cells[0]} ({_pct(st, ref['settling_time_s'])})",
+                     f"{cells[1]} ({_pct(tq, ref['peak_ground_torque_Nm'])})"]
+        cells += [f"{lag:.3f}", f"{t_lo:.2f}-{t_hi:.2f}"]
+        out.append(f"| {name} | " + " | ".join(cells) + f" | {_cost(row, ref)} |")
+    orb = results.get("orbits", {})
+    ref = orb.get("paper")
+    out += ["", f"**Fig. 8 resonance** (`mobile_end`{_n(ref)}, `rh.orbits` from {F1_START} Hz, "
+            "to the first point after the first fold)", "",
+            "| option | fold f1 [Hz] (T max [N]) | peak f1 [Hz] | peak T max [N] | points | "
+            "CPU per point |", "|---|---|---|---|---|---|"]
+    for name in names:
+        row = orb.get(name)
+        if row is None or "refused" in row:
+            out.append(_missing(name, row, 5))
+            continue
+        fold, peak = row["fold"], row["peak"]
+        if fold is None:
+            fc = f"none to {row['f1_last_Hz']:.2f} Hz"
+        else:
+            fc = f"{fold['f1_Hz']:.4f} ({fold['tension_max_N']:.1f})"
+        pc = f"{peak['f1_Hz']:.4f}" + (" (window end)" if peak["at_end"] else "")
+        tc = f"{peak['tension_max_N']:.1f}"
+        if name != "paper" and ref is not None:
+            if fold is not None and ref["fold"] is not None:
+                fc += f" {fold['f1_Hz'] - ref['fold']['f1_Hz']:+.3f} Hz"
+            pc += f" {peak['f1_Hz'] - ref['peak']['f1_Hz']:+.3f} Hz"
+            tc += f" ({_pct(peak['tension_max_N'], ref['peak']['tension_max_N'])})"
+        out.append(f"| {name} | {fc} | {pc} | {tc} | {row['points']} | "
+                   f"{row['cpu_per_point_s']:.2f} s ({_cost(row, ref, 'cpu_per_point_s')}) |")
+    return "\n".join(out)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("parts", nargs="+", choices=PARTS)
+    r.add_argument("--only", nargs="*", default=None, choices=[*OPTIONS, HYSTERESIS])
+    r.add_argument("--again", action="store_true", help="recompute stored options")
+    for part in PARTS:
+        r.add_argument(f"--{part}-elements", type=int, default=ELEMENTS[part])
+    sub.add_parser("table")
+    a = p.parse_args(argv)
+    if a.cmd == "run":
+        import petsc4py
+        petsc4py.init([])
+        logging.disable(logging.INFO)
+        for part in PARTS:
+            ELEMENTS[part] = getattr(a, f"{part}_elements")
+        run(a.parts, a.only, a.again)
+    print(build_table({part: load(part) for part in PARTS}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
