@@ -181,10 +181,11 @@ def run(parts, only, again: bool):
             print(f"[{time.strftime('%H:%M:%S')}] {part}: {name} ...", flush=True)
             try:
                 row = ROWS[part](name, overrides, ELEMENTS[part])
-            except (rh.SceneError, rh.SolverError) as err:  # an option this part refuses
+            except (rh.SceneError, rh.SolverError) as err:  # refused, or failed to solve
                 if name == "paper":
                     raise
-                row = {"refused": str(err).splitlines()[0]}
+                kind = "refused" if isinstance(err, rh.SceneError) else "failed"
+                row = {kind: str(err).splitlines()[0]}
             row["overrides"] = overrides
             stored[name] = row
             (HERE / f"{part}.json").write_text(json.dumps(stored, indent=1))
@@ -198,9 +199,12 @@ def _pct(x, ref):
 
 
 def _missing(name, row, columns: int) -> str:
-    """The row of an option not measured ("pending") or refused by the part."""
-    cells = ["pending"] * columns if row is None else [f"refused: {row['refused']}"] + \
-        ["-"] * (columns - 1)
+    """The row of an option not measured ("pending"), refused or failed in the part."""
+    if row is None:
+        cells = ["pending"] * columns
+    else:
+        kind = "refused" if "refused" in row else "failed"
+        cells = [f"{kind}: {row[kind]}"] + ["-"] * (columns - 1)
     return f"| {name} | " + " | ".join(cells) + " |"
 
 
@@ -225,7 +229,7 @@ def build_table(results: dict) -> str:
             "against the paper's model)", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for name in names:
         row = modes.get(name)
-        if row is None or "refused" in row:
+        if row is None or "refused" in row or "failed" in row:
             out.append(_missing(name, row, len(head) - 1))
             continue
         cells = []
@@ -244,7 +248,7 @@ def build_table(results: dict) -> str:
             "spin(0) [rpm] | tension range [N] | CPU |", "|---|---|---|---|---|---|"]
     for name in names:
         row = sim.get(name)
-        if row is None or "refused" in row:
+        if row is None or "refused" in row or "failed" in row:
             out.append(_missing(name, row, 5))
             continue
         st, tq = row["settling_time_s"], row["peak_ground_torque_Nm"]
@@ -263,7 +267,7 @@ def build_table(results: dict) -> str:
             "CPU per point |", "|---|---|---|---|---|---|"]
     for name in names:
         row = orb.get(name)
-        if row is None or "refused" in row:
+        if row is None or "refused" in row or "failed" in row:
             out.append(_missing(name, row, 5))
             continue
         fold, peak = row["fold"], row["peak"]

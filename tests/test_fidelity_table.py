@@ -30,6 +30,7 @@ def test_table_changes_costs_and_pending_rows():
                                "peak": {"f1_Hz": 12.9, "tension_max_N": 420.0, "at_end": True},
                                "f1_last_Hz": 12.9}}}
     results["modes"][fidelity.HYSTERESIS] = {"refused": "no modes with z"}
+    results["orbits"]["EI law + damping"] = {"failed": "Newton did not converge"}
     table = fidelity.build_table(results)
     rows = {line.split(" | ")[0] + " | " + str(i): line
             for i, line in enumerate(table.splitlines()) if line.startswith("| damping")}
@@ -42,7 +43,9 @@ def test_table_changes_costs_and_pending_rows():
     refused = [x for x in table.splitlines() if x.startswith(f"| {fidelity.HYSTERESIS} |")][0]
     assert refused == f"| {fidelity.HYSTERESIS} | refused: no modes with z | - |"
     # every option without a row says so in all three tables
+    failed = [x for x in table.splitlines() if x.startswith("| EI law + damping |")][2]
+    assert failed == "| EI law + damping | failed: Newton did not converge | - | - | - | - |"
     for name in fidelity.OPTIONS:
-        if name not in ("paper", "damping"):
+        if name not in ("paper", "damping", "EI law + damping"):
             lines = [x for x in table.splitlines() if x.startswith(f"| {name} |")]
             assert len(lines) == 3 and all("pending" in x for x in lines)
