@@ -47,22 +47,27 @@ def create_mesh_1d(comm, cells: np.ndarray, x: np.ndarray):
                                     ghost_mode=dolfinx.mesh.GhostMode.shared_facet)
 
 
-def _mixed(cell, degree: int, copies: int, curvature: bool = False):
+def _mixed(cell, degree: int, copies: int, curvature: bool = False, internal: bool = False):
     """``copies`` x (vector P_p with 3 components, scalar P_p) as one mixed element,
-    with a third vector P_p (the curvature) after the first pair if ``curvature``."""
+    with a third vector P_p (the curvature) after the first pair if ``curvature``,
+    or a scalar DG_(p-1) (an internal variable, the space of alpha') if ``internal``."""
     if NEW:
         vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
         sca = basix.ufl.element("Lagrange", "interval", degree)
-        return basix.ufl.mixed_element([vec, sca] + [vec] * curvature + [vec, sca] * (copies - 1))
+        dg = [basix.ufl.element("DG", "interval", degree - 1)] * internal
+        return basix.ufl.mixed_element([vec, sca] + [vec] * curvature + dg
+                                       + [vec, sca] * (copies - 1))
     vec = ufl.VectorElement("Lagrange", cell, degree, dim=3)
     sca = ufl.FiniteElement("Lagrange", cell, degree)
-    return ufl.MixedElement([vec, sca] + [vec] * curvature + [vec, sca] * (copies - 1))
+    dg = [ufl.FiniteElement("DG", cell, degree - 1)] * internal
+    return ufl.MixedElement([vec, sca] + [vec] * curvature + dg + [vec, sca] * (copies - 1))
 
 
-def rod_element(cell, degree: int, curvature: bool = False):
+def rod_element(cell, degree: int, curvature: bool = False, internal: bool = False):
     """The mixed (r, alpha) element: vector P_p with 3 components and scalar P_p;
-    (r, alpha, kappa) with a second vector P_p if ``curvature`` (forms/mixed.py)."""
-    return _mixed(cell, degree, 1, curvature)
+    (r, alpha, kappa) with a second vector P_p if ``curvature`` (forms/mixed.py);
+    (r, alpha, z) with a scalar DG_(p-1) if ``internal`` (forms/hysteresis.py)."""
+    return _mixed(cell, degree, 1, curvature, internal)
 
 
 def function_space(mesh, element):

@@ -199,6 +199,48 @@ class Damping:
                 f"tau_t = {self.torsion_s:g} s")
 
 
+@dataclass(frozen=True)
+class TorsionHysteresis:
+    """Hysteretic torsion (forms/hysteresis.py): a Bouc-Wen internal twist z in the
+    torsional moment.  A scene's ``[torsion_hysteresis]`` section; ``rho`` = 1 (the
+    default) is the paper's elastic moment GJ tau (Eq. 65) and leaves z out.
+
+        M = GJ (rho tau + (1 - rho) z),
+        dz/dt = A dtau/dt - beta |dtau/dt| |z|^(n-1) z - gamma dtau/dt |z|^n
+
+    (Bouc 1967 in Wen's 1976 form; tau and z in rad/m, t in s).  Its loop is bounded
+    (|z| <= z_u = (A / (beta + gamma))^(1/n)) and dissipates (Wen's condition) when
+    beta > 0 and -beta <= gamma <= beta."""
+
+    rho: float = 1.0  # the elastic share of GJ, in (0, 1]; 1: off [-]
+    A: float = 1.0  # the slope dz/dtau at z = 0: virgin tangent GJ (rho + (1 - rho) A) [-]
+    beta_m_n: float = 0.0  # beta, units (m/rad)^n: the loop's width [(m/rad)^n]
+    gamma_m_n: float = 0.0  # gamma, units (m/rad)^n: its shape (> 0 softens on loading) [(m/rad)^n]
+    n: float = 1.0  # exponent: the sharpness of the yield, >= 1 [-]
+
+    def __post_init__(self):
+        if not (0 < self.rho <= 1):
+            raise ParameterError("torsion_hysteresis.rho", self.rho, "must lie in (0, 1]")
+        _positive("torsion_hysteresis", self, "A")
+        if not (self.n >= 1 and math.isfinite(self.n)):
+            raise ParameterError("torsion_hysteresis.n", self.n, "must be a finite number >= 1")
+        if not math.isfinite(self.beta_m_n) or not math.isfinite(self.gamma_m_n):
+            raise ParameterError("torsion_hysteresis.beta_m_n", self.beta_m_n, "must be finite")
+        if self.active and not (self.beta_m_n > 0 and abs(self.gamma_m_n) <= self.beta_m_n):
+            raise ParameterError(
+                "torsion_hysteresis.gamma_m_n", self.gamma_m_n,
+                f"needs beta_m_n = {self.beta_m_n!r} > 0 and -beta_m_n <= gamma_m_n <= beta_m_n "
+                "(Wen 1976: a bounded, dissipative loop)")
+
+    @property
+    def active(self) -> bool:
+        return self.rho < 1
+
+    def describe(self) -> str:
+        return (f"torsion hysteresis: Bouc-Wen rho = {self.rho:g}, A = {self.A:g}, "
+                f"beta = {self.beta_m_n:g}, gamma = {self.gamma_m_n:g} (m/rad)^n, n = {self.n:g}")
+
+
 GAMMA_TREATMENTS = ("regularised", "off")
 KINEMATICS = ("paper", "extensible")  # forms/rod.py (Eqs. 30-33), forms/extensible.py
 
@@ -230,6 +272,8 @@ class Model:
     kinematics: str = "paper"
     # structural damping: the scene's [damping] section (studies/scene.py puts it here)
     damping: Damping = field(default_factory=Damping)
+    # hysteretic torsion: the scene's [torsion_hysteresis] section (studies/scene.py)
+    torsion_hysteresis: TorsionHysteresis = field(default_factory=TorsionHysteresis)
 
     def describe(self, planar: bool = False) -> str:
         """The model that runs, for summary.json: reduction and the terms switched on."""
@@ -245,7 +289,8 @@ class Model:
             terms.append(f"gamma ({self.gamma})")
         text = (f"{head}; terms: {', '.join(terms) or 'tension only'}; "
                 f"kinematics: {self.kinematics}")
-        return f"{text}; {self.damping.describe()}" if self.damping.active else text
+        extras = [x.describe() for x in (self.damping, self.torsion_hysteresis) if x.active]
+        return "; ".join([text, *extras])
 
     def __post_init__(self):
         if self.gamma not in GAMMA_TREATMENTS:
@@ -260,7 +305,8 @@ class Model:
 #: model switches added after results were stored (sweep checkpoints, the
 #: convergence cache): left out of :meth:`Parameters.as_dict` at their
 #: defaults, so that those results keep their fingerprints
-LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Damping())}
+LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Damping()),
+                        "torsion_hysteresis": dataclasses.asdict(TorsionHysteresis())}
 #: the same for the helix section
 LATER_HELIX_SWITCHES = {"EI_law": None}
 
@@ -404,15 +450,24 @@ class Parameters:
             raise ParameterError("damping", self.model.damping,
                                  "structural damping is implemented by the FE scheme with "
                                  "discretisation.bending = 'ip' only (forms/damping.py)")
+        if self.model.torsion_hysteresis.active and (
+                self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"
+                or not self.model.twist):
+            raise ParameterError("torsion_hysteresis", self.model.torsion_hysteresis,
+                                 "hysteretic torsion is implemented by the FE scheme with "
+                                 "discretisation.bending = 'ip' and model.twist = true only "
+                                 "(forms/hysteresis.py)")
 
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:
         ``p.replace(discretisation={"elements": 32})``; ``damping={...}`` changes
-        the model's damping (the scene's ``[damping]`` section)."""
+        the model's damping (the scene's ``[damping]`` section), ``torsion_hysteresis={...}``
+        its hysteretic torsion."""
         sections = dict(sections)
-        if "damping" in sections:
-            damping = dataclasses.replace(self.model.damping, **sections.pop("damping"))
-            sections["model"] = {**sections.get("model", {}), "damping": damping}
+        for nested in ("damping", "torsion_hysteresis"):  # held by Model
+            if nested in sections:
+                value = dataclasses.replace(getattr(self.model, nested), **sections.pop(nested))
+                sections["model"] = {**sections.get("model", {}), nested: value}
         changed = {name: values if isinstance(values, str)
                    else dataclasses.replace(getattr(self, name), **values)
                    for name, values in sections.items()}
@@ -481,10 +536,21 @@ class Normalised:
     bending_law: bool = False
     mu_per_tension: float = 0.0
     mu_at_zero_tension: float = 0.0
+    # hysteretic torsion (forms/hysteresis.py): tau~ = tau L0 and z~ = z L0, so
+    # beta~ = beta / L0^n and gamma~ = gamma / L0^n; rho = 1: off
+    bw_rho: float = 1.0
+    bw_A: float = 1.0
+    bw_beta: float = 0.0
+    bw_gamma: float = 0.0
+    bw_n: float = 1.0
 
     @property
     def damped(self) -> bool:
         return self.tau_axial > 0 or self.tau_bending > 0 or self.tau_torsion > 0
+
+    @property
+    def hysteretic(self) -> bool:
+        return self.bw_rho < 1
 
     @classmethod
     def from_parameters(cls, p: Parameters) -> "Normalised":
@@ -495,6 +561,7 @@ class Normalised:
         mu = h.EI_Nm2 / (M * g * L0**2)  # (26)
         beta = h.GJ_Nm2 / (M * g * L0**2)  # (26)
         sigma = h.EA_N / (M * g)  # (27)
+        bw = p.model.torsion_hysteresis
         return cls(
             L0=L0, t_scale=t_scale, force_scale=M * g, torque_scale=h.GJ_Nm2 / L0,
             sigma=sigma, mu=mu, beta=beta,
@@ -515,6 +582,8 @@ class Normalised:
             bending_law=law is not None,
             mu_per_tension=0.0 if law is None else law.a_Nm2_per_N / L0**2,
             mu_at_zero_tension=0.0 if law is None else law.b_Nm2 / (M * g * L0**2),
+            bw_rho=bw.rho, bw_A=bw.A, bw_beta=bw.beta_m_n / L0**bw.n,
+            bw_gamma=bw.gamma_m_n / L0**bw.n, bw_n=bw.n,
         )
 
     # -- units back to SI ---------------------------------------------------

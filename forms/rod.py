@@ -22,6 +22,11 @@ B) are instead the variation of the extensible rod's stored energy,
 :mod:`rawehelix.forms.extensible`; :func:`elastic_residual` is the one place
 that chooses.
 
+With ``[torsion_hysteresis]`` (``c.hysteretic``) the state has a third
+field, the Bouc-Wen internal twist z (a DG field), every GJ tau is the moment
+of :mod:`rawehelix.forms.hysteresis` and the residual has z's equation; the
+functions below see it as ``z`` (and its test ``zeta``).
+
 No solver code here: functions take UFL objects and numbers (or constants)
 and return UFL.
 """
@@ -73,6 +78,15 @@ class Coefficients:
     mu_a: Any = 0.0
     mu_b: Any = 0.0
     bending_law: bool = False
+    # hysteretic torsion (forms/hysteresis.py): Bouc-Wen rho, A, beta, gamma
+    # (normalised) and the exponent n (a number: it chooses the form's shape);
+    # ``hysteretic`` False: no z field, the elastic moment
+    bw_rho: Any = 1.0
+    bw_A: Any = 1.0
+    bw_beta: Any = 0.0
+    bw_gamma: Any = 0.0
+    bw_n: float = 1.0
+    hysteretic: bool = False
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
@@ -89,6 +103,8 @@ class Coefficients:
             damped=q.damped,
             mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
             bending_law=q.bending_law,
+            bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),
+            bw_gamma=make(q.bw_gamma), bw_n=q.bw_n, hysteretic=q.hysteretic,
         )
 
 
@@ -165,15 +181,20 @@ def body_force(r_t, c: Coefficients):
 
 
 def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx, dS, ds,
-                     kappa=None, eta=None):
+                     kappa=None, eta=None, z=None):
     """Internal forces and end torques of Eqs. (30)-(31): everything but inertia and loads.
 
     ``kappa``, ``eta``: the curvature field and its test (mixed bending form).
+    ``z``: the Bouc-Wen internal twist; every GJ tau is then the moment
+    GJ (rho tau + (1 - rho) z) of :mod:`rawehelix.forms.hysteresis`.
     ``c.kinematics = "extensible"``: the centre-line forces are the variation
     of the extensible rod's stored energy, :mod:`rawehelix.forms.extensible`
     (IP bending only; the twist terms are the same)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
+    if z is not None:  # the moment / GJ, hysteretic (Fig. 5)
+        from rawehelix.forms import hysteresis
+        tau = hysteresis.moment(tau, z, c)
     if c.kinematics == "extensible":  # stretch and bending from the stored energy
         F = extensible.centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
     elif kappa is None:
@@ -197,13 +218,17 @@ def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures
     derivatives; ``w_tt = None`` gives the stationary residual (and ``w_t =
     None`` zero velocity).  ``measures`` = (dx, dS, ds).  On the space
     (r, alpha, kappa) of the mixed bending form the third field is kappa
-    (which has no rate: the rates' kappa parts are unused)."""
-    r, alpha, *kappa = ufl.split(w)
-    r_t, alpha_t = ufl.split(w_t)[:2] if w_t is not None else (None, None)
+    (which has no rate: the rates' kappa parts are unused); on (r, alpha, z)
+    (``c.hysteretic``) it is the Bouc-Wen twist z, whose rate is read."""
+    r, alpha, *third = ufl.split(w)
+    r_t, alpha_t, *third_t = ufl.split(w_t) if w_t is not None else (None, None)
     r_tt, alpha_tt = ufl.split(w_tt)[:2] if w_tt is not None else (None, None)
+    hysteretic = c.hysteretic and bool(third)
     return residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, test_fields(test), c, degree,
-                              penalty, measures, kappa=kappa[0] if kappa else None,
-                              alpha_t=alpha_t)
+                              penalty, measures,
+                              kappa=third[0] if third and not hysteretic else None,
+                              alpha_t=alpha_t, z=third[0] if hysteretic else None,
+                              z_t=third_t[0] if hysteretic and third_t else None)
 
 
 def test_fields(test):
@@ -212,21 +237,32 @@ def test_fields(test):
 
 
 def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, degree: int,
-                       penalty, measures, kappa=None, alpha_t=None):
+                       penalty, measures, kappa=None, alpha_t=None, z=None, z_t=None):
     """:func:`residual` on fields given one by one, so that (r, alpha) and
     their rates may live in a larger mixed space (the first-order form of the
     dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
     the curvature field of the mixed bending form, with the test
     ``tests[2]``.  ``alpha_t``: the twist rate, read by the structural damping
-    (``c.damped``, forms/damping.py) only."""
+    (``c.damped``, forms/damping.py) and the hysteresis only.  ``z``, ``z_t``:
+    the Bouc-Wen twist and its rate, with the test ``tests[2]``
+    (forms/hysteresis.py); ``z_t`` None (a stationary residual) holds z = 0."""
     dx, dS, ds = measures
-    v, psi, *eta = tests
+    v, psi, *third = tests
     moving = r_t is not None
     if r_t is None:
         r_t = ufl.as_vector((0.0, 0.0, 0.0))
     F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds,
-                          kappa=kappa, eta=eta[0] if eta else None)
+                          kappa=kappa, eta=third[0] if third and kappa is not None else None,
+                          z=z)
          - ufl.inner(body_force(r_t, c), v) * dx)
+    if z is not None:  # the Bouc-Wen equation of z (forms/hysteresis.py)
+        from rawehelix.forms import damping, hysteresis  # (both build on this module)
+        if z_t is None or not moving:
+            F += hysteresis.virgin_residual(z, third[0], dx)
+        else:  # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate
+            tau_t = (c.gamma_coupling * damping.frenet_torsion_rate(r, r_t, c.gamma_eps)
+                     + d(alpha_t))
+            F += hysteresis.evolution_residual(z, z_t, tau_t, third[0], dx, c)
     if c.damped and moving:  # Kelvin-Voigt, from the dissipation potential
         from rawehelix.forms import damping  # (damping builds on this module)
         F += damping.viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)

@@ -6,6 +6,8 @@ Shared by the stationary, dynamic and modal solvers.  Built from validated
 With ``discretisation.bending = "mixed"`` the space is (r, alpha, kappa),
 kappa the curvature field of :mod:`rawehelix.forms.mixed` with kappa = 0 at
 both ends (Eq. 37) as Dirichlet conditions (``curvature_bcs``, also in ``bcs``).
+With ``[torsion_hysteresis]`` it is (r, alpha, z), z the Bouc-Wen internal
+twist on DG_(p-1) (:mod:`rawehelix.forms.hysteresis`), which needs no end condition.
 """
 
 from __future__ import annotations
@@ -40,8 +42,9 @@ class RodDiscretisation:
         self.penalty = disc.penalty
         self.mixed = disc.bending == "mixed"  # the curvature field kappa, forms/mixed.py
         self.mesh = interval.mesh_from_parameters(comm, params)
+        self.hysteretic = params.model.torsion_hysteresis.active  # z, forms/hysteresis.py
         self.W = compat.function_space(self.mesh, compat.rod_element(
-            self.mesh.ufl_cell(), self.degree, curvature=self.mixed))
+            self.mesh.ufl_cell(), self.degree, curvature=self.mixed, internal=self.hysteretic))
         self.w = dolfinx.fem.Function(self.W, name="state")
         self.test = ufl.TestFunction(self.W)
         self.trial = ufl.TrialFunction(self.W)
@@ -84,6 +87,18 @@ class RodDiscretisation:
             self.curvature_bcs = [dolfinx.fem.dirichletbc(self.kappa_zero, dofs_k, self.W.sub(2))]
             self._curvature_problem = None
         self.bcs += self.curvature_bcs
+
+    def end_twist_conditions(self):
+        """alpha(0) = 0 and alpha(1) = ``self.alpha_top`` (a Function, set by the
+        caller): the prescribed end twist of a torsion test (Sec. 4)."""
+        mesh = self.mesh
+        self.alpha_top = dolfinx.fem.Function(self.V_a)
+        bcs = []
+        for x_end, g in ((0.0, self.alpha_zero), (1.0, self.alpha_top)):
+            vertices = compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], x_end))
+            dofs = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, vertices)
+            bcs.append(dolfinx.fem.dirichletbc(g, dofs, self.W.sub(1)))
+        return bcs
 
     def all_dofs(self, W_sub, V_collapsed):
         """Every dof of a sub-space (for a field held at zero)."""
@@ -143,6 +158,10 @@ class RodDiscretisation:
     def curvature(self):
         """kappa as UFL (mixed bending form), or None: r'' is then cellwise."""
         return ufl.split(self.w)[2] if self.mixed else None
+
+    def internal_twist(self, w=None):
+        """z as UFL (hysteretic torsion, forms/hysteresis.py), or None."""
+        return ufl.split(w or self.w)[2] if self.hysteretic else None
 
     def gather_centre_line(self):
         """(s, r (n, 3)) at the Lagrange nodes on rank 0 ((None, None) elsewhere)."""

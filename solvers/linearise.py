@@ -44,6 +44,7 @@ from mpi4py import MPI
 import dolfinx.fem
 import dolfinx.fem.petsc
 
+from rawehelix.errors import SceneError
 from rawehelix.forms import rod as rod_forms
 from rawehelix.forms.kinematics import d
 from rawehelix.solvers.state import RodState
@@ -62,6 +63,10 @@ class Linearisation:
     evaluates them about a state."""
 
     def __init__(self, rod):
+        if rod.hysteretic:  # forms/hysteresis.py: z = A tau about z = 0, not separated here
+            raise SceneError(rod.params.name, "torsion_hysteresis",
+                             "the modal solver does not linearise the hysteretic torsion "
+                             "(forms/hysteresis.py); it runs in time only ('simulate')")
         self.rod = rod
         # separate fields for w, w_t, w_tt: the three Jacobians of F at (w0, 0, 0)
         self.w_t = dolfinx.fem.Function(rod.W, name="velocity")

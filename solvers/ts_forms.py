@@ -30,6 +30,11 @@ U_{n+1}, and an inconsistency g_n is mapped to g_{n+1} = -(1 - alpha_f) /
 alpha_f g_n = -rho_inf g_n (alpha_f = 1 / (1 + rho_inf)): it decays, with
 alternating sign.  The V and A that alpha2 carries for kappa are never read.
 The first-order form is refused with the mixed form.
+
+Hysteretic torsion (``[torsion_hysteresis]``, U = (r, alpha, z)): z's rows
+are the Bouc-Wen ODE on V_z (forms/hysteresis.py), a first-order equation
+that alpha2 integrates through its Newmark relations; the first-order form
+is refused with it too.
 """
 
 from __future__ import annotations
@@ -50,12 +55,13 @@ from rawehelix.solvers.discrete import RodDiscretisation
 
 
 class Fields:
-    """UFL views (r, alpha, r_t, alpha_t) of a formulation's state, and the
-    curvature field ``kappa`` of the mixed bending form (None: r'')."""
+    """UFL views (r, alpha, r_t, alpha_t) of a formulation's state, the
+    curvature field ``kappa`` of the mixed bending form (None: r'') and the
+    Bouc-Wen twist ``z`` of the hysteretic torsion (None: elastic)."""
 
-    def __init__(self, r, alpha, r_t, alpha_t, kappa=None):
+    def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
-        self.kappa = kappa
+        self.kappa, self.z = kappa, z
 
 
 def controller_torque(c: rod.Coefficients, q, fields: Fields, time, offset):
@@ -78,6 +84,7 @@ class _Formulation:
         self.bcs = bcs
         self._t_set = None  # (t, scene, moving end) of the data last set
         self.reuse = None  # a snes.ReusedJacobian: the Jacobian callbacks skip a fresh one
+        self.time_data = []  # more callables t -> None for set_time (a prescribed end twist)
 
     def _keep_jacobian(self, *shifts) -> bool:
         """True if the assembled Jacobian (and its LU) may serve again."""
@@ -126,6 +133,8 @@ class _Formulation:
         self.rod.c.mN.value = q.top_torque(t)  # (69)
         if self.moving_top:
             self._set_top(t)
+        for set_data in self.time_data:
+            set_data(t)
 
     def assemble_residual(self, x, b):
         with b.localForm() as b_local:
@@ -186,9 +195,10 @@ class SecondOrder(_Formulation):
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.shift_v = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
         self.shift_a = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
-        r, alpha, *kappa = ufl.split(self.u)  # kappa: the mixed bending form
+        r, alpha, *third = ufl.split(self.u)  # kappa (mixed bending) or z (hysteresis)
         r_t, alpha_t = ufl.split(self.v)[:2]
-        fields = Fields(r, alpha, r_t, alpha_t, kappa[0] if kappa else None)
+        fields = Fields(r, alpha, r_t, alpha_t, third[0] if rod_.mixed else None,
+                        third[0] if rod_.hysteretic else None)
         c_dyn = self._coefficients(fields)
         F = rod.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree, rod_.penalty,
                          rod_.measures)
@@ -243,6 +253,12 @@ class FirstOrder(_Formulation):
     second_order = False
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
+        if rod_.hysteretic:
+            raise SceneError(
+                rod_.params.name, "torsion_hysteresis",
+                "runs with the second-order integrator only (-rawehelix_ts_type alpha2, the "
+                "default): the first-order TS types are not set up for its internal twist z "
+                "(forms/hysteresis.py)")
         if rod_.mixed:
             raise SceneError(
                 rod_.params.name, "discretisation.bending",

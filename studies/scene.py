@@ -2,7 +2,7 @@
 
 A scene has the sections of :class:`rawehelix.parameters.Parameters`
 (``[helix]``, ``[ends]``, ``[environment]``, ``[torque]``, ``[controller]``,
-``[model]``, ``[damping]``, ``[discretisation]``, ``[time]``) and an optional top-level
+``[model]``, ``[damping]``, ``[torsion_hysteresis]``, ``[discretisation]``, ``[time]``) and an optional top-level
 ``title``.  ``studies/scenes/example.toml`` documents every key.
 
 Any problem raises :class:`SceneError`, whose message names the file, the key
@@ -19,14 +19,15 @@ from pathlib import Path
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
 from rawehelix.parameters import (Controller, Damping, Discretisation, Ends, Environment,
                                         Helix, Model, ParameterError, Parameters, Sweep,
-                                        Time, Torque)
+                                        Time, Torque, TorsionHysteresis)
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
     "controller": Controller, "model": Model, "discretisation": Discretisation,
     "time": Time, "sweep": Sweep, "damping": Damping,
+    "torsion_hysteresis": TorsionHysteresis,
 }
-NESTED = {"damping": "model"}  # sections held by another section's dataclass
+NESTED = {"damping": "model", "torsion_hysteresis": "model"}  # sections held by another section's dataclass
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"
@@ -83,7 +84,7 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
         if name_ not in data:
             raise SceneError(path, name_, f"the section [{name_}] is required")
     sections = {s: _section(path, s, data[s]) for s in SECTIONS if s in data}
-    for nested, holder in NESTED.items():  # [damping] -> Model.damping
+    for nested, holder in NESTED.items():  # [damping] -> Model.damping, ...
         if nested in sections:
             sections[holder] = dataclasses.replace(sections.get(holder, SECTIONS[holder]()),
                                                    **{nested: sections.pop(nested)})
