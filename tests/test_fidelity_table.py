@@ -19,7 +19,7 @@ def test_table_changes_costs_and_pending_rows():
         "simulate": {"paper": {"cpu_s": 2.0, "settling_time_s": 4.0,
                                "peak_ground_torque_Nm": 10.0, "max_spin_lag_rpm": 16.0,
                                "tension_range_N": [198.0, 203.0]},
-                     "damping": {"cpu_s": 3.0, "settling_time_s": None,
+                     "damping": {"cpu_s": 3.0, "paper_cpu_s": 1.0, "settling_time_s": None,
                                  "peak_ground_torque_Nm": 11.0, "max_spin_lag_rpm": 10.0,
                                  "tension_range_N": [198.5, 202.5]}},
         "orbits": {"paper": {"cpu_s": 10.0, "cpu_per_point_s": 1.0, "points": 10,
@@ -36,7 +36,7 @@ def test_table_changes_costs_and_pending_rows():
             for i, line in enumerate(table.splitlines()) if line.startswith("| damping")}
     modes, sim, orb = rows.values()
     assert "1.9000, 0.2500 (-5.00 %, +0.2500)" in modes and modes.endswith("x3.00 |")
-    assert "not settled" in sim and "11.000 (+10.00 %)" in sim and sim.endswith("x1.50 |")
+    assert "not settled" in sim and "11.000 (+10.00 %)" in sim and sim.endswith("x3.00 |")  # its own process's paper
     assert "| 10.000 | 198.50-202.50 |" in sim
     assert "none to 12.90 Hz" in orb and "12.9000 (window end) +0.300 Hz" in orb
     assert "420.0 (-25.00 %)" in orb and "1.50 s (x1.50)" in orb
