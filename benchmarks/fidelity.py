@@ -10,6 +10,10 @@ overrides, as ``--set`` takes them) it measures, through the public API only
 * ``simulate``: Sec. 5.2 (``nominal_operation``): the settling time into the
   2 % band (the summary's ``settling_time_s``, studies/metrics.py) and the
   peak |ground torque|;
+* ``sweep``: the same resonance by the paper's brute-force sweep
+  (``rh.sweep`` on SWEEP_F1, continued upward): where the upper branch
+  ends (the largest drop of T max) and its largest T max; the only
+  measurement of the options whose orbits fail;
 * ``orbits``: the Fig. 8 resonance (``mobile_end``): the branch from
   ``F1_START`` upward without superharmonic sites (as docs/orbits.md "Issue
   test 4"), stopped at the first point after the first fold; the fold's f1
@@ -19,7 +23,7 @@ overrides, as ``--set`` takes them) it measures, through the public API only
 and the cost of each as the CPU time (time.process_time) of the same part
 for the paper's model in the same process (orbits: CPU time per point).
 
-    .venv/bin/python benchmarks/fidelity.py run modes simulate orbits [--only NAME ...]
+    .venv/bin/python benchmarks/fidelity.py run modes simulate orbits sweep [--only NAME ...]
     .venv/bin/python benchmarks/fidelity.py table
 
 ``run`` stores each (part, option) in benchmarks/fidelity/<part>.json as it
@@ -78,8 +82,9 @@ def _hysteresis_law():
 #: options whose row stays "pending" until measured (the hysteresis: until its branch is in)
 PENDING = (HYSTERESIS,)
 
-PARTS = ("modes", "simulate", "orbits")
-ELEMENTS = {"modes": 16, "simulate": 16, "orbits": 4}
+PARTS = ("modes", "simulate", "orbits", "sweep")
+ELEMENTS = {"modes": 16, "simulate": 16, "orbits": 4, "sweep": 4}
+SWEEP_F1 = [round(11.5 + 0.1 * k, 1) for k in range(15)]  # Hz, the sweep's grid
 REPEATS = 3  # modes, simulate: the median CPU time of REPEATS runs after one that compiles
 F1_START = 11.5  # Hz, the start of docs/orbits.md's fold window
 F1_STOP = {"paper": 12.9, "extensible": 12.9, "damping": 12.9}  # else F1_STOP_WIDE
@@ -162,7 +167,25 @@ def orbits_row(name: str, overrides: dict, N: int) -> dict:
             "branch": result.branch}
 
 
-ROWS = {"modes": modes_row, "simulate": simulate_row, "orbits": orbits_row}
+def sweep_row(name: str, overrides: dict, N: int) -> dict:
+    """The paper's own Fig. 8 method: ``rh.sweep`` continued from one f1 of
+    SWEEP_F1 to the next (time integration to the periodic state); the upper
+    branch ends at the largest drop of T max."""
+    scene = rh.load_scene("mobile_end", elements=N, degree=3, overrides=overrides)
+    start = time.process_time()
+    result = rh.sweep(scene, SWEEP_F1)
+    cpu = time.process_time() - start
+    f1 = [p["f1_Hz"] for p in result.points]
+    tmax = [p["tension_max_N"] for p in result.points]
+    drop = min(range(len(f1) - 1), key=lambda i: tmax[i + 1] - tmax[i])
+    k = max(range(len(f1)), key=lambda i: tmax[i])
+    return {"elements": N, "cpu_s": cpu, "f1_Hz": f1, "tension_max_N": tmax,
+            "periodic": [bool(p["periodic"]) for p in result.points],
+            "jump_Hz": [f1[drop], f1[drop + 1]], "jump_N": [tmax[drop], tmax[drop + 1]],
+            "peak": {"f1_Hz": f1[k], "tension_max_N": tmax[k]}}
+
+
+ROWS = {"modes": modes_row, "simulate": simulate_row, "orbits": orbits_row, "sweep": sweep_row}
 
 
 def load(part: str) -> dict:
@@ -282,10 +305,18 @@ def _orbits_cells(name, row, ref):
             f"{row['cpu_per_point_s']:.2f} s ({_cost(row, ref, 'cpu_per_point_s')})"]
 
 
+def _sweep_cells(name, row, ref):
+    (a, b), (ta, tb), peak = row["jump_Hz"], row["jump_N"], row["peak"]
+    tc = f"{peak['tension_max_N']:.1f} ({peak['f1_Hz']:.1f})"
+    if name != "paper":
+        tc += f" {_pct(peak['tension_max_N'], ref['peak']['tension_max_N'])}"
+    return [f"{a:.1f}-{b:.1f} ({ta:.0f} -> {tb:.0f})", tc, _cost(row, ref)]
+
+
 def build_table(results: dict) -> str:
     """The markdown fidelity table from ``{part: {option: row}}`` (rows as
     :func:`run` stores them); options without a row say "pending"."""
-    modes, sim, orb = (results.get(part, {}) for part in PARTS)
+    modes, sim, orb, swp = (results.get(part, {}) for part in PARTS)
     ref = modes.get("paper")
     fams = [f for f in VIBRATIONS if ref and f in ref["first"]]
     head = ["option"] + [f"{FAMILY_LABELS[f]} 1: f [Hz], decay [1/s]" for f in fams] + ["CPU"]
@@ -300,6 +331,11 @@ def build_table(results: dict) -> str:
             f"{F1_START} Hz, to the first point after the first fold)", "",
             "| option | fold f1 [Hz] (T max [N]) | peak f1 [Hz] | peak T max [N] | points | "
             "CPU per point |", "|---|---|---|---|---|---|", *_lines(orb, 5, _orbits_cells)]
+    out += ["", f"**Fig. 8 by the paper's sweep** (`mobile_end`{_n(swp.get('paper'))}, "
+            f"`rh.sweep` at f1 = {SWEEP_F1[0]}, {SWEEP_F1[1]} .. {SWEEP_F1[-1]} Hz, continued "
+            "upward)", "", "| option | upper branch ends between [Hz] (T max [N]) | "
+            "largest T max [N] (at f1 [Hz]) | CPU |", "|---|---|---|---|",
+            *_lines(swp, 3, _sweep_cells)]
     return "\n".join(out)
 
 
