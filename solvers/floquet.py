@@ -27,6 +27,8 @@ import numpy as np
 
 from rawehelix.errors import SolverError
 
+BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
+
 
 @dataclasses.dataclass
 class Orbit:
@@ -85,7 +87,10 @@ class PeriodMap:
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
               steps: int | None = None) -> Orbit:
         """Newton on G(X) = P(X) - X - Delta e_alpha = 0 (chord: the monodromy is
-        refreshed when an iteration contracts |G| by less than 10x)."""
+        refreshed when an iteration contracts |G| by less than 10x), backtracking:
+        where |G| does not fall after a step (or the period map fails), a chord step
+        is redone from its start with a fresh monodromy and a Newton step is
+        halved, down to BACKTRACK_MIN of itself."""
         start = time.perf_counter()
         self.newton_iterations = 0
         X = X0.copy()
@@ -94,12 +99,32 @@ class PeriodMap:
         e = self.e_alpha
         delta = self.rotation(f1_Hz) if self.controller else 0.0
         mono, last, its = None, np.inf, 0
+        back = None  # (X, delta, step, fraction) of the last Newton step, for backtracking
         for its in range(1, max_it + 1):
             need = mono is None
-            G, _, Phi = self.shooting_residual(X, f1_Hz, delta, tangent=need, steps=steps)
+            try:
+                G, _, Phi = self.shooting_residual(X, f1_Hz, delta, tangent=need, steps=steps)
+                res = np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
+            except SolverError:  # the step's Newton failed from this X
+                G, res = None, np.inf
+            if back is not None and not res < last:  # no descent
+                X0_, d0, step, frac, fresh = back
+                if not fresh:  # the chord's monodromy was stale: Newton from there
+                    X, delta, mono, back, last = X0_, d0, None, None, np.inf
+                    continue
+                if frac < BACKTRACK_MIN:  # half the Newton step, down to this
+                    raise SolverError(f"orbits: shooting at f1 = {f1_Hz} Hz found no descent "
+                                      f"along its Newton step (|G|/|X| = {last:.3g}); start "
+                                      f"nearer the orbit (a lower f1, or more lead-in periods)")
+                frac /= 2
+                X, delta = X0_ - frac * step[:-1], d0 - frac * step[-1]
+                back = (X0_, d0, step, frac, fresh)
+                continue
+            if G is None:
+                raise SolverError(f"orbits: the period map failed from the shooting's "
+                                  f"start at f1 = {f1_Hz} Hz")
             if need:
                 mono = Phi
-            res = np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
             if res <= tol:
                 break
             A = mono - np.eye(X.size)
@@ -107,12 +132,13 @@ class PeriodMap:
                 mono = None  # slow: a fresh monodromy at the next iteration
             last = res
             if self.controller:
-                X = X - np.linalg.solve(A, G)
+                step = np.append(np.linalg.solve(A, G), 0.0)
             else:  # unknowns (X, Delta); phase: e . (X - X_prev) = 0.  Without torque
                 # the spin is free too (a family of orbits): the least-squares step
                 K = np.block([[A, -e[:, None]], [e[None, :], np.zeros((1, 1))]])
                 step = np.linalg.lstsq(K, np.concatenate([G, [0.0]]), rcond=None)[0]
-                X, delta = X - step[:-1], delta - step[-1]
+            back = (X, delta, step, 1.0, need)
+            X, delta = X - step[:-1], delta - step[-1]
         else:
             raise SolverError(f"orbits: shooting did not converge at f1 = {f1_Hz} Hz in "
                               f"{max_it} iterations (|G|/|X| = {res:.3g} > {tol:g})")

@@ -101,6 +101,11 @@ class AlphaMap(PeriodMap):
         if comm.size > 1:
             raise SolverError("orbits: the shooting solver runs on one rank (dense monodromy); "
                               "run separate frequency windows on separate ranks")
+        if params.model.torsion_hysteresis.active:
+            raise SolverError("orbits: hysteretic torsion ([torsion_hysteresis]) is not "
+                              "supported: the shooting does not converge with its internal "
+                              "variable in the state (|G|/|X| stays near 0.5 from the lead-in "
+                              "at 11.5 Hz, N = 4); use 'rawehelix sweep' for its Fig. 8")
         self.params = params
         # solver: a DynamicsSolver of params to share (the chord stepper's backend)
         self.solver = solver or DynamicsSolver.from_stationary(params, comm)
