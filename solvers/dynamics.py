@@ -450,7 +450,14 @@ class DynamicsSolver:
             f"{reason_name(snes.getConvergedReason())}, time step {self.q.time_s(self.ts.getTimeStep()):.3g} s. "
             f"Try a smaller first step (time.dt_s), more retries "
             f"(-{PREFIX}ts_max_snes_failures 20), adaptive steps (-{PREFIX}ts_adapt_type basic), "
-            f"more Newton iterations (-{PREFIX}ts_snes_max_it 30) or more elements.")
+            f"more Newton iterations (-{PREFIX}ts_snes_max_it 30) or more elements."
+            + law_hint(self.params))
+
+
+def law_hint(params) -> str:
+    """The EI law's convexity limit, for a failure message ('' without a law)."""
+    law = params.helix.EI_law
+    return law.failure_hint(params.helix.EA_N) if law is not None else ""
 
     # -- fields ---------------------------------------------------------------------
     def state_arrays(self) -> dict | None:

@@ -71,7 +71,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat
 from rawehelix.parameters import Parameters
-from rawehelix.solvers.dynamics import DynamicsSolver
+from rawehelix.solvers.dynamics import DynamicsSolver, law_hint
 from rawehelix.solvers.floquet import Orbit, PeriodMap  # noqa: F401  (Orbit re-exported)
 from rawehelix.solvers.snes import SolverError
 
@@ -478,7 +478,13 @@ class AlphaMap(PeriodMap):
         trajectory = [X]  # X_k, then each step's stage value and X_{k+1}
         for k in range(M):
             z = self.predict(history, X[:n], X[n:2 * n], X[2 * n:], h)
-            X, Phi = self.step(k * h, h, X, Phi, z)
+            try:
+                X, Phi = self.step(k * h, h, X, Phi, z)
+            except SolverError as err:
+                hint = law_hint(self.params)
+                if not hint:
+                    raise
+                raise SolverError(str(err) + hint) from err
             history = [self.stage] + history[:self.order]
             if not np.all(np.isfinite(X)):
                 raise SolverError(f"orbits: the state became NaN or Inf at f1 = {f1_Hz} Hz")

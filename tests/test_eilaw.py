@@ -329,3 +329,20 @@ def test_bending_damping_uses_the_local_EI():
                     assert decay == pytest.approx(expected, rel=1e-2), (n, decay, expected)
                 elif n == 1:
                     assert decay / expected - 1 > 2e-2, (n, decay, expected)
+
+
+def test_a_failed_period_with_the_law_names_its_convexity_limit():
+    """The Sec. 5.3 helix driven with the identified law (labtest bending --fit) has
+    no stable state (the energy's convexity is lost at kappa ~ 0.01 1/m): the
+    period map's step fails, and its message says why instead of only asking for
+    a smaller step."""
+    import rawehelix as rh
+    from rawehelix.solvers.orbits import AlphaMap
+    from rawehelix.solvers.snes import SolverError
+
+    p = rh.load_scene("mobile_end", elements=4).replace(
+        model={"kinematics": "extensible"},
+        helix={"EI_law": {"a_Nm2_per_N": 34.88, "b_Nm2": 2303.0}})
+    m = AlphaMap(p)
+    with pytest.raises(SolverError, match="convex only while the curvature"):
+        m.period(m.X_stationary, 11.5)
