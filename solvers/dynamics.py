@@ -454,11 +454,6 @@ class DynamicsSolver:
             + law_hint(self.params))
 
 
-def law_hint(params) -> str:
-    """The EI law's convexity limit, for a failure message ('' without a law)."""
-    law = params.helix.EI_law
-    return law.failure_hint(params.helix.EA_N) if law is not None else ""
-
     # -- fields ---------------------------------------------------------------------
     def state_arrays(self) -> dict | None:
         """The current state along s (normalised), on rank 0 (None elsewhere)."""
@@ -496,4 +491,7 @@ def law_hint(params) -> str:
         return out
 
 
-
+def law_hint(params) -> str:
+    """The EI law's convexity limit, for a failure message ('' without a law)."""
+    law = params.helix.EI_law
+    return law.failure_hint(params.helix.EA_N) if law is not None else ""
