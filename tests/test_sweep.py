@@ -126,7 +126,8 @@ def test_chunks_are_contiguous_and_balanced(k):
         assert max(map(cost, parts)) < 0.9 * max(map(cost, even))
 
 
-@pytest.mark.slow  # 79 s
+@pytest.mark.slow
+@pytest.mark.long  # 177 s on a fresh clone (make test-long)
 def test_resonance_of_the_paper_at_n2(tmp_path):
     """Fig. 8 at N = 2: flat up to ~8 Hz, a rise above about 9 Hz, peak (> 900 N)
     near 13 Hz, collapse above."""
