@@ -127,7 +127,6 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
                          superharmonics=superharmonics)
 
 
-
 def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=None,
             fit: bool = False, rod_EI_Nm2: float | None = None, elements: int | None = None,
             degree: int | None = None, gravity: bool = True, comm=None):

@@ -452,14 +452,15 @@ def superharmonic_between(site: Site, points) -> dict | None:
     if not (d[1] < d[0] and d[1] <= d[2]):
         return None
     f = np.array([z.f1_Hz, a.f1_Hz, b.f1_Hz])
-    c2, c1, c0 = np.polyfit(f - f[1], d**2, 2)
+    parabola = np.polyfit(f - f[1], d**2, 2)
+    c2, c1 = parabola[:2]
     fv = f[1] - c1 / (2 * c2) if c2 > 0 else f[1]
     if not min(f) <= fv <= max(f):
         fv = f[1]
     at = lambda values: float(np.polyval(np.polyfit(f - f[1], values, 2), fv - f[1]))  # noqa: E731
     return {"f1_Hz": float(fv), "kind": "superharmonic", "order": site.k,
             "f_n_Hz": site.f_n_Hz,
-            "distance": float(np.sqrt(max(at(d**2), 0.0))),
+            "distance": float(np.sqrt(max(np.polyval(parabola, fv - f[1]), 0.0))),
             "tension_max_N": at([o.tension_max_N for o in (z, a, b)]),
             "oscillation_N": at([o.tension_max_N - o.tension_min_N for o in (z, a, b)]),
             "multiplier": [mus[1].real, mus[1].imag], "bracket_Hz": [z.f1_Hz, b.f1_Hz]}

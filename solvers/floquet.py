@@ -99,7 +99,7 @@ class PeriodMap:
         e = self.e_alpha
         delta = self.rotation(f1_Hz) if self.controller else 0.0
         mono, last, its = None, np.inf, 0
-        back = None  # (X, delta, step, fraction) of the last Newton step, for backtracking
+        back = None  # (X, delta, step, fraction, fresh monodromy) of the last step taken
         for its in range(1, max_it + 1):
             need = mono is None
             try:

@@ -220,20 +220,20 @@ def period_map(params: Parameters):
     return AlphaMap(params, comm=MPI.COMM_SELF)
 
 
-def driven_frequencies(params: Parameters, f_max_Hz: float) -> list[float]:
+def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> list[float]:
     """The lateral natural frequencies [Hz] up to f_max of the scene's linearisation
-    about its stationary state, in its scheme, on this rank."""
+    about its stationary state, in its scheme, on this rank (``m``: the scene's
+    period map, whose stationary state the spline scheme linearises about)."""
     from rawehelix.families import LATERAL
     if params.discretisation.scheme == "spline":
         from rawehelix.solvers.spline_galerkin import spectrum
-        m = period_map(params)
-        q = m.q_base
-        return sorted(abs(x.eigenvalue.imag) / (2 * np.pi * q.t_scale)
-                      for x in spectrum.modes(m.system, m.embed(m.X_stationary))
-                      if x.family in LATERAL
-                      and abs(x.eigenvalue.imag) / (2 * np.pi * q.t_scale) <= f_max_Hz)
+        to_Hz = 1.0 / (2 * np.pi * m.q_base.t_scale)
+        f = [abs(x.eigenvalue.imag) * to_Hz
+             for x in spectrum.modes(m.system, m.embed(m.X_stationary)) if x.family in LATERAL]
+        return sorted(x for x in f if x <= f_max_Hz)
     from rawehelix.solvers.response import HarmonicResponse
     from rawehelix.studies.response import natural_modes
+    # the FE linearisation about the circle's centre (R1 = 0), as `rawehelix response`
     solver = HarmonicResponse.from_stationary(params, MPI.COMM_SELF, scene=params.name)
     return [x["frequency_Hz"] for x in natural_modes(solver, f_max_Hz, margin=1.0)
             if x["family"] in LATERAL]
@@ -246,9 +246,9 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
     start_f1, stop_f1 = window
     lo, hi = sorted(window)
-    sites = (sites_for(driven_frequencies(params, max(superharmonics) * hi), lo, hi,
-                       superharmonics) if superharmonics else ())
     m = period_map(params)
+    sites = (sites_for(driven_frequencies(params, m, max(superharmonics) * hi), lo, hi,
+                       superharmonics) if superharmonics else ())
     branch = Branch(m, tension_step=tension_step, sites=sites)
     stored = store.load() if store else None
     if stored:
