@@ -188,20 +188,12 @@ class WindowStore:
 
 def open_directory(outdir: Path, header: dict, comm):
     """Refuse a directory that holds another branch, then write its header (collective)."""
-    error = None
-    if comm.rank == 0:
-        path = Path(outdir) / HEADER
-        if path.exists():
-            old = json.loads(path.read_text())
-            if old != header:
-                error = (f"{path}: holds another branch (scene {old.get('scene')!r}, "
-                         f"f1 windows {old.get('windows')}, tension_step "
-                         f"{old.get('tension_step')}); use another -o directory or delete it")
-        else:
-            writers.write_json(path, header)
-    error = comm.bcast(error, root=0)
-    if error:
-        raise OrbitsStoreError(error)
+    old = writers.claim_directory(Path(outdir) / HEADER, header, comm)
+    if old is not None:
+        raise OrbitsStoreError(f"{Path(outdir) / HEADER}: holds another branch (scene "
+                               f"{old.get('scene')!r}, f1 windows {old.get('windows')}, "
+                               f"tension_step {old.get('tension_step')}); use another -o "
+                               f"directory or delete it")
 
 
 def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[float]]:

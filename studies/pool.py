@@ -53,18 +53,13 @@ class Store:
 
     def open(self, comm):
         """Refuse a directory that holds another study, then create it (collective)."""
-        error = None
-        if comm.rank == 0:
-            path = self.outdir / HEADER
-            if path.exists() and json.loads(path.read_text()) != writers._jsonable(self.header):
-                error = (f"holds another study ({path} differs: scene, discretisation, keys, "
-                         f"sample or quantities); use another -o directory or delete it")
-            else:
-                self.points.mkdir(parents=True, exist_ok=True)
-                writers.write_json(path, self.header)
-        error = comm.bcast(error, root=0)
-        if error:
-            raise SceneError("-o", str(self.outdir), error)
+        path = self.outdir / HEADER
+        if writers.claim_directory(path, self.header, comm) is not None:
+            raise SceneError("-o", str(self.outdir),
+                             f"holds another study ({path} differs: scene, discretisation, keys, "
+                             f"sample or quantities); use another -o directory or delete it")
+        if comm.rank == 0:  # (a point's record makes its directory too: write_json)
+            self.points.mkdir(parents=True, exist_ok=True)
         return self
 
     def finished(self, task_id: str) -> dict | None:

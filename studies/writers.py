@@ -51,6 +51,22 @@ def write_json(path: Path, data: dict) -> Path:
     return write_text(path, json.dumps(_jsonable(data), indent=2) + "\n")
 
 
+def claim_directory(path: Path, header: dict, comm) -> dict | None:
+    """A run's header file ``path``: written on rank 0 if absent; if it holds
+    another header, that one is returned on every rank (the caller refuses the
+    directory), else None.  Collective."""
+    old = None
+    if comm.rank == 0:
+        path = Path(path)
+        if path.exists():
+            stored = json.loads(path.read_text())
+            if stored != _jsonable(header):
+                old = stored
+        else:
+            write_json(path, header)
+    return comm.bcast(old, root=0)
+
+
 def summary_and_figure(outdir, rank: int, summary: dict, figure) -> Path:
     """On rank 0: ``outdir``/summary.json and ``figure(outdir)`` (a callable that
     writes the study's figure there); other ranks write nothing.  ``outdir``."""
