@@ -27,6 +27,7 @@ test: install
 
 test-long: install
 	$(PY) -m pytest -q -m long $(PYTEST_ARGS)
+	$(MPIRUN) $(PY) -m pytest -q -m "mpi and long" -p no:cacheprovider $(PYTEST_ARGS)
 
 test-debian13:
 	@bash scripts/test-debian13.sh

@@ -146,7 +146,8 @@ def test_resonance_of_the_paper_at_n2(tmp_path):
 
 
 @pytest.mark.mpi
-@pytest.mark.slow  # 88 s
+@pytest.mark.slow
+@pytest.mark.long  # 170-300 s under mpirun since the periodicity test judges the oscillation
 def test_two_ranks_match_one(tmp_path_factory):
     """Chunks on 2 ranks give the points of 1 rank to the periodicity tolerance
     (the second chunk starts from the stationary state with a lead-in instead of
