@@ -374,6 +374,17 @@ def report(result: OrbitsResult) -> str:
     lines.append(f"  largest Floquet multiplier modulus: "
                  f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
                  f"{len(unstable)}")
+    defects = [p["defects"] for p in s["branch"] if "defects" in p]
+    if defects:  # carried entries (hysteretic torsion: z, solvers/floquet.py)
+        internal = [p["internal_multipliers"] for p in s["branch"]
+                    if p.get("internal_multipliers", {}).get("count")]
+        lines.append("  carried along by the shooting (hysteretic torsion's z): largest drift of "
+                     "z over a period " + f"{max(d.get('z', 0.0) for d in defects):.2g}" +
+                     " of z, largest residual after it " +
+                     f"{max(d.get('carried', 0.0) for d in defects):.2g}" +
+                     (f"; z's multipliers (set aside from the stability) within "
+                      f"{max(i['max_distance_to_1'] for i in internal):.1g} of 1"
+                      if internal else ""))
     for kind, items in (("fold", s["folds"]), ("bifurcation", s["bifurcations"]),
                         ("peak", s["peaks"])):
         for x in items:
