@@ -383,7 +383,7 @@ def report(result: OrbitsResult) -> str:
                      " of z, largest residual after it " +
                      f"{max(d.get('carried', 0.0) for d in defects):.2g}" +
                      (f"; z's multipliers (set aside from the stability) within "
-                      f"{max(i['max_distance_to_1'] for i in internal):.1g} of 1"
+                      f"{max(i.get('max_distance_to_1', 0.0) for i in internal):.1g} of 1"
                       if internal else ""))
     for kind, items in (("fold", s["folds"]), ("bifurcation", s["bifurcations"]),
                         ("peak", s["peaks"])):
