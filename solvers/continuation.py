@@ -62,6 +62,7 @@ import time
 import numpy as np
 import scipy.linalg
 
+from rawehelix.solvers import floquet
 from rawehelix.solvers.floquet import Orbit, PeriodMap
 from rawehelix.solvers.snes import SolverError
 
@@ -218,14 +219,16 @@ class Branch:
         return self.m.shooting_residual(X, f1, self.m.rotation(f1), tangent=tangent, steps=steps)
 
     def _G_f1(self, X, f1, steps, eps=1e-5):
-        return (self._G(X, f1 + eps, steps)[0] - self._G(X, f1 - eps, steps)[0]) / (2 * eps)
+        gf = (self._G(X, f1 + eps, steps)[0] - self._G(X, f1 - eps, steps)[0]) / (2 * eps)
+        gf[floquet.carried_of(self.m)] = 0.0  # carried entries (floquet.py): not on the tangent
+        return gf
 
     def _bordered(self, A, gf, tau):
         """[[M - I, G_f1], [(w^2 tau)^T]]: the corrector's and the tangent's matrix."""
         return np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
 
     def _tangent(self, orbit: Orbit, tau_prev, steps):
-        A = orbit.monodromy - np.eye(orbit.X.size)
+        A = floquet.newton_matrix(orbit.monodromy, floquet.carried_of(self.m))
         gf = self._G_f1(orbit.X, orbit.f1_Hz, steps)
         K = self._bordered(A, gf, tau_prev)
         rhs = np.zeros(K.shape[0])
@@ -248,13 +251,14 @@ class Branch:
             slow = lu is not None and res > 0.1 * last  # the chord is too far off
             G, tension, Phi = self._G(X, f1, steps, tangent=slow)
             if slow:  # Newton: the monodromy and G_f1 here
-                A, gf = Phi - np.eye(n), self._G_f1(X, f1, steps)
+                A = floquet.newton_matrix(Phi, floquet.carried_of(self.m))
+                gf = self._G_f1(X, f1, steps)
                 K, lu = self._bordered(A, gf, tau), None
-            last, res = res, np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
+            last, res = res, floquet.shooting_norm(G, X, floquet.carried_of(self.m))
             log.debug("corrector %d: f1 = %.6f Hz, |G|/|X| = %.3g, ds %.3g%s", its, f1, res,
                       ds, " (fresh monodromy)" if slow else "")
             if res <= self.tol:
-                return X, f1, its, res, tension
+                return floquet.settle(X, G, floquet.carried_of(self.m)), f1, its, res, tension
             if lu is None:
                 lu = scipy.linalg.lu_factor(K)
             r = np.concatenate([G, [(self.w**2 * tau) @ (Y - Y0) - ds]])

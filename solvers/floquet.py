@@ -15,6 +15,26 @@ Here, with Delta the rotation per period:
 
     G(X) = P(X) - X - Delta e_alpha = 0                          (shooting)
 
+Carried entries (``carried``, empty by default).  A scheme may name entries
+of its state that the Newton does not solve for but carries along: the
+hysteretic torsion's internal twist z and the generalised-alpha scheme's
+rate and acceleration of it (V_z, A_z) in
+:class:`rawehelix.solvers.orbits.AlphaMap`.  At an orbit z hardly moves (the
+twist's travel per period is tiny), so its multipliers are 1 - O(beta
+travel): M - I is nearly singular in z, and z's Newton correction, G_z / (1
+- mu), overshoots the kinks of the law (|dtau|, |z|); V_z and A_z ring
+after every reversal of the twist rate, so that P's values of them are not
+smooth in X either.  The Newton matrix has the carried entries' rows of the
+monodromy set to zero (:meth:`PeriodMap.newton_matrix`): its step sets them
+to P's (substitution, X_c <- P_c(X)) and solves the other entries with the
+change of X_c included (their columns are kept); the residual measured
+(:meth:`PeriodMap.shooting_norm`) is that of the other entries; the orbit's
+carried entries are P's at the converged X.  :meth:`PeriodMap.finish`
+measures what remains (``Orbit.defects``, :meth:`PeriodMap.defects`) and
+refuses the orbit where a defect exceeds its entry of ``defect_tolerances``.
+Multipliers that belong to the carried variables (:meth:`PeriodMap.set_aside`)
+are reported apart (``Orbit.internal_multipliers``), not in the stability.
+
 No FE code (numpy only), so that the spline reference stays free of it.
 """
 
@@ -28,6 +48,37 @@ import numpy as np
 from rawehelix.errors import SolverError
 
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
+
+
+def carried_of(period_map) -> np.ndarray:
+    """The map's carried entries (none for a map without the attribute)."""
+    return getattr(period_map, "carried", PeriodMap.carried)
+
+
+def newton_matrix(Phi, carried):
+    """M - I, the carried entries' rows of the monodromy M set to zero."""
+    if carried.size:
+        Phi = Phi.copy()
+        Phi[carried, :] = 0.0
+    return Phi - np.eye(Phi.shape[0])
+
+
+def shooting_norm(G, X, carried) -> float:
+    """|G| / max(1, |X|) over the entries the Newton solves for."""
+    if carried.size:
+        keep = np.ones(X.size, dtype=bool)
+        keep[carried] = False
+        G, X = G[keep], X[keep]
+    return np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
+
+
+def settle(X, G, carried):
+    """X with its carried entries replaced by P's, X_c + G_c (G at X)."""
+    if not carried.size:
+        return X
+    X = X.copy()
+    X[carried] += G[carried]
+    return X
 
 
 @dataclasses.dataclass
@@ -47,6 +98,10 @@ class Orbit:
     wall_s: float
     monodromy: np.ndarray | None = dataclasses.field(default=None, repr=False)  # dP/dX at X
     symmetry_multiplier: complex | None = None  # the free rotation's pair (no controller)
+    #: the scheme's periodicity defects at the orbit (``PeriodMap.defects``; {}: none)
+    defects: dict = dataclasses.field(default_factory=dict)
+    #: multipliers of the carried variables, set aside (``PeriodMap.set_aside``; None: none)
+    internal_multipliers: np.ndarray | None = dataclasses.field(default=None, repr=False)
 
     @property
     def max_multiplier(self) -> float:
@@ -57,15 +112,60 @@ class Orbit:
         return self.max_multiplier < 1.0
 
     def entry(self) -> dict:
-        return {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
-                "tension_min_N": self.tension_min_N, "stable": self.stable,
-                "max_multiplier": self.max_multiplier,
-                "newton_iterations": self.newton_iterations, "residual": self.residual,
-                "steps_per_period": self.steps, "wall_s": self.wall_s}
+        out = {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
+               "tension_min_N": self.tension_min_N, "stable": self.stable,
+               "max_multiplier": self.max_multiplier,
+               "newton_iterations": self.newton_iterations, "residual": self.residual,
+               "steps_per_period": self.steps, "wall_s": self.wall_s}
+        if self.defects:
+            out["defects"] = dict(self.defects)
+        if self.internal_multipliers is not None:
+            mu = self.internal_multipliers
+            out["internal_multipliers"] = {
+                "count": int(mu.size),
+                "max_modulus": float(np.abs(mu).max()) if mu.size else None,
+                "max_distance_to_1": float(np.abs(mu - 1.0).max()) if mu.size else None}
+        return out
 
 
 class PeriodMap:
     """Shooting on a scheme's period map (see the module's docstring)."""
+
+    #: entries of X the Newton does not solve for (module docstring, "Carried entries")
+    carried = np.zeros(0, dtype=int)
+
+    def newton_matrix(self, Phi):
+        return newton_matrix(Phi, self.carried)
+
+    def shooting_norm(self, G, X) -> float:
+        return shooting_norm(G, X, self.carried)
+
+    def settle(self, X, G):
+        return settle(X, G, self.carried)
+
+    #: the largest defect allowed at an orbit, by name (:meth:`defects`)
+    defect_tolerances: dict = {}
+
+    def defects(self, G, X, Phi) -> dict:
+        """The periodicity defects at X (G = P(X) - X - Delta e_alpha, Phi = dP/dX):
+        here, with carried entries, "carried": the shooting's residual
+        (:meth:`shooting_norm`) at the orbit, whose carried entries are P's of the
+        last Newton period: what substituting them left in the solved entries."""
+        if not self.carried.size:
+            return {}
+        return {"carried": float(self.shooting_norm(G, X))}
+
+    def defect_meaning(self, name: str) -> str:
+        """What a defect of :meth:`defects` measures (the refusal's message)."""
+        return {"carried": "with the carried entries set to P's, the solved entries are no "
+                           "longer periodic within the tolerance"}.get(name, name)
+
+    def set_aside(self, mu, vectors):
+        """A boolean mask of the multipliers (eigenvectors: columns of ``vectors``)
+        that belong to the carried variables, or None (none; eigenvectors not needed)."""
+        return None
+
+    needs_vectors = False  # set_aside reads the eigenvectors
 
     def period(self, X, f1_Hz: float, tangent: bool = False, steps: int | None = None,
                on_step=None):
@@ -104,7 +204,7 @@ class PeriodMap:
             need = mono is None
             try:
                 G, _, Phi = self.shooting_residual(X, f1_Hz, delta, tangent=need, steps=steps)
-                res = np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
+                res = self.shooting_norm(G, X)
             except SolverError:  # the step's Newton failed from this X
                 G, res = None, np.inf
             if back is not None and not res < last:  # no descent
@@ -126,8 +226,9 @@ class PeriodMap:
             if need:
                 mono = Phi
             if res <= tol:
+                X = self.settle(X, G)
                 break
-            A = mono - np.eye(X.size)
+            A = self.newton_matrix(mono)
             if res > 0.1 * last and not need:
                 mono = None  # slow: a fresh monodromy at the next iteration
             last = res
@@ -147,8 +248,24 @@ class PeriodMap:
     def finish(self, X, f1_Hz, delta, its, res, start, steps=None) -> Orbit:
         """The orbit through X: one more period with the tangent gives the
         Floquet multipliers at the orbit itself, and the tension over it."""
-        _, tension, Phi = self.period(X, f1_Hz, tangent=True, steps=steps)
-        mu = np.linalg.eigvals(Phi)
+        PX, tension, Phi = self.period(X, f1_Hz, tangent=True, steps=steps)
+        defects = self.defects(PX - X - delta * self.e_alpha, X, Phi)
+        for name, value in defects.items():
+            limit = self.defect_tolerances.get(name)
+            if limit is not None and not value <= limit:
+                raise SolverError(
+                    f"orbits: at f1 = {f1_Hz} Hz the orbit's {name} defect is "
+                    f"{value:.3g} > {limit:g}: {self.defect_meaning(name)} (docs/orbits.md, "
+                    f"'carried entries')")
+        internal = None
+        if self.needs_vectors:
+            mu, vectors = np.linalg.eig(Phi)
+            aside = self.set_aside(mu, vectors)
+            internal = mu[aside]
+            internal = internal[np.argsort(-np.abs(internal))]
+            mu = mu[~aside]
+        else:
+            mu = np.linalg.eigvals(Phi)
         symmetry = None
         if not self.controller:
             # the free rotation alpha -> alpha + c and the uniform spin that drives it
@@ -163,5 +280,6 @@ class PeriodMap:
                       tension_min_N=float(T.min()), multipliers=mu, newton_iterations=its,
                       residual=float(res), steps=steps or self.steps_per_period(f1_Hz),
                       wall_s=time.perf_counter() - start, monodromy=Phi,
-                      symmetry_multiplier=symmetry)
+                      symmetry_multiplier=symmetry, defects=defects,
+                      internal_multipliers=internal)
         return orbit

@@ -82,6 +82,10 @@ ROUNDOFF = 1e-14  # |dz| / max(1, |z|) at which an iterate is round-off, not a c
 #: weights of the newest-first stage values in the extrapolation of order k
 EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0), 3: (4.0, -6.0, 4.0, -1.0)}
 STALL = 100.0  # |dz| within STALL round-offs that stops contracting: at R's floor
+#: hysteretic torsion (floquet.py, "Carried entries"): the largest residual of the solved
+#: entries once the carried ones are P's (10 x the shooting's tol), the largest drift of
+#: z over a period relative to z, and the distance to 1 of a multiplier of z
+CARRIED_TOL, Z_TOL, Z_MULTIPLIER = 1e-6, 1e-6, 1e-3
 NEWTON = ("chord", "full")  # the steps' Newton: chord (held LU), or full (the reference)
 
 
@@ -101,11 +105,6 @@ class AlphaMap(PeriodMap):
         if comm.size > 1:
             raise SolverError("orbits: the shooting solver runs on one rank (dense monodromy); "
                               "run separate frequency windows on separate ranks")
-        if params.model.torsion_hysteresis.active:
-            raise SolverError("orbits: hysteretic torsion ([torsion_hysteresis]) is not "
-                              "supported: the shooting does not converge with its internal "
-                              "variable in the state (|G|/|X| stays near 0.5 from the lead-in "
-                              "at 11.5 Hz, N = 4); use 'rawehelix sweep' for its Fig. 8")
         self.params = params
         # solver: a DynamicsSolver of params to share (the chord stepper's backend)
         self.solver = solver or DynamicsSolver.from_stationary(params, comm)
@@ -131,6 +130,11 @@ class AlphaMap(PeriodMap):
         _, alpha_dofs = compat.collapse(self.solver.rod.W.sub(1))
         self.e_alpha = np.zeros(3 * n)
         self.e_alpha[np.asarray(alpha_dofs)] = 1.0  # a uniform twist of U
+        self.z_dofs = np.zeros(0, dtype=int)
+        if params.model.torsion_hysteresis.active:  # z and its V and A: carried (floquet.py)
+            _, z_dofs = compat.collapse(self.solver.rod.W.sub(2))
+            self.z_dofs = np.asarray(z_dofs, dtype=int)
+            self.carried = np.concatenate([self.z_dofs, n + self.z_dofs, 2 * n + self.z_dofs])
         self.controller = self.q_base.k1 != 0.0
         self.floor = self.solver.residual_floor()
         self.newton_iterations = 0  # of the steps, since the last orbit() began
@@ -151,6 +155,39 @@ class AlphaMap(PeriodMap):
         self.offset = stationary.offset
         w_t = stationary.w_t if stationary.w_t is not None else np.zeros(n)
         self.X_stationary = np.concatenate([stationary.w, w_t, np.zeros(n)])
+
+    #: the defects allowed at an orbit (floquet.py, "Carried entries"; docs/orbits.md)
+    defect_tolerances = {"carried": CARRIED_TOL, "z": Z_TOL}
+
+    def defects(self, G, X, Phi) -> dict:
+        """floquet's carried defect and, with the hysteretic torsion, z's own:
+        |G_z| / max(1, |z|), z's drift over one period relative to z."""
+        out = super().defects(G, X, Phi)
+        if self.z_dofs.size:
+            z = self.z_dofs
+            out["z"] = float(np.linalg.norm(G[z]) / max(1.0, np.linalg.norm(X[z])))
+        return out
+
+    def defect_meaning(self, name: str) -> str:
+        if name == "z":
+            return ("the hysteretic torsion's internal twist z still drifts over a period "
+                    "with the rod periodic (its multipliers are 1 - O(beta x twist travel), "
+                    "so the shooting carries z instead of solving for it); more lead-in "
+                    "periods, or 'rawehelix sweep'")
+        return super().defect_meaning(name)
+
+    @property
+    def needs_vectors(self) -> bool:
+        return bool(self.z_dofs.size)
+
+    def set_aside(self, mu, vectors):
+        """z's multipliers: real within Z_MULTIPLIER of 1, their eigenvector mostly
+        z in U (|v_z| > |v_U| / 2); 1 - mu ~ beta x the twist's travel per period,
+        how much of a change of z a period forgets (docs/orbits.md)."""
+        U = vectors[:self.n]
+        share = np.linalg.norm(U[self.z_dofs], axis=0) / np.maximum(
+            np.linalg.norm(U, axis=0), 1e-300)
+        return (np.abs(mu - 1.0) <= Z_MULTIPLIER) & (share > 0.5)
 
     # -- the scheme -----------------------------------------------------------------
     @property

@@ -147,6 +147,9 @@ class WindowStore:
         k = len(list(self.dir.glob("p*.json")))
         record = {"entry": orbit.entry(), "delta": orbit.delta, "events": events,
                   "multipliers": [[float(m.real), float(m.imag)] for m in orbit.multipliers]}
+        if orbit.internal_multipliers is not None:  # the carried variables' (floquet.py)
+            record["internal_multipliers"] = [[float(m.real), float(m.imag)]
+                                              for m in orbit.internal_multipliers]
         writers.write_npz(self.dir / f"p{k:04d}.npz", {"X": orbit.X})
         writers.write_json(self.dir / f"p{k:04d}.json", record)
         writers.write_npz(self.dir / "state.npz", {**state.arrays(), "index": np.array(k)})
@@ -172,11 +175,15 @@ class WindowStore:
                 X = data["X"]
             e = record["entry"]
             mu = np.array([complex(re, im) for re, im in record["multipliers"]])
+            internal = record.get("internal_multipliers")
+            if internal is not None:
+                internal = np.array([complex(re, im) for re, im in internal])
             orbits.append(Orbit(f1_Hz=e["f1_Hz"], X=X, delta=record["delta"],
                                 tension_max_N=e["tension_max_N"], tension_min_N=e["tension_min_N"],
                                 multipliers=mu, newton_iterations=e["newton_iterations"],
                                 residual=e["residual"], steps=e["steps_per_period"],
-                                wall_s=e["wall_s"]))
+                                wall_s=e["wall_s"], defects=e.get("defects", {}),
+                                internal_multipliers=internal))
             for ev in record["events"]:
                 kind = "peak" if ev["kind"] == "superharmonic" else ev["kind"]
                 events.get(kind, events["bifurcation"]).append(ev)
@@ -367,6 +374,17 @@ def report(result: OrbitsResult) -> str:
     lines.append(f"  largest Floquet multiplier modulus: "
                  f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
                  f"{len(unstable)}")
+    defects = [p["defects"] for p in s["branch"] if "defects" in p]
+    if defects:  # carried entries (hysteretic torsion: z, solvers/floquet.py)
+        internal = [p["internal_multipliers"] for p in s["branch"]
+                    if p.get("internal_multipliers", {}).get("count")]
+        lines.append("  carried along by the shooting (hysteretic torsion's z): largest drift of "
+                     "z over a period " + f"{max(d.get('z', 0.0) for d in defects):.2g}" +
+                     " of z, largest residual after it " +
+                     f"{max(d.get('carried', 0.0) for d in defects):.2g}" +
+                     (f"; z's multipliers (set aside from the stability) within "
+                      f"{max(i.get('max_distance_to_1', 0.0) for i in internal):.1g} of 1"
+                      if internal else ""))
     for kind, items in (("fold", s["folds"]), ("bifurcation", s["bifurcations"]),
                         ("peak", s["peaks"])):
         for x in items:

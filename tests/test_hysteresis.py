@@ -168,3 +168,47 @@ def test_same_torsion_loop_on_one_and_two_ranks():
     params = segment(LAW, elements=4)
     loops = [run(params, 20.0, 1, 50, comm=comm)[2] for comm in (MPI.COMM_SELF, MPI.COMM_WORLD)]
     assert np.max(np.abs(loops[0] - loops[1])) < 1e-9 * np.max(np.abs(loops[0]))
+
+
+def test_orbit_is_the_sweeps_periodic_point_with_z_carried():
+    """Fig. 8 by the orbits with the Fig. 5 law (mobile_end, N = 4, dt = 0.5 ms,
+    11.5 Hz; about 12 s).  z and its alpha2 rate and acceleration are carried
+    along by the shooting (solvers/floquet.py, "Carried entries"), Newton on the
+    rod: T max equals the brute-force sweep's periodic point (rh.sweep, same
+    scene, N, dt) within 1e-3 (measured 1.5e-5); z drifts by < Z_TOL of itself
+    over a period; z's multipliers, one per z dof, are within 1e-6 of 1 (the
+    twist hardly travels: measured 1 - 1e-8) and set aside from the
+    stability.  The orbit is the integrator's, z free: three more periods of
+    the full state keep the rod periodic and z still (a z reset, lost or
+    mis-carried breaks this).  Newton on the whole state, z solved for, finds
+    no orbit (the diagnosis: M - I nearly singular in z, kinks in |dtau|)."""
+    import rawehelix as rh
+    from rawehelix.solvers.orbits import CARRIED_TOL, Z_TOL, AlphaMap
+    from rawehelix.solvers.snes import SolverError
+
+    fig5 = {"rho": 0.5, "A": 2.39, "beta_m_n": 4.78, "gamma_m_n": 4.78, "n": 1.0}
+    sc = rh.load_scene("mobile_end", elements=4).replace(torsion_hysteresis=fig5)
+    (point,) = rh.sweep(sc, [11.5]).points
+    assert point["periodic"]
+    m = AlphaMap(sc)
+    o = m.orbit(m.X_stationary, 11.5, lead_in=5)
+    print("orbit", o.tension_max_N, "sweep", point["tension_max_N"], o.defects,
+          o.internal_multipliers)
+    assert o.residual <= 1e-7
+    assert o.tension_max_N == pytest.approx(point["tension_max_N"], rel=1e-3)
+    assert o.defects["z"] <= Z_TOL and o.defects["carried"] <= CARRIED_TOL
+    z = m.z_dofs
+    assert np.linalg.norm(o.X[z]) > 0.1  # z remembers the lead-in: not the virgin 0
+    mu = o.internal_multipliers
+    assert mu.size == z.size and np.all(np.abs(mu - 1.0) < 1e-6)
+    assert o.stable and o.max_multiplier < 0.99 and o.entry()["defects"] == o.defects
+    X = o.X
+    for _ in range(3):
+        PX, _, _ = m.period(X, 11.5)
+        G = PX - X - o.delta * m.e_alpha
+        assert m.shooting_norm(G, X) <= CARRIED_TOL
+        assert np.linalg.norm(G[z]) <= Z_TOL * max(1.0, np.linalg.norm(X[z]))
+        X = PX - o.delta * m.e_alpha
+    m.carried = np.zeros(0, dtype=int)  # z, V_z, A_z solved for by the Newton
+    with pytest.raises(SolverError, match="orbits: shooting"):
+        m.orbit(m.X_stationary, 11.5, lead_in=5)
