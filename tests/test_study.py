@@ -54,6 +54,7 @@ def test_unknown_quantity_names_the_known_ones():
 import json  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
+import shutil  # noqa: E402
 import signal  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
@@ -126,6 +127,66 @@ def test_a_machinery_failure_is_not_a_failed_point(tmp_path, monkeypatch):
         study.compute(study.Source("mobile_end", elements=N), [EI], ["sag_m"], tmp_path,
                       fd_step=0, comm=MPI.COMM_SELF)
     assert not list((tmp_path / "points").glob("*.json"))
+
+
+ABORT_SCRIPT = '''
+import sys, time
+from mpi4py import MPI
+from rawehelix.errors import SceneError
+from rawehelix.studies import pool
+
+class FullDisk(pool.Store):  # the machinery fails on rank 1 only
+    def save(self, record):
+        if MPI.COMM_WORLD.rank == 1:
+            raise OSError(28, "No space left on device (test)")
+        super().save(record)
+
+def load(overrides):  # a failed point at once, no solve; rank 0 slower
+    if MPI.COMM_WORLD.rank == 0:
+        time.sleep(0.05)
+    raise SceneError("--set", "test", "a failed point")
+
+tasks = [pool.Task(f"p{k:05d}", {}) for k in range(400)]
+store = FullDisk(sys.argv[1], {"test": "abort"}).open(MPI.COMM_WORLD)
+pool.run(tasks, load, ["sag_m"], store)
+print("every task finished", flush=True)
+'''
+
+
+def test_a_machinery_failure_on_one_of_two_ranks_ends_the_job(tmp_path):
+    """Under mpirun -n 2, a machinery failure on rank 1 (a full disk) ends the
+    whole job at once with a non-zero exit and the traceback, while rank 0
+    still has ~20 s of points to take (0.05 s each): without comm.Abort rank 0
+    would end its points and wait for rank 1 at the end for ever."""
+    mpirun = shutil.which("mpirun")
+    if mpirun is None:
+        pytest.skip("needs mpirun")
+    script = tmp_path / "abort.py"
+    script.write_text(ABORT_SCRIPT)
+    env = {k: v for k, v in os.environ.items()  # not this process's own MPI's settings
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_"))}
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([mpirun, "-n", "2", "--oversubscribe", sys.executable, str(script),
+                             str(tmp_path / "out")], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=25)
+    except subprocess.TimeoutExpired:
+        proc.terminate()  # mpirun passes SIGTERM on to the ranks (they are not in its group)
+        try:
+            proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+        pytest.fail("the job hung: still running after 25 s")
+    elapsed = time.perf_counter() - t0
+    assert proc.returncode != 0
+    assert "every task finished" not in out
+    assert "No space left on device (test)" in err  # rank 1's traceback
+    assert "MPI_ABORT" in err  # mpirun's message
+    assert len(pool.computed(tmp_path / "out")) < 200  # rank 0 did not go on to the end
+    assert elapsed < 15
 
 
 def test_bad_key_or_value_is_the_scene_error(tmp_path):
