@@ -47,11 +47,18 @@ def _study_command(ranks: int, points: int, elements: int, outdir: Path) -> dict
            "--quantity", "lateral_frequency_Hz", "--fd-step", "0", "-o", str(outdir)]
     shutil.rmtree(outdir, ignore_errors=True)
     load = os.getloadavg()[0]
-    t0 = time.perf_counter()
+    t0, u0 = time.perf_counter(), time.time()
     subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    wall = time.perf_counter() - t0
+    wall, u1 = time.perf_counter() - t0, time.time()
     s = json.loads((outdir / "summary.json").read_text())
+    points = [json.loads(p.read_text()) for p in sorted((outdir / "points").glob("*.json"))]
     return {"command_wall_s": wall, "load_1min_before": load,
+            # before the last rank's loop starts (mpirun, imports, the scenes checked) and
+            # after the last rank's loop ends (gathering, sensitivities, CSV, figures)
+            "startup_s": max(x["loop_start_unix"] for x in s["loops"]) - u0,
+            "tail_s": u1 - max(x["loop_end_unix"] for x in s["loops"]),
+            "point_cpu_s": float(np.median([p["point_cpu_s"] for p in points])),
+            "point_wall_s": float(np.median([p["point_wall_s"] for p in points])),
             "loop_wall_s": max(x["loop_wall_s"] for x in s["loops"]),
             "loop_cpu_s": sum(x["loop_cpu_s"] for x in s["loops"]),
             "loop_cpu_s_max_rank": max(x["loop_cpu_s"] for x in s["loops"]),
@@ -73,7 +80,7 @@ def bench_speedup(points: int = POINTS, elements: int = ELEMENTS, repeats: int =
             r.pop("csv")
     med = {k: {m: float(np.median([r[m] for r in rows])) for m in
                ("command_wall_s", "loop_wall_s", "loop_cpu_s", "loop_cpu_s_max_rank",
-                "load_1min_before")}
+                "startup_s", "tail_s", "point_cpu_s", "point_wall_s", "load_1min_before")}
            for k, rows in runs.items()}
     return {"points": points, "elements": elements, "quantity": "lateral_frequency_Hz",
             "runs": {str(k): v for k, v in runs.items()}, "median": {str(k): v for k, v in med.items()},

@@ -135,14 +135,15 @@ def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_
     """Evaluate the unfinished ``tasks`` on the ranks of ``comm`` (collective);
     ``load(overrides) -> Parameters`` builds a task's scene.  Returns
     ``{"records": {id: record} (every task in order, on every rank), "computed": n,
-    "loop_wall_s", "loop_cpu_s" (this rank)}``."""
+    "loop_wall_s", "loop_cpu_s", "loop_start_unix", "loop_end_unix", "loop_points"
+    (this rank)}``."""
     done = None
     if comm.rank == 0:
         done = {t.id: r for t in tasks if (r := store.finished(t.id)) is not None}
     done = comm.bcast(done, root=0)
     todo = [k for k, t in enumerate(tasks) if t.id not in done]
     mine = []
-    c0, w0 = time.process_time(), time.perf_counter()
+    c0, w0, t0 = time.process_time(), time.perf_counter(), time.time()
     try:
         counter = _Counter(comm) if comm.size > 1 else None
         k = 0
@@ -160,7 +161,8 @@ def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_
                 log(f"[rank {comm.rank}] {task.id} ({k + 1}/{len(todo)}): "
                     f"{shown or record['status']} ({record['point_wall_s']:.1f} s)")
             k += 0 if counter else 1
-        loop = {"loop_wall_s": time.perf_counter() - w0, "loop_cpu_s": time.process_time() - c0}
+        loop = {"loop_wall_s": time.perf_counter() - w0, "loop_cpu_s": time.process_time() - c0,
+                "loop_start_unix": t0, "loop_end_unix": time.time(), "loop_points": len(mine)}
         if counter:
             counter.free()
     except Exception:  # the machinery failed on this rank: stop every rank

@@ -354,8 +354,8 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
                                       fd_step)).open(comm)
     out = pool.run(tasks, source.load, wanted, store, comm=comm, log=log)
     records = out["records"]
-    loops = comm.allgather({"rank": comm.rank, "loop_wall_s": out.get("loop_wall_s"),
-                            "loop_cpu_s": out.get("loop_cpu_s")})
+    loops = comm.allgather({"rank": comm.rank, **{k: v for k, v in out.items()
+                                                  if k.startswith("loop_")}})
     sens = sensitivities(records, base, wanted, fd_step)
     design_records = [r for r in records.values() if r["kind"] == "design"]
     indices = {}
