@@ -42,6 +42,7 @@ import dataclasses
 import io
 import itertools
 import math
+import threading
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -352,6 +353,8 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
         raise SceneError("--fd-step", fd_step, "must be in [0, 1)")
     if point_timeout is not None and not (point_timeout > 0 and math.isfinite(point_timeout)):
         raise SceneError("--point-timeout", point_timeout, "must be a number of seconds > 0")
+    if point_timeout is not None and threading.current_thread() is not threading.main_thread():
+        raise SceneError("--point-timeout", point_timeout, "needs the main thread (SIGALRM)")
     tasks, X, base, skipped = make_tasks(source, variables, sample, points, fd_step)
     params = source.load()
     store = pool.Store(outdir, header(source, params, variables, sample, points, wanted,
