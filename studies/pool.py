@@ -13,9 +13,11 @@ as soon as it is finished; a run started again (after SIGKILL too) skips
 every task whose record exists, and ``DIR/computed.log`` gets one line per
 task computed.  A failed task (the stage raised one of
 ``quantities.POINT_ERRORS``) is recorded with its reason and counts as
-finished.  Any other exception on a rank is a failure of the machinery: the
-traceback is printed and the whole job aborted (``comm.Abort``), since the
-other ranks would otherwise wait for ever at the end.
+finished; so does one that ran past ``point_timeout`` (:func:`time_limit`),
+unless a later run allows it more time.  Any other exception on a rank is a
+failure of the machinery: the traceback is printed and the whole job aborted
+(``comm.Abort``), since the other ranks would otherwise wait for ever at the
+end.
 """
 
 from __future__ import annotations

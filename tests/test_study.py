@@ -149,7 +149,8 @@ def test_a_point_past_its_time_limit_fails_and_is_retried_with_a_longer_one(tmp_
     for r in first.records.values():
         assert r["status"] == "failed" and r["timed_out_s"] == 2
         assert r["values"]["sag_m"] > 0 and r["values"]["lateral_frequency_Hz"] is None
-        assert r["errors"] == {"lateral_frequency_Hz": "modes: timed out after 2 s (--point-timeout)"}
+        assert r["errors"] == {
+            "lateral_frequency_Hz": "modes: timed out after 2 s (--point-timeout)"}
     assert ",failed,modes: timed out after 2 s" in first.csv_text()
     study.compute(source, *args, fd_step=0, comm=MPI.COMM_SELF, point_timeout=2)
     assert len(pool.computed(tmp_path)) == 2  # the same limit: not computed again
