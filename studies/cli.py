@@ -10,7 +10,7 @@
     rawehelix labtest axial|bending|torsion [--tension T1,T2,...] [--loads X1,...] [--fit]
                       [--EI VALUE] [--scene SCENE] [--no-gravity] [--elements N] [-o DIR]
     rawehelix study SCENE --vary KEY=START:STOP:COUNT [--vary ...] [--sample grid|lhs|sobol
-                    --points N] --quantity Q[,Q...] [--fd-step h] [-o DIR]
+                    --points N] --quantity Q[,Q...] [--fd-step h] [--point-timeout S] [-o DIR]
     rawehelix calibrate SCENE --fit KEY[,KEY...] --target Q=VALUE[,...] [--bounds KEY=LO:HI]
                     [--uncertainty REL] [-o DIR]
 
@@ -81,6 +81,9 @@ def _parser() -> argparse.ArgumentParser:
                            help="the design (default grid; lhs, sobol: scipy.stats.qmc, SALib)")
             p.add_argument("--points", type=int, default=None,
                            help="lhs: points; sobol: base points N (N (d + 2) scenes)")
+            p.add_argument("--point-timeout", type=float, default=None, metavar="S",
+                           help="a point still running after S seconds (wall) fails with "
+                                "that reason; a rerun with a longer limit computes it again")
         if name in ("study", "calibrate"):
             p.add_argument("--quantity" if name == "study" else "--target", required=True,
                            metavar="Q[,Q...]" if name == "study" else "Q=VALUE[,...]",
@@ -358,7 +361,7 @@ def _study(rh, params, args, outdir, comm) -> int:
     variables = [study.parse_vary(v) for v in args.vary]
     result = study.compute(_source(args), variables, quantities.parse_list(args.quantity),
                            outdir, sample=args.sample, points=args.points, fd_step=args.fd_step,
-                           comm=comm, log=log.info)
+                           comm=comm, log=log.info, point_timeout=args.point_timeout)
     return _write_and_say(comm, result, study.report(result), outdir)
 
 

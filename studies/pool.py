@@ -13,15 +13,18 @@ as soon as it is finished; a run started again (after SIGKILL too) skips
 every task whose record exists, and ``DIR/computed.log`` gets one line per
 task computed.  A failed task (the stage raised one of
 ``quantities.POINT_ERRORS``) is recorded with its reason and counts as
-finished.  Any other exception on a rank is a failure of the machinery: the
-traceback is printed and the whole job aborted (``comm.Abort``), since the
-other ranks would otherwise wait for ever at the end.
+finished; so does one that ran past ``point_timeout`` (:func:`time_limit`),
+unless a later run allows it more time.  Any other exception on a rank is a
+failure of the machinery: the traceback is printed and the whole job aborted
+(``comm.Abort``), since the other ranks would otherwise wait for ever at the
+end.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import signal
 import sys
 import time
 import traceback
@@ -111,17 +114,58 @@ def idle_barrier(comm, poll_s: float = 0.01):
         time.sleep(poll_s)
 
 
-def _evaluate(task: Task, load, wanted: list[str]) -> dict:
+def time_limit(seconds: float | None, call):
+    """``call(timed_out)`` with an alarm after ``seconds`` (None: no limit): SIGALRM
+    raises quantities.PointTimeout once, in the main thread, at the next Python
+    instruction (a PETSc or SLEPc call in C ends first); ``timed_out()`` gives
+    the reason from then on.  Returns ``(call's result or None if the exception
+    escaped it, reason or None)``."""
+    from rawehelix.studies import quantities
+    if not seconds:
+        return call(lambda: None), None
+    reason = []
+
+    def alarm(signum, frame):
+        if not reason:  # raises once: the handlers below cannot be hit again
+            reason.append(f"timed out after {seconds:g} s (--point-timeout)")
+            raise quantities.PointTimeout(reason[0])
+
+    def timed_out():
+        return reason[0] if reason else None
+
+    old = signal.signal(signal.SIGALRM, alarm)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, seconds)
+        try:
+            return call(timed_out), timed_out()
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+    except quantities.PointTimeout:  # outside a stage (loading the scene, between stages)
+        return None, timed_out()
+    finally:
+        signal.signal(signal.SIGALRM, old)
+
+
+def _evaluate(task: Task, load, wanted: list[str], point_timeout: float | None = None) -> dict:
     from rawehelix.studies import quantities
     c0, w0 = time.process_time(), time.perf_counter()
     record = {"id": task.id, "kind": task.kind, "overrides": task.overrides}
-    try:
-        params = load(task.overrides)
-    except quantities.POINT_ERRORS as err:  # validated before the run: not expected
-        out = {"values": dict.fromkeys(wanted), "errors": dict.fromkeys(wanted, str(err)),
-               "cpu_s": {}, "wall_s": {}}
-    else:
-        out = quantities.evaluate(params, wanted)
+
+    def failed(reason):
+        return {"values": dict.fromkeys(wanted), "errors": dict.fromkeys(wanted, reason),
+                "cpu_s": {}, "wall_s": {}}
+
+    def point(timed_out):
+        try:
+            params = load(task.overrides)
+        except quantities.POINT_ERRORS as err:  # validated before the run: not expected
+            return failed(timed_out() or str(err))
+        return quantities.evaluate(params, wanted, timed_out)
+
+    out, late = time_limit(point_timeout, point)
+    out = out or failed(late)
+    if late:
+        record["timed_out_s"] = point_timeout
     record.update(out)
     record["status"] = "failed" if out["errors"] else "ok"
     record["point_cpu_s"] = time.process_time() - c0
@@ -130,19 +174,30 @@ def _evaluate(task: Task, load, wanted: list[str]) -> dict:
     return record
 
 
+def _retry(record: dict, point_timeout: float | None) -> bool:
+    """A record that timed out under a shorter limit than this run's."""
+    limit = record.get("timed_out_s")
+    return limit is not None and (point_timeout is None or point_timeout > limit)
+
+
 def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_WORLD,
-        log=None) -> dict:
+        log=None, point_timeout: float | None = None) -> dict:
     """Evaluate the unfinished ``tasks`` on the ranks of ``comm`` (collective);
-    ``load(overrides) -> Parameters`` builds a task's scene.  Returns
+    ``load(overrides) -> Parameters`` builds a task's scene.  A point still
+    running after ``point_timeout`` seconds (wall) fails with that reason
+    (:func:`time_limit`); a record that timed out after fewer seconds than
+    ``point_timeout`` (or None) is not finished, and is computed again.  Returns
     ``{"records": {id: record} (every task in order, on every rank), "computed": n,
-    "loop_wall_s", "loop_cpu_s" (this rank)}``."""
+    "loop_wall_s", "loop_cpu_s", "loop_start_unix", "loop_end_unix", "loop_points"
+    (this rank)}``."""
     done = None
     if comm.rank == 0:
-        done = {t.id: r for t in tasks if (r := store.finished(t.id)) is not None}
+        done = {t.id: r for t in tasks if (r := store.finished(t.id)) is not None
+                and not _retry(r, point_timeout)}
     done = comm.bcast(done, root=0)
     todo = [k for k, t in enumerate(tasks) if t.id not in done]
     mine = []
-    c0, w0 = time.process_time(), time.perf_counter()
+    c0, w0, t0 = time.process_time(), time.perf_counter(), time.time()
     try:
         counter = _Counter(comm) if comm.size > 1 else None
         k = 0
@@ -151,7 +206,7 @@ def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_
             if k >= len(todo):
                 break
             task = tasks[todo[k]]
-            record = _evaluate(task, load, wanted)
+            record = _evaluate(task, load, wanted, point_timeout)
             store.save(record)
             mine.append(record)
             if log:
@@ -160,7 +215,8 @@ def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_
                 log(f"[rank {comm.rank}] {task.id} ({k + 1}/{len(todo)}): "
                     f"{shown or record['status']} ({record['point_wall_s']:.1f} s)")
             k += 0 if counter else 1
-        loop = {"loop_wall_s": time.perf_counter() - w0, "loop_cpu_s": time.process_time() - c0}
+        loop = {"loop_wall_s": time.perf_counter() - w0, "loop_cpu_s": time.process_time() - c0,
+                "loop_start_unix": t0, "loop_end_unix": time.time(), "loop_points": len(mine)}
         if counter:
             counter.free()
     except Exception:  # the machinery failed on this rank: stop every rank

@@ -47,10 +47,15 @@ class QuantityError(ValueError):
     """The stage ran but does not give the quantity (no fold, not settled, ...)."""
 
 
+class PointTimeout(Exception):
+    """A point ran past its time limit (``rawehelix study --point-timeout``): raised
+    once, by the alarm of :func:`rawehelix.studies.pool.time_limit`."""
+
+
 #: what a failed point is (recorded with its reason); anything else is a
 #: failure of the machinery and stops the whole study
 POINT_ERRORS = (SolverError, SceneError, ParameterError, QuantityError, ArithmeticError,
-                ValueError, RuntimeError)
+                ValueError, RuntimeError, PointTimeout)
 
 
 # -- the stages ----------------------------------------------------------------------------
@@ -189,12 +194,15 @@ def parse_list(text: str, where: str = "--quantity") -> list[str]:
     return items
 
 
-def evaluate(params: Parameters, wanted: list[str]) -> dict:
+def evaluate(params: Parameters, wanted: list[str], timed_out: Callable | None = None) -> dict:
     """Every quantity of ``wanted`` for one scene, each stage computed once on
     COMM_SELF: ``{"values": {name: float | None}, "errors": {name: reason},
     "cpu_s": {stage: s}, "wall_s": {stage: s}}``.  A stage that fails leaves
     its quantities None with the reason; exceptions other than POINT_ERRORS
-    (a failure of the machinery) propagate."""
+    (a failure of the machinery) propagate.  ``timed_out() -> reason | None``:
+    once it gives a reason, the stage then running (whatever it raised, e.g. a
+    PETSc error from a callback that the alarm interrupted) and the stages after
+    it fail with that reason."""
     stages: dict[tuple, list] = {}
     for name in wanted:
         quantity, f1 = parse(name)
@@ -203,12 +211,18 @@ def evaluate(params: Parameters, wanted: list[str]) -> dict:
     values, errors, cpu, wall = {}, {}, {}, {}
     for (stage, f1), members in stages.items():
         label = stage if f1 is None else f"{stage}{AT}{f1:g}"
+        late = timed_out() if timed_out else None
         c0, w0 = time.process_time(), time.perf_counter()
-        try:
-            result, failure = STAGES[stage](params, f1), None
-        except POINT_ERRORS as err:
-            result, failure = None, f"{label}: {type(err).__name__}: {err}"
-        cpu[label], wall[label] = time.process_time() - c0, time.perf_counter() - w0
+        if late:
+            result, failure = None, f"{label}: not run, the point {late}"
+        else:
+            try:
+                result, failure = STAGES[stage](params, f1), None
+            except POINT_ERRORS as err:
+                result, failure = None, f"{label}: {type(err).__name__}: {err}"
+            if timed_out and (late := timed_out()):
+                result, failure = None, f"{label}: {late}"
+            cpu[label], wall[label] = time.process_time() - c0, time.perf_counter() - w0
         for name, quantity in members:
             values[name] = None
             if failure:

@@ -42,6 +42,7 @@ import dataclasses
 import io
 import itertools
 import math
+import threading
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -332,11 +333,13 @@ def header(source: Source, params: Parameters, variables, sample, points, wanted
 
 def compute(source: Source, variables: list[Variable], wanted: list[str], outdir,
             sample: str = "grid", points: int | None = None, fd_step: float | None = None,
-            comm=MPI.COMM_WORLD, log=None) -> StudyResult:
+            comm=MPI.COMM_WORLD, log=None, point_timeout: float | None = None) -> StudyResult:
     """Run (or resume) the study in ``outdir`` on the ranks of ``comm``
     (collective); the result on every rank.  ``fd_step``: None is FD_STEP, 0
-    no sensitivities.  Raises SceneError for bad input before anything is
-    computed or written."""
+    no sensitivities.  ``point_timeout``: seconds (wall) after which a point
+    fails (:func:`rawehelix.studies.pool.time_limit`; a rerun with a longer
+    limit or none computes it again).  Raises SceneError for bad input before
+    anything is computed or written."""
     start = time.perf_counter()
     fd_step = FD_STEP if fd_step is None else fd_step
     if sample not in SAMPLES:
@@ -348,14 +351,19 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
         quantities.parse(name)
     if not 0 <= fd_step < 1:
         raise SceneError("--fd-step", fd_step, "must be in [0, 1)")
+    if point_timeout is not None and not (point_timeout > 0 and math.isfinite(point_timeout)):
+        raise SceneError("--point-timeout", point_timeout, "must be a number of seconds > 0")
+    if point_timeout is not None and threading.current_thread() is not threading.main_thread():
+        raise SceneError("--point-timeout", point_timeout, "needs the main thread (SIGALRM)")
     tasks, X, base, skipped = make_tasks(source, variables, sample, points, fd_step)
     params = source.load()
     store = pool.Store(outdir, header(source, params, variables, sample, points, wanted,
                                       fd_step)).open(comm)
-    out = pool.run(tasks, source.load, wanted, store, comm=comm, log=log)
+    out = pool.run(tasks, source.load, wanted, store, comm=comm, log=log,
+                   point_timeout=point_timeout)
     records = out["records"]
-    loops = comm.allgather({"rank": comm.rank, "loop_wall_s": out.get("loop_wall_s"),
-                            "loop_cpu_s": out.get("loop_cpu_s")})
+    loops = comm.allgather({"rank": comm.rank, **{k: v for k, v in out.items()
+                                                  if k.startswith("loop_")}})
     sens = sensitivities(records, base, wanted, fd_step)
     design_records = [r for r in records.values() if r["kind"] == "design"]
     indices = {}
@@ -376,6 +384,7 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
                "failed": {r["id"]: r["errors"] for r in records.values()
                           if r["status"] == "failed"},
                "cpu_s_per_point_by_stage": {s: float(np.median(c)) for s, c in cost.items()},
+               "point_timeout_s": point_timeout,
                "computed_now": out["computed"], "ranks": comm.size, "loops": loops,
                "wall_s": time.perf_counter() - start}
     return StudyResult(params.name, params.title or params.name, variables, wanted, sample,

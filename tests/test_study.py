@@ -54,6 +54,7 @@ def test_unknown_quantity_names_the_known_ones():
 import json  # noqa: E402
 import math  # noqa: E402
 import os  # noqa: E402
+import shutil  # noqa: E402
 import signal  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
@@ -119,13 +120,107 @@ def test_failed_points_are_recorded_and_the_study_goes_on(tmp_path):
 def test_a_machinery_failure_is_not_a_failed_point(tmp_path, monkeypatch):
     """An exception outside quantities.POINT_ERRORS stops the run (with more
     ranks: comm.Abort of all) instead of being recorded."""
-    def broken(params, wanted):
+    def broken(params, wanted, timed_out=None):
         raise KeyError("machinery")
     monkeypatch.setattr(quantities, "evaluate", broken)
     with pytest.raises(KeyError):
         study.compute(study.Source("mobile_end", elements=N), [EI], ["sag_m"], tmp_path,
                       fd_step=0, comm=MPI.COMM_SELF)
     assert not list((tmp_path / "points").glob("*.json"))
+
+
+def test_a_point_past_its_time_limit_fails_and_is_retried_with_a_longer_one(tmp_path,
+                                                                           monkeypatch):
+    """--point-timeout: a stage still running at the limit is interrupted (the
+    one here sleeps 60 s), the point fails with the reason and keeps the values
+    of the stages before it; a rerun with the same limit skips it, one with a
+    longer limit computes it again."""
+    source = study.Source("mobile_end", elements=N)
+    quantities.evaluate(source.load(), ["sag_m"])  # the stationary forms compiled
+
+    def slow(params, f1=None):
+        time.sleep(60)
+    monkeypatch.setitem(quantities.STAGES, "modes", slow)
+    args = ([study.parse_vary("helix.EI_Nm2=3000:6000:2")], ["sag_m", "lateral_frequency_Hz"],
+            tmp_path)
+    t0 = time.perf_counter()
+    first = study.compute(source, *args, fd_step=0, comm=MPI.COMM_SELF, point_timeout=2)
+    assert time.perf_counter() - t0 < 15
+    for r in first.records.values():
+        assert r["status"] == "failed" and r["timed_out_s"] == 2
+        assert r["values"]["sag_m"] > 0 and r["values"]["lateral_frequency_Hz"] is None
+        assert r["errors"] == {
+            "lateral_frequency_Hz": "modes: timed out after 2 s (--point-timeout)"}
+    assert ",failed,modes: timed out after 2 s" in first.csv_text()
+    study.compute(source, *args, fd_step=0, comm=MPI.COMM_SELF, point_timeout=2)
+    assert len(pool.computed(tmp_path)) == 2  # the same limit: not computed again
+    monkeypatch.setitem(quantities.STAGES, "modes", lambda params, f1=None: [])
+    again = study.compute(source, *args, fd_step=0, comm=MPI.COMM_SELF, point_timeout=30)
+    assert len(pool.computed(tmp_path)) == 4
+    for r in again.records.values():  # computed: the stage ran (and found no lateral mode)
+        assert "timed_out_s" not in r
+        assert "no mode of the families" in r["errors"]["lateral_frequency_Hz"]
+    with pytest.raises(rh.SceneError, match="--point-timeout"):
+        study.compute(source, *args, fd_step=0, comm=MPI.COMM_SELF, point_timeout=0)
+
+
+ABORT_SCRIPT = '''
+import sys, time
+from mpi4py import MPI
+from rawehelix.errors import SceneError
+from rawehelix.studies import pool
+
+class FullDisk(pool.Store):  # the machinery fails on rank 1 only
+    def save(self, record):
+        if MPI.COMM_WORLD.rank == 1:
+            raise OSError(28, "No space left on device (test)")
+        super().save(record)
+
+def load(overrides):  # a failed point at once, no solve; rank 0 slower
+    if MPI.COMM_WORLD.rank == 0:
+        time.sleep(0.05)
+    raise SceneError("--set", "test", "a failed point")
+
+tasks = [pool.Task(f"p{k:05d}", {}) for k in range(400)]
+store = FullDisk(sys.argv[1], {"test": "abort"}).open(MPI.COMM_WORLD)
+pool.run(tasks, load, ["sag_m"], store)
+print("every task finished", flush=True)
+'''
+
+
+def test_a_machinery_failure_on_one_of_two_ranks_ends_the_job(tmp_path):
+    """Under mpirun -n 2, a machinery failure on rank 1 (a full disk) ends the
+    whole job at once with a non-zero exit and the traceback, while rank 0
+    still has ~20 s of points to take (0.05 s each): without comm.Abort rank 0
+    would end its points and wait for rank 1 at the end for ever."""
+    mpirun = shutil.which("mpirun")
+    if mpirun is None:
+        pytest.skip("needs mpirun")
+    script = tmp_path / "abort.py"
+    script.write_text(ABORT_SCRIPT)
+    env = {k: v for k, v in os.environ.items()  # not this process's own MPI's settings
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_"))}
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([mpirun, "-n", "2", "--oversubscribe", sys.executable, str(script),
+                             str(tmp_path / "out")], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=25)
+    except subprocess.TimeoutExpired:
+        proc.terminate()  # mpirun passes SIGTERM on to the ranks (they are not in its group)
+        try:
+            proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+        pytest.fail("the job hung: still running after 25 s")
+    elapsed = time.perf_counter() - t0
+    assert proc.returncode != 0
+    assert "every task finished" not in out
+    assert "No space left on device (test)" in err  # rank 1's traceback
+    assert len(pool.computed(tmp_path / "out")) < 200  # rank 0 did not go on to the end
+    assert elapsed < 15
 
 
 def test_bad_key_or_value_is_the_scene_error(tmp_path):
