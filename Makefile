@@ -30,7 +30,7 @@ test-long: install
 	$(MPIRUN) $(PY) -m pytest -q -m "mpi and long" -p no:cacheprovider $(PYTEST_ARGS)
 
 test-debian13:
-	@bash scripts/test-debian13.sh
+	@MARKS="$(MARKS)" bash scripts/test-debian13.sh
 
 clean:
 	rm -rf results .pytest_cache
