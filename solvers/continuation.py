@@ -12,6 +12,17 @@ G_f1 central differences of G over f1 with the steps per period held
 (one M for the whole corrector, so that the map is smooth in f1).  The
 next tangent solves [[M - I, G_f1], [tau_k^T]] tau = (0, 1).
 
+A corrector that had to refresh the monodromy starts the next one with the
+monodromy at its predictor (``State.fresh``): below the resonance the
+multipliers rotate by 2 pi f_n d(1/f1) between points, so the last point's
+monodromy is a stale chord.  After two slow correctors in a row (>= SLOW
+iterations) or a failed one, and while every multiplier of the last point is
+FOLD_MARGIN away from +1 (no fold near, so f1 parametrises the branch), the
+next point is found by *natural* steps (``State.natural``): shooting at the
+predictor's f1 (:meth:`PeriodMap.orbit`, with the scheme's own steps per period
+there), f1 moving by at most NATURAL_STEP of itself.  Near a fold the
+arclength corrector takes over again.
+
 The step adapts: x1.5 after a corrector of <= 5 iterations, /1.5 after >= 7,
 /2 after a failure; and so that T max changes by at most ``tension_step``
 (relative) between two points: a corrected point past it is refused (before
@@ -71,14 +82,17 @@ log = logging.getLogger(__name__)
 TENSION_STEP = 0.05  # the largest relative change of T max between two branch points
 BISECTION_HZ = 1e-4  # PD / NS located to this width in f1 [Hz]
 BISECTION_MAX = 12  # probes per bisection
-PEAK_PROBES = 5  # correctors per peak refinement
-PEAK_TOL = 1e-5  # a peak's T max located to this relative change between two vertices
+PEAK_PROBES = 8  # correctors per peak refinement
+PEAK_TOL = 1e-6  # a peak's T max located to this relative change between two vertices
 SITE_WINDOW = 0.05  # the step control acts within this relative distance of a site's f1
 ANGLE_STEP = 0.3  # within a window: the angle's change per step over |mu - 1|
 LIGHT = 0.5  # multipliers of modulus below this are not a site's (damped over a period)
 SITE_ANGLE = 0.5  # a site's multiplier: within this of its predicted angle [rad]
 RUN = 200  # the points a site's multiplier is tracked over (the last of the branch)
 SUPERHARMONIC_ORDERS = (2, 3)  # k of the k:1 resonances the sites are made for
+FOLD_MARGIN = 0.02  # natural steps only while every multiplier is this far from +1
+NATURAL_STEP = 0.25  # a natural step moves f1 by at most this fraction of itself
+SLOW = 6  # two correctors in a row of this many iterations turn to natural steps
 
 
 @dataclasses.dataclass(frozen=True)
@@ -142,6 +156,13 @@ def track(site: Site, points) -> list:
     return out
 
 
+def far_from_folds(mu) -> bool:
+    """No multiplier within FOLD_MARGIN of +1: no fold (a real multiplier through
+    +1) is near, so f1 parametrises the branch and shooting at fixed f1 is sound."""
+    mu = np.asarray(mu)
+    return bool(mu.size == 0 or np.min(np.abs(mu - 1.0)) > FOLD_MARGIN)
+
+
 def _unstable(mu) -> dict:
     """Multipliers outside the unit circle, by kind (real > 1, real < -1, complex)."""
     out = np.abs(mu) > 1.0 + 1e-9
@@ -182,13 +203,18 @@ class State:
     gf: np.ndarray
     w: np.ndarray
     ds: float
+    fresh: bool = False  # the next corrector starts with a monodromy at its predictor
+    natural: bool = False  # the next point by shooting at fixed f1, if no fold is near
 
     def arrays(self) -> dict:
-        return {"tau": self.tau, "A": self.A, "gf": self.gf, "w": self.w, "ds": np.array(self.ds)}
+        return {"tau": self.tau, "A": self.A, "gf": self.gf, "w": self.w, "ds": np.array(self.ds),
+                "fresh": np.array(self.fresh), "natural": np.array(self.natural)}
 
     @classmethod
     def from_arrays(cls, data) -> "State":
-        return cls(tau=data["tau"], A=data["A"], gf=data["gf"], w=data["w"], ds=float(data["ds"]))
+        flag = lambda key: bool(data[key]) if key in data else False  # noqa: E731 (older stores)
+        return cls(tau=data["tau"], A=data["A"], gf=data["gf"], w=data["w"], ds=float(data["ds"]),
+                   fresh=flag("fresh"), natural=flag("natural"))
 
 
 class Branch:
@@ -236,34 +262,61 @@ class Branch:
         tau = np.linalg.solve(K, rhs)
         return tau / np.linalg.norm(self.w * tau), A, gf
 
-    def _correct(self, prev: Orbit, tau, A, gf, ds, steps):
+    def _correct(self, prev: Orbit, tau, A, gf, ds, steps, fresh: bool = False):
         """The corrector from ``prev`` along ``tau`` by ``ds``: (X, f1, iterations,
-        |G|/|X|, the tension over the period (normalised)) or None if it fails."""
+        |G|/|X|, the tension over the period (normalised), whether it refreshed the
+        monodromy) or None if it fails.  ``fresh``: the first iteration takes the
+        monodromy at the predictor instead of ``A`` (the last point's)."""
         n = prev.X.size
         Y0 = np.concatenate([prev.X, [prev.f1_Hz]])
         Y = Y0 + ds * tau
         K = self._bordered(A, gf, tau)
-        lu, res, last = None, np.inf, np.inf
+        lu, res, last, refreshed = None, np.inf, np.inf, False
         for its in range(1, self.max_it + 1):
             X, f1 = Y[:n], float(Y[-1])
             if not f1 > 0:
                 return None
-            slow = lu is not None and res > 0.1 * last  # the chord is too far off
-            G, tension, Phi = self._G(X, f1, steps, tangent=slow)
+            # the chord is too far off (or stale from the start)
+            slow = (lu is not None and res > 0.1 * last) or (fresh and its == 1)
+            try:
+                G, tension, Phi = self._G(X, f1, steps, tangent=slow)
+            except SolverError as err:  # the period's steps failed from this iterate
+                log.debug("corrector %d: the period map failed at f1 = %.6f Hz: %s", its, f1, err)
+                return None
             if slow:  # Newton: the monodromy and G_f1 here
                 A = floquet.newton_matrix(Phi, floquet.carried_of(self.m))
                 gf = self._G_f1(X, f1, steps)
-                K, lu = self._bordered(A, gf, tau), None
+                K, lu, refreshed = self._bordered(A, gf, tau), None, True
             last, res = res, floquet.shooting_norm(G, X, floquet.carried_of(self.m))
             log.debug("corrector %d: f1 = %.6f Hz, |G|/|X| = %.3g, ds %.3g%s", its, f1, res,
                       ds, " (fresh monodromy)" if slow else "")
             if res <= self.tol:
-                return floquet.settle(X, G, floquet.carried_of(self.m)), f1, its, res, tension
+                return (floquet.settle(X, G, floquet.carried_of(self.m)), f1, its, res, tension,
+                        refreshed)
             if lu is None:
                 lu = scipy.linalg.lu_factor(K)
             r = np.concatenate([G, [(self.w**2 * tau) @ (Y - Y0) - ds]])
             Y = Y - scipy.linalg.lu_solve(lu, r)
         return None
+
+    def _natural(self, prev: Orbit, st: State) -> Orbit | None:
+        """The next point by shooting at the predictor's f1 (natural parameter), from
+        the predictor's state, with the monodromy at each start of the shooting's
+        Newton (:meth:`PeriodMap.orbit`) and the scheme's own steps per period at that
+        f1; None if it fails.  The step moves f1 by at most NATURAL_STEP of itself
+        (``st.ds`` is cut to match)."""
+        cap = NATURAL_STEP * prev.f1_Hz / max(abs(st.tau[-1]), 1e-300)
+        st.ds = max(self.ds_min, min(st.ds, cap))
+        Y = np.concatenate([prev.X, [prev.f1_Hz]]) + st.ds * st.tau
+        f1 = float(Y[-1])
+        if not f1 > 0:
+            return None
+        try:
+            return self.m.orbit(Y[:-1], f1, tol=self.tol, max_it=self.max_it,
+                                steps=self.m.steps_per_period(f1))
+        except SolverError as err:
+            log.debug("natural step to %.6f Hz failed: %s", f1, err)
+            return None
 
     def start(self, first: Orbit, direction: float = 1.0):
         """The first point and its tangent in ``direction`` of f1."""
@@ -305,21 +358,32 @@ class Branch:
             prev, st = self.points[-1], self.state
             start = time.perf_counter()
             steps = self.m.steps_per_period(prev.f1_Hz)
-            got = self._correct(prev, st.tau, st.A, st.gf, st.ds, steps)
+            natural = st.natural and far_from_folds(prev.multipliers)
+            if natural:  # the corrector was slow and no fold is near: shooting at the next f1
+                orbit = self._natural(prev, st)
+                got = None if orbit is None else (orbit.X, orbit.f1_Hz, orbit.newton_iterations,
+                                                  orbit.residual, None, True)
+            else:
+                got = self._correct(prev, st.tau, st.A, st.gf, st.ds, steps, fresh=st.fresh)
             if got is None:
                 st.ds /= 2
+                st.natural = True  # a failed corrector: try the next step at fixed f1
                 if st.ds < self.ds_min:
                     raise SolverError(f"continuation: the corrector failed at f1 = "
                                       f"{prev.f1_Hz:.4f} Hz with the smallest step {self.ds_min}")
                 continue
-            X, f1, its, res, tension = got
-            change = abs(self.m.q.tension_N(tension).max() / prev.tension_max_N - 1.0)
+            X, f1, its, res, tension, refreshed = got
+            T_max = orbit.tension_max_N if natural else self.m.q.tension_N(tension).max()
+            change = abs(T_max / prev.tension_max_N - 1.0)
             if change > self.tension_step and st.ds > self.ds_min:
-                # T max moved too far: a shorter step, before the Floquet period
+                # T max moved too far: a shorter step (before the Floquet period of a corrector)
                 st.ds = max(self.ds_min, st.ds * max(0.2, 0.8 * self.tension_step / change))
                 continue
-            orbit = self.m.finish(X, f1, self.m.rotation(f1), its, res, start, steps)
-            tau_new, A, gf = self._tangent(orbit, st.tau, steps)
+            if not natural:
+                orbit = self.m.finish(X, f1, self.m.rotation(f1), its, res, start, steps)
+            # the new point's tangent with the steps it was found with (a natural step:
+            # its own at its f1); the events between the two with the last point's
+            tau_new, A, gf = self._tangent(orbit, st.tau, orbit.steps)
             events = self._detect(prev, orbit, st, tau_new, steps)
             ds = st.ds
             if its <= 5:  # an easy corrector (a chord step and a refresh or two)
@@ -329,7 +393,8 @@ class Branch:
             if change > 0:  # the next change of T max, predicted linearly, within the bound
                 ds = max(self.ds_min, min(ds, st.ds * 0.8 * self.tension_step / change))
             ds = max(self.ds_min, self._site_step(self.points + [orbit], tau_new[-1], ds))
-            self.state = State(tau=tau_new, A=A, gf=gf, w=self.w.copy(), ds=ds)
+            self.state = State(tau=tau_new, A=A, gf=gf, w=self.w.copy(), ds=ds, fresh=refreshed,
+                               natural=natural or min(its, prev.newton_iterations) >= SLOW)
             self.points.append(orbit)
             if on_point:
                 on_point(orbit, events, self.state)
@@ -388,8 +453,9 @@ class Branch:
     def _peak(self, z: Orbit, a: Orbit, b: Orbit, st: State, steps) -> dict:
         """A local maximum of T max at or near a (T max of z < a >= b): the vertex
         of the parabola through (s, T max) of the three, in arclength s from a
-        along its tangent, then correctors at the vertex, each replacing the
-        lowest of the three, until T max changes by less than PEAK_TOL."""
+        along its tangent, then correctors at the vertex, each keeping the highest
+        point and its neighbours in s (a bracket), until T max changes by less
+        than PEAK_TOL."""
         Y = lambda o: np.concatenate([o.X, [o.f1_Hz]])  # noqa: E731
         s_z = float((self.w**2 * st.tau) @ (Y(z) - Y(a)))
         pts = [(s_z, z.tension_max_N, z.f1_Hz), (0.0, a.tension_max_N, a.f1_Hz),
@@ -407,12 +473,17 @@ class Branch:
             probes += 1
             if got is None:
                 break
-            _, f1, _, _, tension = got
+            _, f1, _, _, tension, _ = got
             T = float(self.m.q.tension_N(tension).max())
             previous = best
             if T > best[1]:
                 best, located = (sv, T, f1), "refined"
-            pts[int(np.argmin(y))] = (sv, T, f1)
+            # the highest of the four and its neighbours on either side in s: a bracket
+            # (dropping the lowest could drop the only point beyond the vertex)
+            pts = sorted(pts + [(sv, T, f1)])
+            top = int(np.argmax([p[1] for p in pts]))
+            top = min(max(top, 1), len(pts) - 2)
+            pts = pts[top - 1:top + 2]
             if abs(T / previous[1] - 1) <= PEAK_TOL:
                 break
         return {"f1_Hz": best[2], "tension_max_N": best[1], "kind": "peak", "located": located,
@@ -427,7 +498,7 @@ class Branch:
             if got is None:
                 raise SolverError(f"continuation: the corrector failed while bisecting a "
                                   f"{kind} between {a.f1_Hz:.5f} and {b.f1_Hz:.5f} Hz")
-            X, f1, its, res, _ = got
+            X, f1, its, res, _, _ = got
             o = self.m.finish(X, f1, self.m.rotation(f1), its, res, time.perf_counter(), steps)
             return o.f1_Hz, o.multipliers, o
 
