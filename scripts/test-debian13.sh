@@ -43,8 +43,9 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$PKGS" ]; then
     "apt-get update -q && apt-get install -y -q --no-install-recommends $(echo $PKGS)"
   # SALib (rawehelix study's Sobol' indices) is not packaged by Debian; its
   # dependencies are, so pip adds SALib alone
-  cert=(); [ -f "$ROOT/etc/rawehelix-host-ca.crt" ] && cert=(--cert /etc/rawehelix-host-ca.crt)
-  chroot "$ROOT" pip install -q --break-system-packages --no-deps "${cert[@]}" "SALib==1.5.1"
+  # (Debian 13's pip verifies by OpenSSL's store, truststore: SSL_CERT_FILE, not --cert)
+  cert=(); [ -f "$ROOT/etc/rawehelix-host-ca.crt" ] && cert=(SSL_CERT_FILE=/etc/rawehelix-host-ca.crt)
+  chroot "$ROOT" env "${cert[@]}" pip install -q --break-system-packages --no-deps "SALib==1.5.1"
   echo "$PKGS" > "$stamp"
 fi
 
