@@ -346,3 +346,48 @@ def test_a_failed_period_with_the_law_names_its_convexity_limit():
     m = AlphaMap(p)
     with pytest.raises(SolverError, match="convex only while the curvature"):
         m.period(m.X_stationary, 11.5)
+
+
+def _convexity_ratio(m, orbit, law, EA_N) -> float:
+    """The largest kappa^2 a^2 EA / EI(T) over one period of ``orbit`` at the
+    Lagrange nodes: the identified law's stored energy is convex in (eps, kappa)
+    only where it is below 1 (parameters.EILaw.failure_hint).  kappa = |r''| of
+    each element's cubic through its four nodes (p = 3), T the rod's tension."""
+    q = m.q
+    worst = []
+
+    def on_step(probes):
+        fields = probes.fields()
+        s, r, T = fields["s"], fields["r"], q.tension_N(fields["tension"])
+        for e in range(0, len(s) - 1, 3):
+            cubics = [np.polyder(np.polyfit(s[e:e + 4], r[e:e + 4, d], 3), 2) for d in range(3)]
+            kappa = np.linalg.norm([np.polyval(c, s[e:e + 4]) for c in cubics], axis=0) / q.L0
+            worst.append(np.max(kappa**2 * law.a_Nm2_per_N**2 * EA_N / law.EI_Nm2(T[e:e + 4])))
+
+    m.period(orbit.X, orbit.f1_Hz, on_step=on_step)
+    return max(worst)
+
+
+@pytest.mark.slow
+def test_the_paper_resonance_lies_where_the_identified_law_is_not_convex():
+    """Why the identified law has no Fig. 8 resonance (docs/physics.md): on the
+    paper model's own orbit near the resonance peak (12.59 Hz, T max 562.6 N,
+    N = 4) the curvature passes the law's convexity limit sqrt(EI(T) / EA) / a
+    (measured: kappa^2 a^2 EA / EI(T) up to 19.7; 18.0 at 11.5 Hz, 2.9 at
+    8 Hz), while at 3 Hz, on the flat part of the curve, it stays far inside it
+    (0.021; 0.15 at 5 Hz): the law's energy cannot carry the resonance, whatever
+    the solver."""
+    import rawehelix as rh
+    from rawehelix.parameters import EILaw
+    from rawehelix.solvers.orbits import AlphaMap
+
+    p = rh.load_scene("mobile_end", elements=4)
+    law = EILaw(a_Nm2_per_N=34.88, b_Nm2=2303.0)
+    m = AlphaMap(p)
+    orbit = m.orbit(m.X_stationary, 11.5, lead_in=5)
+    for f1 in (11.8, 12.1, 12.3, 12.45, 12.59):  # the upper stable branch
+        orbit = m.orbit(orbit.X, f1)
+    assert orbit.tension_max_N == pytest.approx(562.58, rel=1e-4) and orbit.stable
+    assert _convexity_ratio(m, orbit, law, p.helix.EA_N) > 4.0
+    low = m.orbit(m.X_stationary, 3.0, lead_in=3)
+    assert _convexity_ratio(m, low, law, p.helix.EA_N) < 0.1
