@@ -129,6 +129,18 @@ def _fold(summary):
     return float(summary["folds"][0]["f1_Hz"])
 
 
+def _peak(field: str):
+    """The highest local maximum of T max along the orbits (``peaks`` of kind peak)."""
+    def pick(summary):
+        found = [x for x in summary["peaks"] if x["kind"] == "peak"]
+        if not found:
+            f = [p["f1_Hz"] for p in summary["branch"]]
+            raise QuantityError(f"T max has no peak along the branch in f1 = {min(f):g}-"
+                                f"{max(f):g} Hz")
+        return float(max(found, key=lambda x: x["tension_max_N"])[field])
+    return pick
+
+
 def _tension_max(summary):
     point = summary["points"][0]
     return _given(point.get("tension_max_N"),
@@ -158,6 +170,10 @@ QUANTITIES = {q.name: q for q in [
              "f1 of the largest T max of the sweep over the scene's [sweep] list (Fig. 8)"),
     Quantity("fold_Hz", "Hz", "orbits", _fold,
              "f1 of the first fold of the periodic orbits over the [sweep] window"),
+    Quantity("peak_Hz", "Hz", "orbits", _peak("f1_Hz"),
+             "f1 of the highest peak of T max along the orbits over the [sweep] window"),
+    Quantity("peak_tension_N", "N", "orbits", _peak("tension_max_N"),
+             "the highest peak of T max along the orbits over the [sweep] window"),
     Quantity(f"tension_max_N{AT}F1", "N", "sweep@F1", _tension_max,
              "largest tension at s = 0 of the periodic response at f1 = F1 Hz"),
 ]}
