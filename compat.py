@@ -22,6 +22,25 @@ ALPHA2_AS_PETSC_318 = not NEW
 if NEW:
     import basix.ufl
 
+# How long a process waits for another's JIT compilation of the same form before it
+# raises TimeoutError.  DOLFINx's default, 10 s, is shorter than one compilation of
+# the rod's forms on a loaded 2-core machine, so two ranks of a study (each on
+# COMM_SELF) starting on a cold cache could fail where they only had to wait.
+JIT_TIMEOUT_S = 600
+
+
+def _lengthen_jit_timeout(seconds: float):
+    import dolfinx.jit
+    defaults = getattr(dolfinx.jit, "DOLFINX_DEFAULT_JIT_PARAMETERS", None)
+    if defaults is None:  # later DOLFINx names them options
+        defaults = getattr(dolfinx.jit, "DOLFINX_DEFAULT_JIT_OPTIONS", {})
+    if "timeout" in defaults:
+        value, doc = defaults["timeout"]
+        defaults["timeout"] = (max(value, seconds), doc)
+
+
+_lengthen_jit_timeout(JIT_TIMEOUT_S)
+
 
 def interval_coordinate_element():
     """The P1 coordinate element of a 1D interval mesh with gdim 1."""
