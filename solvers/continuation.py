@@ -56,7 +56,11 @@ land at its edge.  The site's multiplier is tracked from point to point
 predicted angle 2 pi (f_n / f1 - k) where a run in the window begins, then
 the one nearest the last one's angle moved by the predicted rotation, so
 that the many other lightly damped multipliers (70 of 156 at N = 4), which
-rotate at other rates, are not taken for it.
+rotate at other rates, are not taken for it.  Only near the linearisation's
+state (the orbit's mean T(0) within LINEAR_SHIFT of its tension,
+:meth:`Site.holds_at`): on the primary resonance's S-curve a site's prediction
+means nothing (at N = 4 the 3:1 site of a 38.1 Hz lateral mode, 12.70 Hz, lies
+on it, and 10 "superharmonic" minima of |mu - 1| were reported there).
 Where |mu - 1| has a minimum at a point of a window (the points before and
 after it farther), the resonance is located by the vertex of the parabola
 through |mu - 1|^2 of the three in f1 (|mu - 1|^2 ~ (1 - |mu|)^2 + theta^2,
@@ -90,6 +94,7 @@ LIGHT = 0.5  # multipliers of modulus below this are not a site's (damped over a
 SITE_ANGLE = 0.5  # a site's multiplier: within this of its predicted angle [rad]
 RUN = 200  # the points a site's multiplier is tracked over (the last of the branch)
 SUPERHARMONIC_ORDERS = (2, 3)  # k of the k:1 resonances the sites are made for
+LINEAR_SHIFT = 0.1  # sites act on orbits whose mean T(0) is within this of the linearised one
 FOLD_MARGIN = 0.02  # natural steps only while every multiplier is this far from +1
 NATURAL_STEP = 0.25  # a natural step moves f1 by at most this fraction of itself
 SLOW = 6  # two correctors in a row of this many iterations turn to natural steps
@@ -101,6 +106,7 @@ class Site:
 
     f_n_Hz: float
     k: int
+    tension_N: float | None = None  # T(0) of the linearised state (None: not checked)
 
     @property
     def f1_Hz(self) -> float:
@@ -113,13 +119,24 @@ class Site:
     def near(self, f1: float) -> bool:
         return abs(f1 / self.f1_Hz - 1.0) <= SITE_WINDOW
 
+    def holds_at(self, orbit: Orbit) -> bool:
+        """The orbit's mean tension at s = 0 is within LINEAR_SHIFT of the
+        linearised state's, so f_n (~ sqrt(T) for the lateral modes) has moved
+        by less than the window: on a resonance's S-curve (T several times the
+        stationary) the prediction means nothing."""
+        if self.tension_N is None:
+            return True
+        mean = 0.5 * (orbit.tension_max_N + orbit.tension_min_N)
+        return abs(mean / self.tension_N - 1.0) <= LINEAR_SHIFT
+
 
 def sites_for(frequencies_Hz, f1_lo: float, f1_hi: float,
-              orders=SUPERHARMONIC_ORDERS) -> list[Site]:
-    """The k:1 sites f_n / k of the natural frequencies f_n inside [f1_lo, f1_hi];
+              orders=SUPERHARMONIC_ORDERS, tension_N: float | None = None) -> list[Site]:
+    """The k:1 sites f_n / k of the natural frequencies f_n inside [f1_lo, f1_hi]
+    (of the linearisation about a state whose tension at s = 0 is ``tension_N``);
     sites closer than a tenth of the window (a lateral pair) are one."""
     out = []
-    for site in sorted((Site(float(f), int(k)) for f in frequencies_Hz for k in orders
+    for site in sorted((Site(float(f), int(k), tension_N) for f in frequencies_Hz for k in orders
                         if f1_lo <= f / k <= f1_hi), key=lambda x: x.f1_Hz):
         if not out or site.f1_Hz / out[-1].f1_Hz - 1.0 > 0.1 * SITE_WINDOW:
             out.append(site)
@@ -137,7 +154,7 @@ def track(site: Site, points) -> list:
     for o in points:
         mu = np.asarray(o.multipliers)
         mu = mu[np.abs(mu) >= LIGHT]
-        if not site.near(o.f1_Hz) or mu.size == 0:
+        if not site.near(o.f1_Hz) or mu.size == 0 or not site.holds_at(o):
             out.append(None)
             last = None
             continue

@@ -219,17 +219,20 @@ def period_map(params: Parameters):
     return AlphaMap(params, comm=MPI.COMM_SELF)
 
 
-def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> list[float]:
+def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[float], float]:
     """The lateral natural frequencies [Hz] up to f_max of the scene's linearisation
     about its stationary state, in its scheme, on this rank (``m``: the scene's
-    period map, whose stationary state the spline scheme linearises about)."""
+    period map, whose stationary state the spline scheme linearises about), and
+    that state's tension at s = 0 [N] (where the sites' predictions hold)."""
     from rawehelix.families import LATERAL
     if params.discretisation.scheme == "spline":
         from rawehelix.solvers.spline_galerkin import spectrum
         to_Hz = 1.0 / (2 * np.pi * m.q_base.t_scale)
+        y0 = m.embed(m.X_stationary)
         f = [abs(x.eigenvalue.imag) * to_Hz
-             for x in spectrum.modes(m.system, m.embed(m.X_stationary)) if x.family in LATERAL]
-        return sorted(x for x in f if x <= f_max_Hz)
+             for x in spectrum.modes(m.system, y0) if x.family in LATERAL]
+        T0 = m.q_base.tension_N(m.system.tension(y0, 0.0, s=np.array([0.0])))[0]
+        return sorted(x for x in f if x <= f_max_Hz), float(T0)
     from rawehelix.solvers.response import HarmonicResponse
     from rawehelix.studies.response import natural_modes
     # the FE linearisation about the circle's centre (R1 = 0), as `rawehelix response`;
@@ -239,20 +242,31 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> list[float]:
     if params.model.damping.active:
         params = params.replace(damping={"axial_s": 0.0, "bending_s": 0.0, "torsion_s": 0.0})
     solver = HarmonicResponse.from_stationary(params, MPI.COMM_SELF, scene=params.name)
-    return [x["frequency_Hz"] for x in natural_modes(solver, f_max_Hz, margin=1.0)
-            if x["family"] in LATERAL]
+    T0 = params.normalised().tension_N(solver.modal.stationary_result.tension)[0]
+    return ([x["frequency_Hz"] for x in natural_modes(solver, f_max_Hz, margin=1.0)
+             if x["family"] in LATERAL], float(T0))
 
 
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
                   superharmonics=()):
-    """One window on this rank: (entries, folds, bifurcations, peaks)."""
+    """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
     from rawehelix.solvers.continuation import Branch, sites_for
+    from rawehelix.solvers.snes import SolverError
 
     start_f1, stop_f1 = window
     lo, hi = sorted(window)
     m = period_map(params)
-    sites = (sites_for(driven_frequencies(params, m, max(superharmonics) * hi), lo, hi,
-                       superharmonics) if superharmonics else ())
+    sites, about = (), {"sites": []}
+    if superharmonics:
+        try:
+            f_n, T0 = driven_frequencies(params, m, max(superharmonics) * hi)
+        except SolverError as err:  # the step control's aid only: trace without it, and say so
+            about["sites_error"] = (f"superharmonic sites not computed ({err}); the T max "
+                                    f"step alone, which may step over a narrow superharmonic "
+                                    f"resonance")
+        else:
+            sites = sites_for(f_n, lo, hi, superharmonics, tension_N=T0)
+            about["sites"] = [{"f1_Hz": x.f1_Hz, "f_n_Hz": x.f_n_Hz, "order": x.k} for x in sites]
     branch = Branch(m, tension_step=tension_step, sites=sites)
     stored = store.load() if store else None
     if stored:
@@ -273,7 +287,7 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
     branch.trace(None, stop_f1, max_points=max_points, progress=each,
                  on_point=store.save if store else None)
     entries = [o.entry() for o in branch.points]
-    return entries, branch.folds, branch.bifurcations, branch.peaks
+    return entries, branch.folds, branch.bifurcations, branch.peaks, about
 
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
@@ -344,7 +358,7 @@ class _Stopped(Exception):
 def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
     """The windows' pieces in order, with T max on both sides of each cut."""
     branch, folds, bifurcations, found, info, junctions = [], [], [], [], [], []
-    for k, (entries, f, b, p) in enumerate(pieces):
+    for k, (entries, f, b, p, sites) in enumerate(pieces):
         if k > 0:
             left, right, x = branch[-2:], entries[0], cuts[k][0]
             if len(left) < 2:
@@ -359,7 +373,7 @@ def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
         folds += f
         bifurcations += b
         found += p
-        info.append({"rank": k, "f1_Hz": cuts[k], "points": len(entries)})
+        info.append({"rank": k, "f1_Hz": cuts[k], "points": len(entries), **sites})
     disc = params.discretisation
     spline = disc.scheme == "spline"
     return OrbitsResult(scene=params.name, title=params.title, elements=disc.elements,
@@ -379,6 +393,9 @@ def report(result: OrbitsResult) -> str:
     lines.append(f"  largest Floquet multiplier modulus: "
                  f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
                  f"{len(unstable)}")
+    for w in s["windows"]:
+        if "sites_error" in w:
+            lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
     defects = [p["defects"] for p in s["branch"] if "defects" in p]
     if defects:  # carried entries (hysteretic torsion: z, solvers/floquet.py)
         internal = [p["internal_multipliers"] for p in s["branch"]

@@ -4,6 +4,7 @@ of the period map, and the orbit against the brute-force periodic response."""
 import numpy as np
 import pytest
 import scipy.linalg
+from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.solvers.forced import FEBackend
@@ -504,7 +505,7 @@ def test_the_branch_locates_period_doubling_and_neimark_sacker(kind):
     assert bif["probes"] <= 12
 
 
-@pytest.mark.parametrize("with_sites", [True, False])
+@pytest.mark.parametrize("with_sites", [True, False, "far from the linearised state"])
 def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     """A stand-in map whose multiplier pair 0.95 exp(+-2 pi i 10 Hz / f1) passes +1
     at f1 = 5 Hz (2:1 of a 10 Hz mode): with the site named, the steps near it
@@ -512,19 +513,22 @@ def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     to 1e-3 Hz, |mu - 1| there = 1 - 0.95; another mode's pair passing nearer +1
     inside the window (at 4.867 Hz) is not taken for the site's (the tracking);
     without the site the T max step alone (T max is linear here) steps over it
-    and reports nothing."""
+    and reports nothing, and so does a site whose linearised state's tension is
+    not the orbits' (their mean T(0) ~ 75 N here; the site's 50 N: a prediction
+    that holds nowhere on the branch, as on a resonance's S-curve)."""
     from rawehelix.solvers.continuation import Branch, Site, sites_for
 
     m = _LinearMap("superharmonic")
     first = m.finish(m.fixed(4.6), 4.6, 0.0, 1, 0.0, 0.0)
-    sites = sites_for([10.0], 4.6, 5.4) if with_sites else ()
-    assert list(sites) == ([Site(10.0, 2)] if with_sites else [])
+    T0 = 50.0 if with_sites == "far from the linearised state" else 75.0
+    sites = sites_for([10.0], 4.6, 5.4, tension_N=T0) if with_sites else ()
+    assert list(sites) == ([Site(10.0, 2, T0)] if with_sites else [])
     assert sites_for([10.0, 10.0002], 4.6, 5.4) == [Site(10.0, 2)]  # a lateral pair: one site
     branch = Branch(m, ds=0.2, ds_max=0.5, sites=sites)
     points = branch.trace(first, 5.4)
     found = [p for p in branch.peaks if p["kind"] == "superharmonic"]
     f = np.array([p.f1_Hz for p in points])
-    if not with_sites:
+    if with_sites is not True:
         assert not found and np.max(np.diff(f)) > 0.2
         return
     (res,) = found
@@ -583,3 +587,23 @@ def test_the_branch_crosses_the_quasi_static_band_in_natural_steps(alpha_map):
     alone = m.orbit(m.X_stationary, last.f1_Hz, lead_in=3)
     assert alone.tension_max_N == pytest.approx(last.tension_max_N, rel=1e-7)
     assert alone.tension_min_N == pytest.approx(last.tension_min_N, rel=1e-7)
+
+
+def test_orbits_without_their_sites_say_so(monkeypatch):
+    """The superharmonic sites come from a modal solve (SLEPc's PEP did not close
+    at N = 4 with the extensible kinematics); when it fails the branch is traced
+    with the T max step alone and the summary and the report say so, instead
+    of the whole command failing (or tracing silently without them)."""
+    from rawehelix.solvers.snes import SolverError
+    from rawehelix.studies import orbits
+
+    def fail(*args):
+        raise SolverError("SLEPc PEP found 88 of 90 eigenpairs")
+
+    params = rh.load_scene("mobile_end", elements=4, degree=3, overrides=SCENE)
+    monkeypatch.setattr(orbits, "driven_frequencies", fail)
+    got = orbits.compute(params, 9.0, 9.2, comm=MPI.COMM_SELF)
+    (window,) = got.windows
+    assert window["sites"] == [] and "88 of 90" in window["sites_error"]
+    assert len(got.branch) >= 2 and got.branch[-1]["f1_Hz"] > 9.2
+    assert "warning, f1 9:9.2 Hz: superharmonic sites not computed" in orbits.report(got)
