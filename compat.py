@@ -41,6 +41,39 @@ def _lengthen_jit_timeout(seconds: float):
 
 _lengthen_jit_timeout(JIT_TIMEOUT_S)
 
+# FFCx takes a form's C file, created exclusively, as the lock of its compilation,
+# and its ".c.cached" as the sign that it is done.  A process killed while it
+# compiles (a study stopped with SIGKILL, to be resumed) leaves the lock behind,
+# and every later process would wait JIT_TIMEOUT_S for it, then fail.  A lock this
+# old with no result is such a leftover (a compilation of the rod's forms takes
+# under a minute on a loaded machine).
+JIT_STALE_S = 180
+
+
+def clear_stale_jit_locks(older_than_s: float = JIT_STALE_S) -> list:
+    """Set aside (as ``.c.stale``) FFCx's locks without a result older than
+    ``older_than_s`` in DOLFINx's JIT cache; returns their paths."""
+    import os
+    import time
+    from pathlib import Path
+
+    import dolfinx.jit
+    cache = Path(dolfinx.jit.get_parameters()["cache_dir"])
+    now, cleared = time.time(), []
+    for lock in cache.glob("libffcx_*.c") if cache.is_dir() else ():
+        try:
+            stale = (not lock.with_suffix(".c.cached").exists()
+                     and now - lock.stat().st_mtime > older_than_s)
+            if stale:
+                os.replace(lock, lock.with_suffix(".c.stale"))
+                cleared.append(lock)
+        except FileNotFoundError:  # another process finished or cleared it meanwhile
+            pass
+    return cleared
+
+
+clear_stale_jit_locks()
+
 
 def interval_coordinate_element():
     """The P1 coordinate element of a 1D interval mesh with gdim 1."""

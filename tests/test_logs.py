@@ -69,3 +69,35 @@ def test_stationary_on_a_cold_cache_prints_nothing_on_stderr(tmp_path):
     """
     assert _run(code, tmp_path) == []
     assert (tmp_path / "out" / "summary.json").is_file()
+
+
+def test_a_killed_compilation_does_not_hold_up_the_next_run():
+    """FFCx's lock of a compilation (the exclusive C file) left by a process killed
+    while it compiled is set aside once it is older than compat.JIT_STALE_S, so
+    that the next run (a study resumed after SIGKILL) compiles instead of waiting
+    for it and failing; a fresh lock, or one with its result, is left alone."""
+    import os
+    import time
+    from pathlib import Path
+
+    import dolfinx.jit
+
+    from rawehelix import compat
+
+    cache = Path(dolfinx.jit.get_parameters()["cache_dir"])
+    cache.mkdir(parents=True, exist_ok=True)
+    tag = f"libffcx_forms_test{os.getpid()}"
+    dead, live, done = (cache / f"{tag}{k}.c" for k in ("dead", "live", "done"))
+    for path in (dead, live, done):
+        path.write_text("")
+    done.with_suffix(".c.cached").write_text("")
+    old = time.time() - 2 * compat.JIT_STALE_S
+    for path in (dead, done):
+        os.utime(path, (old, old))
+    try:
+        cleared = compat.clear_stale_jit_locks()
+        assert dead in cleared and live not in cleared and done not in cleared
+        assert dead.with_suffix(".c.stale").exists() and live.exists() and done.exists()
+    finally:
+        for path in cache.glob(f"{tag}*"):
+            path.unlink()
