@@ -374,9 +374,10 @@ def test_time_integrating_quantities_equal_the_single_run_api():
 @pytest.mark.slow
 def test_orbit_quantities_equal_the_single_run_api():
     """The orbits stage gives rh.orbits's first fold and its highest peak of
-    T max, exactly (N = 4, the window 11.5-12.75 Hz past the fold at 12.70 Hz);
-    with 2 % bending damping the branch has no fold, and the point says so
-    while its peak is still given (the peak T max below the undamped one)."""
+    T max, exactly (N = 4, the window 11.5-12.75 Hz over the peak at 12.59 Hz
+    and the fold at 12.70 Hz); with 2 % bending damping the branch has no fold
+    (10.9-11.5 Hz, over its peak at 11.17 Hz), and the point says so while its
+    peak is still given (measured 280.8 N against the undamped 562.6 N)."""
     window = {"sweep.f1_start_Hz": 11.5, "sweep.f1_stop_Hz": 12.75}
     scene = rh.load_scene("mobile_end", elements=4, overrides=window)
     wanted = ["fold_Hz", "peak_Hz", "peak_tension_N"]
@@ -386,9 +387,11 @@ def test_orbit_quantities_equal_the_single_run_api():
     peak = max((x for x in s["peaks"] if x["kind"] == "peak"), key=lambda x: x["tension_max_N"])
     assert got["values"] == {"fold_Hz": s["folds"][0]["f1_Hz"], "peak_Hz": peak["f1_Hz"],
                              "peak_tension_N": peak["tension_max_N"]}
-    assert got["values"]["fold_Hz"] == pytest.approx(12.7003, abs=1e-3)
+    assert got["values"]["fold_Hz"] == pytest.approx(12.7003, abs=1e-2)
+    assert got["values"]["peak_Hz"] == pytest.approx(12.591, abs=1e-2)
     damped = quantities.evaluate(rh.load_scene("mobile_end", elements=4, overrides={
-        "sweep.f1_start_Hz": 10.0, "sweep.f1_stop_Hz": 12.75, "damping.bending_s": 2e-3}), wanted)
+        "sweep.f1_start_Hz": 10.9, "sweep.f1_stop_Hz": 11.5, "damping.bending_s": 2e-3}), wanted)
     assert "no fold" in damped["errors"]["fold_Hz"], damped["errors"]
     assert set(damped["errors"]) == {"fold_Hz"}
-    assert damped["values"]["peak_tension_N"] < 0.9 * got["values"]["peak_tension_N"]
+    assert damped["values"]["peak_Hz"] == pytest.approx(11.17, abs=0.05)
+    assert damped["values"]["peak_tension_N"] < 0.6 * got["values"]["peak_tension_N"]
