@@ -29,11 +29,16 @@ if NEW:
 JIT_TIMEOUT_S = 600
 
 
+def jit_options() -> dict:
+    """DOLFINx's JIT options in force (0.5: "parameters", 0.9: "options")."""
+    import dolfinx.jit
+    return dolfinx.jit.get_options() if NEW else dolfinx.jit.get_parameters()
+
+
 def _lengthen_jit_timeout(seconds: float):
     import dolfinx.jit
-    defaults = getattr(dolfinx.jit, "DOLFINX_DEFAULT_JIT_PARAMETERS", None)
-    if defaults is None:  # later DOLFINx names them options
-        defaults = getattr(dolfinx.jit, "DOLFINX_DEFAULT_JIT_OPTIONS", {})
+    defaults = (dolfinx.jit.DOLFINX_DEFAULT_JIT_OPTIONS if NEW
+                else dolfinx.jit.DOLFINX_DEFAULT_JIT_PARAMETERS)
     if "timeout" in defaults:
         value, doc = defaults["timeout"]
         defaults["timeout"] = (max(value, seconds), doc)
@@ -57,8 +62,7 @@ def clear_stale_jit_locks(older_than_s: float = JIT_STALE_S) -> list:
     import time
     from pathlib import Path
 
-    import dolfinx.jit
-    cache = Path(dolfinx.jit.get_parameters()["cache_dir"])
+    cache = Path(jit_options()["cache_dir"])
     now, cleared = time.time(), []
     for lock in cache.glob("libffcx_*.c") if cache.is_dir() else ():
         try:

@@ -80,11 +80,9 @@ def test_a_killed_compilation_does_not_hold_up_the_next_run():
     import time
     from pathlib import Path
 
-    import dolfinx.jit
-
     from rawehelix import compat
 
-    cache = Path(dolfinx.jit.get_parameters()["cache_dir"])
+    cache = Path(compat.jit_options()["cache_dir"])
     cache.mkdir(parents=True, exist_ok=True)
     tag = f"libffcx_forms_test{os.getpid()}"
     dead, live, done = (cache / f"{tag}{k}.c" for k in ("dead", "live", "done"))
