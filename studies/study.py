@@ -283,7 +283,10 @@ def scatter_png(path: Path, result: StudyResult):
     """Each quantity (rows) against each key (columns), the base point marked."""
     plt = writers._pyplot()
     nq, nv = len(result.wanted), len(result.variables)
-    fig, axes = plt.subplots(nq, nv, figsize=(3.4 * nv + 0.6, 2.6 * nq + 0.6), squeeze=False)
+    # each key's column shares its range: a quantity given at one point alone keeps it
+    # (at least 6.4 in wide, so that one key's column keeps the whole title)
+    fig, axes = plt.subplots(nq, nv, figsize=(max(3.4 * nv + 0.6, 6.4), 2.6 * nq + 0.6),
+                             squeeze=False, sharex="col")
     X = result.keys_of()
     base = result.records.get("base")
     for i, name in enumerate(result.wanted):
