@@ -115,9 +115,16 @@ def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
     f = np.array([p["f1_Hz"] for p in branch])
     T = np.array([p["tension_max_N"] for p in branch])
     stable = np.array([p["stable"] for p in branch])
-    for k in range(len(f) - 1):
-        solid = stable[k] and stable[k + 1]
-        ax.plot(f[k:k + 2], T[k:k + 2], "-" if solid else "--", color="C0", lw=1.6)
+    # a segment is solid where both its ends are stable; each run of like segments is
+    # one line, so that the dashes of a densely traced unstable branch still show
+    solid = stable[:-1] & stable[1:]
+    k = 0
+    while k < len(solid):
+        end = k
+        while end + 1 < len(solid) and solid[end + 1] == solid[k]:
+            end += 1
+        ax.plot(f[k:end + 2], T[k:end + 2], "-" if solid[k] else "--", color="C0", lw=1.6)
+        k = end + 1
     ax.plot([], [], "-", color="C0", label="stable orbits")
     ax.plot([], [], "--", color="C0", label="unstable orbits")
     if folds:

@@ -608,3 +608,35 @@ def test_orbits_without_their_sites_say_so(monkeypatch):
     assert window["sites"] == [] and "88 of 90" in window["sites_error"]
     assert len(got.branch) >= 2 and got.branch[-1]["f1_Hz"] > 9.2
     assert "warning, f1 9:9.2 Hz: superharmonic sites not computed" in orbits.report(got)
+
+
+def test_the_diagram_draws_each_run_of_stability_as_one_line(tmp_path):
+    """orbits.png: a run of unstable points is one dashed line (drawn point by point,
+    a densely traced unstable branch showed no dashes), stable runs solid."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from rawehelix.studies import orbits
+
+    stable = [True] * 5 + [False] * 40 + [True] * 5
+    branch = [{"f1_Hz": 10.0 + 0.01 * k, "tension_max_N": 100.0 + k, "stable": s}
+              for k, s in enumerate(stable)]
+    drawn = []
+    real_plot = matplotlib.axes.Axes.plot
+
+    def plot(self, *args, **kwargs):
+        lines = real_plot(self, *args, **kwargs)
+        drawn.extend(line for line in lines if len(line.get_xdata()) > 1)
+        return lines
+
+    matplotlib.axes.Axes.plot = plot
+    try:
+        orbits.diagram_png(tmp_path / "o.png", branch, [], [], "test")
+    finally:
+        matplotlib.axes.Axes.plot = real_plot
+        plt.close("all")
+    assert [(line.get_linestyle(), len(line.get_xdata())) for line in drawn] == [
+        ("-", 5), ("--", 42), ("-", 5)]
+    assert (tmp_path / "o.png").stat().st_size > 5_000
