@@ -238,7 +238,7 @@ class Branch:
     """A branch of orbits traced by pseudo-arclength continuation."""
 
     def __init__(self, alpha_map: PeriodMap, ds: float = 0.1, ds_min: float = 1e-4,
-                 ds_max: float = 0.5, tol: float = 1e-7, max_it: int = 8,
+                 ds_max: float = 2.0, tol: float = 1e-7, max_it: int = 8,
                  tension_step: float = TENSION_STEP, sites=(), angle_step: float = ANGLE_STEP):
         if not alpha_map.controller:
             raise SolverError("continuation: a scene without the controller's integral action "
