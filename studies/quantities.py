@@ -122,10 +122,15 @@ def _resonance(summary):
     return _given(summary.get("resonance_Hz"), "no periodic point of the sweep has a T max")
 
 
+def _along(summary) -> str:
+    """The orbits' f1 range, for a quantity that the branch does not give."""
+    f = [p["f1_Hz"] for p in summary["branch"]]
+    return f"in f1 = {min(f):g}-{max(f):g} Hz"
+
+
 def _fold(summary):
     if not summary["folds"]:
-        f = [p["f1_Hz"] for p in summary["branch"]]
-        raise QuantityError(f"the branch has no fold in f1 = {min(f):g}-{max(f):g} Hz")
+        raise QuantityError(f"the branch has no fold {_along(summary)}")
     return float(summary["folds"][0]["f1_Hz"])
 
 
@@ -134,9 +139,7 @@ def _peak(field: str):
     def pick(summary):
         found = [x for x in summary["peaks"] if x["kind"] == "peak"]
         if not found:
-            f = [p["f1_Hz"] for p in summary["branch"]]
-            raise QuantityError(f"T max has no peak along the branch in f1 = {min(f):g}-"
-                                f"{max(f):g} Hz")
+            raise QuantityError(f"T max has no peak along the branch {_along(summary)}")
         return float(max(found, key=lambda x: x["tension_max_N"])[field])
     return pick
 
