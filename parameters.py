@@ -395,9 +395,9 @@ class Sweep:
     f1_stop_Hz: float = 15.0  # last f1 (included when on the step) [Hz]
     f1_step_Hz: float = 0.5  # step [Hz]
     lead_in_s: float = 10.0  # simulated time before the first point of a chunk is judged [s]
-    periodic_tolerance: float = 1.0e-3  # change of per-period T max, T min / (T max - T min)
+    periodic_tolerance: float = 1.0e-3  # remainder of the transient / (T max - T min)
     min_periods: int = 4  # periods integrated at each f1 before judging periodicity
-    max_periods: int = 200  # cap; a point that hits it is flagged not periodic
+    max_periods: int = 500  # cap; a point that hits it is flagged not periodic
     record_periods: int = 4  # periods over which max, min and mean tension are taken
     samples_per_period: int = 64  # tension samples per forcing period
 

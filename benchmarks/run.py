@@ -225,7 +225,7 @@ LEVERS = {
     "0. before: UFL's quadrature, full Newton (rtol 1e-8)":
         (-1, {"ts_jacobian_reuse": 0.0, "ts_snes_rtol": 1e-8}),
     "1. + quadrature 3p": (0, {"ts_jacobian_reuse": 0.0, "ts_snes_rtol": 1e-8}),
-    "2. + reused Jacobian and LU (rate 0.1, rtol 1e-6): the sweep's default":
+    "2. + reused Jacobian and LU (rate 0.1, rtol 1e-6): the sweep's default until 2026-12-02":
         (0, {"ts_jacobian_reuse": 0.1, "ts_snes_rtol": 1e-6}),
 }
 

@@ -89,7 +89,7 @@ BISECTION_MAX = 12  # probes per bisection
 PEAK_PROBES = 8  # correctors per peak refinement
 PEAK_TOL = 1e-6  # a peak's T max located to this relative change between two vertices
 SITE_WINDOW = 0.05  # the step control acts within this relative distance of a site's f1
-ANGLE_STEP = 0.3  # within a window: the angle's change per step over |mu - 1|
+ANGLE_STEP = 0.5  # within a window: the angle's change per step over |mu - 1|
 LIGHT = 0.5  # multipliers of modulus below this are not a site's (damped over a period)
 SITE_ANGLE = 0.5  # a site's multiplier: within this of its predicted angle [rad]
 RUN = 200  # the points a site's multiplier is tracked over (the last of the branch)
@@ -97,6 +97,7 @@ SUPERHARMONIC_ORDERS = (2, 3)  # k of the k:1 resonances the sites are made for
 LINEAR_SHIFT = 0.1  # sites act on orbits whose mean T(0) is within this of the linearised one
 FOLD_MARGIN = 0.02  # natural steps only while every multiplier is this far from +1
 NATURAL_STEP = 0.25  # a natural step moves f1 by at most this fraction of itself
+STOP_TOL = 1e-9  # relative: a point this near the window's end ends the trace
 SLOW = 6  # two correctors in a row of this many iterations turn to natural steps
 
 
@@ -317,13 +318,15 @@ class Branch:
             Y = Y - scipy.linalg.lu_solve(lu, r)
         return None
 
-    def _natural(self, prev: Orbit, st: State) -> Orbit | None:
+    def _natural(self, prev: Orbit, st: State, f1_stop: float) -> Orbit | None:
         """The next point by shooting at the predictor's f1 (natural parameter), from
         the predictor's state, with the monodromy at each start of the shooting's
         Newton (:meth:`PeriodMap.orbit`) and the scheme's own steps per period at that
-        f1; None if it fails.  The step moves f1 by at most NATURAL_STEP of itself
-        (``st.ds`` is cut to match)."""
-        cap = NATURAL_STEP * prev.f1_Hz / max(abs(st.tau[-1]), 1e-300)
+        f1; None if it fails.  The step moves f1 by at most NATURAL_STEP of itself,
+        and not past ``f1_stop`` (``st.ds`` is cut to match): at 0.5 Hz a period is
+        the dearest of the curve, and one past the window cost 46 s of 505 at N = 8."""
+        room = abs(f1_stop - prev.f1_Hz)
+        cap = min(NATURAL_STEP * prev.f1_Hz, room) / max(abs(st.tau[-1]), 1e-300)
         st.ds = max(self.ds_min, min(st.ds, cap))
         Y = np.concatenate([prev.X, [prev.f1_Hz]]) + st.ds * st.tau
         f1 = float(Y[-1])
@@ -370,7 +373,10 @@ class Branch:
         lo, hi = sorted((self.points[0].f1_Hz, f1_stop))
         n = self.points[0].X.size
         last = self.points[-1]
-        if len(self.points) > 1 and not (lo <= last.f1_Hz <= hi):
+        def done(f1):  # out of the window, or at its end (where a natural step lands)
+            return not (lo <= f1 <= hi) or abs(f1 - f1_stop) <= STOP_TOL * f1_stop
+
+        if len(self.points) > 1 and done(last.f1_Hz):
             return self.points  # a resumed branch that had already left the window
         while len(self.points) < max_points:
             prev, st = self.points[-1], self.state
@@ -378,7 +384,7 @@ class Branch:
             steps = self.m.steps_per_period(prev.f1_Hz)
             natural = st.natural and far_from_folds(prev.multipliers)
             if natural:  # the corrector was slow and no fold is near: shooting at the next f1
-                orbit = self._natural(prev, st)
+                orbit = self._natural(prev, st, f1_stop)
                 got = None if orbit is None else (orbit.X, orbit.f1_Hz, orbit.newton_iterations,
                                                   orbit.residual, None, True)
             else:
@@ -418,7 +424,7 @@ class Branch:
                 on_point(orbit, events, self.state)
             if progress:
                 progress(orbit)
-            if not (lo <= f1 <= hi):
+            if done(f1):
                 break
         return self.points
 

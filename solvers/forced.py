@@ -4,6 +4,11 @@ One :class:`DynamicsSolver` serves a whole chunk of a sweep.  Each forcing
 frequency restarts the time integrator from the given state at the start of
 its periods, with the first step ``time.dt_s``; so a point continued in memory
 and a point resumed from its predecessor's saved state take the same steps.
+Within one frequency the periods continue the integration: alpha2's restart
+(two half backward-Euler steps for the acceleration, PETSc's TSAlpha_Restart)
+perturbs the state by O(dt), and done every period it moved the periodic state
+below 1.5 Hz, where a transient decays by 4 % a period, by 30 % of the
+oscillation T max - T min (docs/orbits.md, "The sweep against the orbits").
 States are :class:`~rawehelix.solvers.state.RodState`; the backend reads and
 writes no files (``pack``/``unpack`` convert to and from plain arrays)."""
 
@@ -29,12 +34,14 @@ class FEBackend:
     #: cannot get below its tolerance however small the step; a Newton failure
     #: still cuts the step (by 4), with no limit on their count over a sweep;
     #: and modified Newton: one LU for many fixed steps (snes.ReusedJacobian),
-    #: rebuilt when an iteration contracts |F| by less than 10x; its linear rate
-    #: needs a Newton tolerance matched to the step's own error: 1e-6 moves T
-    #: max at 10 Hz by 2e-5 relative and halves the cost (docs/speed.md).
+    #: rebuilt when an iteration contracts |F| by less than 10x, at rtol 1e-8.
+    #: (At 1e-6 its error, ~3e-5 of T a period and not periodic, kept the 1 Hz
+    #: point 0.2-0.5 of its oscillation off the orbit for 400 periods; 1e-8 costs
+    #: x1.19 at 10 Hz, N = 8, and the same at 1 Hz, N = 4: docs/orbits.md,
+    #: "The sweep against the orbits".)
     #: ``FULL_NEWTON`` switches it off (the converge study's reference runs).
     OPTIONS = {"ts_adapt_type": "none", "ts_max_snes_failures": -1, "ts_snes_max_it": 25,
-               "ts_jacobian_reuse": 0.1, "ts_snes_rtol": 1.0e-6}
+               "ts_jacobian_reuse": 0.1, "ts_snes_rtol": 1.0e-8}
     FULL_NEWTON = {"ts_jacobian_reuse": 0.0, "ts_snes_rtol": 1.0e-8}
 
     def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None):
@@ -44,6 +51,7 @@ class FEBackend:
         self.dt = params.time.dt_s / params.normalised().t_scale
         self._stationary = self.solver.state()
         self._motion = (params.ends.circle_frequency_Hz, 0.0)
+        self._last = None  # (the state the last advance returned, the motion it ran)
 
     def stationary(self) -> RodState:
         """The state the solver was built with: stationary, top at phase 0, at rest."""
@@ -53,18 +61,29 @@ class FEBackend:
         """The circle of Eq. (70) at f1, at phase 0 at the normalised time t_start."""
         self._motion = (f1_Hz, t_start)
 
+    def continues(self, state: RodState) -> bool:
+        """True if ``state`` is what the last :meth:`advance` returned, at the same
+        circle: the integration goes on from the solver's own state (with its
+        acceleration) instead of restarting."""
+        return self._last is not None and state is self._last[0] and self._last[1] == self._motion
+
     def advance(self, state: RodState, t0: float, t1: float, t_out):
         solver = self.solver
-        solver.set_state(dataclasses.replace(state, t=t0))
-        solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
+        restart = not self.continues(state)
+        self._last = None  # until this advance has succeeded
+        if restart:
+            solver.set_state(dataclasses.replace(state, t=t0))
+            solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
         ts = solver.ts
+        ts.setTime(t0)  # (the sum of the steps may differ from t0 by round-off)
         # uniform steps of at most time.dt_s that end exactly at t1: no step is
         # cut to land on a sample time (a cut step costs a third Newton
         # iteration and spoils the next step's predictor); the tension is
         # recorded at every step and interpolated to t_out
         step = (t1 - t0) / math.ceil((t1 - t0) / self.dt - 1e-9)
         ts.setTimeStep(step)
-        ts.restartStep()
+        if restart:
+            ts.restartStep()
         samples = [(t0, solver.probes.value("tension0"))]  # (above 31 Hz a step > T/64)
 
         def record(s):
@@ -75,7 +94,9 @@ class FEBackend:
         times = np.array([t for t, _ in samples])
         values = np.array([v for _, v in samples])
         tension = np.interp(np.asarray(t_out), times, values) if len(times) else np.full(len(t_out), np.nan)
-        return solver.state(), tension
+        out = solver.state()
+        self._last = (out, self._motion)
+        return out, tension
 
     @staticmethod
     def pack(state: RodState) -> dict:
