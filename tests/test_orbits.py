@@ -162,6 +162,35 @@ def test_sweep_periodicity_test_finds_the_orbit_at_1_hz():
     assert abs(point.tension_min_N - orbit.tension_min_N) <= 2e-3 * oscillation
 
 
+@pytest.fixture(scope="module")
+def converged_map():
+    """N = 8, p = 3, dt = 0.5 ms: the converged discretisation of Fig. 8."""
+    return AlphaMap(rh.load_scene("mobile_end", elements=8, degree=3,
+                                  overrides={"torque.rise_time_s": 0.05, "sweep.lead_in_s": 1.0}))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("f1", [9.0, 11.5, 13.0, 14.5])  # upper branch below the peak; lower above
+def test_stable_branch_is_the_brute_force_sweep_at_the_converged_n(converged_map, f1):
+    """Issue 13 test 1 at N = 8: on both sides of the peak (9 and 11.5 Hz on the
+    upper branch, 13 and 14.5 Hz on the lower one, outside the bistable 11.97-12.70
+    Hz), the orbit's T max and T min equal the brute-force sweep point's, with the
+    sweep's own backend, test and tolerance (1e-3 of T max - T min), from the
+    stationary state: measured within 9e-6 of T max and 5.6e-4 of the
+    oscillation (at 11.5 Hz; 64-381 periods)."""
+    m = converged_map
+    orbit = m.orbit(m.X_stationary, f1, lead_in=5)
+    assert orbit.residual <= 1e-7 and orbit.stable
+    backend = FEBackend(m.params)
+    point, _, _ = periodic_response(backend, m.params.normalised(), f1, backend.stationary(), 0.0,
+                                    m.params.sweep, True)
+    assert point.periodic
+    assert orbit.tension_max_N == pytest.approx(point.tension_max_N, rel=1e-4)
+    oscillation = orbit.tension_max_N - orbit.tension_min_N
+    assert abs(orbit.tension_max_N - point.tension_max_N) <= 1e-3 * oscillation
+    assert abs(orbit.tension_min_N - point.tension_min_N) <= 1e-3 * oscillation
+
+
 def test_continuation_points_are_orbits_and_the_command_writes_the_branch(alpha_map, tmp_path):
     """A short branch (9.0 -> 9.25 Hz, N = 4): every point is a fixed point of
     the period map (direct shooting at its f1 finds the same T max to 1e-6),
