@@ -94,16 +94,20 @@ class ChordAlpha(AlphaMap):
         """T(0) (normalised) of the configuration u (one rank): Eq. (29) at s = 0."""
         return self._sigma * (math.sqrt(float(np.dot(d := self._D @ u, d))) - 1.0)
 
-    def run(self, t0, h, steps, u, v):
-        """``steps`` steps of h from (u, v) at t0, with alpha2's start: the final (u, v)
-        and the tension at s = 0 after every step (normalised, the start's first)."""
+    def run(self, t0, h, steps, u, v, a=None):
+        """``steps`` steps of h from (u, v) at t0, with alpha2's start (or from the
+        acceleration ``a``, a run continued): the final (u, v) and the tension at
+        s = 0 after every step (normalised, the start's first); the final
+        acceleration is ``self.acceleration``."""
         tension = np.empty(steps + 1)
         tension[0] = self.tension0(u)
-        a = self.start(t0, h, u, v)
+        if a is None:
+            a = self.start(t0, h, u, v)
         history = []  # the last stage values, newest first
         for k in range(steps):
             u, v, a, z = self.solve_stage(t0 + k * h, h, u, v, a, self.predict(history, u, v, a, h))
             history = [z] + history[:self.order]
             tension[k + 1] = self.tension0(u)
+        self.acceleration = a
         return u, v, tension
 

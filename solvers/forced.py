@@ -112,8 +112,10 @@ class ChordBackend(FEBackend):
     step loop instead of PETSc TS: the same scheme, start and uniform steps, so
     the same numbers to the Newton tolerance; one rank, dense LU (small N).
     Where the TS path cuts a step after a Newton failure, this one raises
-    SolverError.  Not the sweep's backend: it is 1.8x faster, not the 5x of
-    issue 12 (docs/speed.md, section 5); ``chord`` options go to ChordAlpha."""
+    SolverError.  Like the TS path it continues within a frequency (alpha2's
+    start only at a new state or circle).  Not the sweep's backend: it is 1.8x
+    faster, not the 5x of issue 12 (docs/speed.md, section 5); ``chord``
+    options go to ChordAlpha."""
 
     def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None,
                  **chord):
@@ -124,14 +126,19 @@ class ChordBackend(FEBackend):
 
     def advance(self, state: RodState, t0: float, t1: float, t_out):
         solver, form = self.solver, self.solver.form
-        solver.set_state(dataclasses.replace(state, t=t0))
-        solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
+        a = self.stepper.acceleration if self.continues(state) else None
+        self._last = None  # until this advance has succeeded
+        if a is None:
+            solver.set_state(dataclasses.replace(state, t=t0))
+            solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
         steps = math.ceil((t1 - t0) / self.dt - 1e-9)
         h = (t1 - t0) / steps
-        u, v, tension = self.stepper.run(t0, h, steps, form.u.x.array.copy(), form.v.x.array.copy())
+        u, v, tension = self.stepper.run(t0, h, steps, form.u.x.array.copy(), form.v.x.array.copy(),
+                                         a=a)
         form.u.x.array[:] = u
         form.v.x.array[:] = v
         times = t0 + h * np.arange(steps + 1)
         out = solver.rod.get_state(form.u, form.v, t1)
         out.offset = float(form.offset.value)
+        self._last = (out, self._motion)
         return out, np.interp(np.asarray(t_out), times, tension)

@@ -117,6 +117,30 @@ def test_chord_step_loop_equals_petsc_alpha2():
     assert np.max(np.abs(T_wrong - T_ts)) > 1e-3 * np.max(np.abs(T_ts))
 
 
+@pytest.mark.parametrize("kind", ["ts", "chord"])
+def test_the_backends_continue_within_a_frequency(kind):
+    """Issue 13: a sweep point's periods continue the integration.  Two advances
+    of 100 steps at 10 Hz (N = 4), the second from the state the first returned,
+    equal one advance of 200 steps: to round-off on the TS path (measured 5e-15
+    in U), to the chord's tolerance on the chord loop (2.8e-12); the second from
+    a copy of that state restarts alpha2, whose backward-Euler start moves U by
+    1.2e-5, which the sweep had done every period."""
+    from rawehelix.solvers.forced import ChordBackend
+    params = scene.load("mobile_end", elements=4, degree=3)
+    backend = (FEBackend(params, MPI.COMM_SELF, options=FEBackend.FULL_NEWTON) if kind == "ts"
+               else ChordBackend(params, MPI.COMM_SELF, tol=1e-12))
+    backend.set_frequency(10.0, 0.0)
+    t1, t2 = 100 * backend.dt, 200 * backend.dt
+    whole, _ = backend.advance(backend.stationary(), 0.0, t2, [t2])
+    half, _ = backend.advance(backend.stationary(), 0.0, t1, [t1])
+    assert backend.continues(half) and not backend.continues(half.copy())
+    continued, _ = backend.advance(half, t1, t2, [t2])
+    half, _ = backend.advance(backend.stationary(), 0.0, t1, [t1])
+    restarted, _ = backend.advance(half.copy(), t1, t2, [t2])
+    assert abs(continued.w - whole.w).max() <= (1e-13 if kind == "ts" else 1e-10)
+    assert abs(restarted.w - whole.w).max() > 1e-6
+
+
 def test_chord_step_that_does_not_converge_raises():
     """A step that cannot meet the stopping test raises SolverError (one
     iteration allowed: the contraction is never measured), and so does a
