@@ -124,7 +124,8 @@ def test_the_backends_continue_within_a_frequency(kind):
     equal one advance of 200 steps: to round-off on the TS path (measured 5e-15
     in U), to the chord's tolerance on the chord loop (2.8e-12); the second from
     a copy of that state restarts alpha2, whose backward-Euler start moves U by
-    1.2e-5, which the sweep had done every period."""
+    1.2e-5 (PETSc 3.18; 4e-7 with 3.22's TSALPHA2, Debian 13), which the sweep
+    had done every period."""
     from rawehelix.solvers.forced import ChordBackend
     params = scene.load("mobile_end", elements=4, degree=3)
     backend = (FEBackend(params, MPI.COMM_SELF, options=FEBackend.FULL_NEWTON) if kind == "ts"
@@ -138,7 +139,7 @@ def test_the_backends_continue_within_a_frequency(kind):
     half, _ = backend.advance(backend.stationary(), 0.0, t1, [t1])
     restarted, _ = backend.advance(half.copy(), t1, t2, [t2])
     assert abs(continued.w - whole.w).max() <= (1e-13 if kind == "ts" else 1e-10)
-    assert abs(restarted.w - whole.w).max() > 1e-6
+    assert abs(restarted.w - whole.w).max() > 1e-7
 
 
 def test_chord_step_that_does_not_converge_raises():
