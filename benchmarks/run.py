@@ -27,6 +27,11 @@ sections and keeps the others' last results.
 10. ``orbits``: the cost of a continuation point of the FE periodic orbits at
     N = 4 and 8 (benchmarks/orbits.py), the former full-Newton dense map
     against the chord steps with the sparse tangent, CPU time in one process.
+11. ``curve``: the issue-13 target, the whole Fig. 8 curve by continuation
+    (``rawehelix orbits --f1 15:0.5``, both branches) against the brute-force
+    sweep (``rawehelix sweep --f1 0.5:15:0.5``) at the same N and dt, each a
+    whole command in turn, CPU time of the command (``--curve-repeats`` runs,
+    default 1: about 15 min a run at N = 8).
 """
 
 from __future__ import annotations
@@ -389,7 +394,40 @@ TARGETS = {
     "rtf": {"sec5.2": "real-time factor >= 5 (Sec. 5.2)",
             "sec5.3": "real-time factor >= 5 on one core with T max error <= 1e-3 (issue 12)"},
     "sweep_few": "FE N = 8 over spline N = 2 on the same points <= 0.5 (issue 12)",
+    "curve": "ratio <= 1/5 (issue 13)",
 }
+
+
+def _cpu_of(cmd: list[str]) -> float:
+    """CPU time [s] (user + system) of a command run to its end."""
+    import resource
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def bench_curve(elements: int, repeats: int) -> dict:
+    """Section 11: the whole curve by continuation against the brute-force sweep,
+    one process each, in turn, CPU time of the whole command."""
+    exe = str(Path(sys.executable).with_name("rawehelix"))
+    out = HERE / "curve"
+    cases = {"orbits": ["orbits", "mobile_end", "--elements", str(elements), "--f1", "15:0.5"],
+             "sweep": ["sweep", "mobile_end", "--elements", str(elements), "--f1", "0.5:15:0.5"]}
+    cpu = {k: [] for k in cases}
+    for _ in range(repeats):
+        for key, args in cases.items():
+            shutil.rmtree(out / key, ignore_errors=True)
+            cpu[key].append(_cpu_of([exe, *args, "-o", str(out / key)]))
+    orbits = json.loads((out / "orbits" / "summary.json").read_text())
+    sweep = json.loads((out / "sweep" / "summary.json").read_text())
+    shutil.rmtree(out, ignore_errors=True)
+    result = {"elements": elements, "points": len(orbits["branch"]),
+              "folds_Hz": [f["f1_Hz"] for f in orbits["folds"]],
+              "not_periodic_Hz": sweep["not_periodic_Hz"],
+              **{f"{k}_cpu_s": stats(v) for k, v in cpu.items()}}
+    result["ratio"] = result["orbits_cpu_s"]["median"] / result["sweep_cpu_s"]["median"]
+    return result
 
 
 def bench_orbits(elements) -> dict:
@@ -462,11 +500,18 @@ def markdown(r: dict) -> str:
                      f"{v['f1_Hz']} Hz, CPU time | {c['median']:.2f} s ({c['min']:.2f}-{c['max']:.2f}) "
                      f"against the former {f['median']:.2f} s ({f['min']:.2f}-{f['max']:.2f}): "
                      f"x{v['speedup_point']:.2f} | the whole curve <= 1/5 of the sweep |")
+    c = r.get("curve")
+    if c:
+        lines.append(f"| 11. the whole Fig. 8 curve, both branches, by continuation (`orbits --f1 "
+                     f"15:0.5`, {c['points']} points) against the brute-force sweep (30 points), "
+                     f"N = {c['elements']}, CPU time of each command | "
+                     f"{_spread(c['orbits_cpu_s'])} against {_spread(c['sweep_cpu_s'])}: ratio "
+                     f"{c['ratio']:.2f} | {TARGETS['curve']} |")
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits")
+            "orbits", "curve")
 
 
 def main():
@@ -475,6 +520,7 @@ def main():
     parser.add_argument("--only", default=",".join(SECTIONS),
                         help="comma-separated sections to run")
     parser.add_argument("--sweep-repeats", type=int, default=3)
+    parser.add_argument("--curve-repeats", type=int, default=1)
     args = parser.parse_args()
     quiet()
     repeats = 2 if args.quick else 3
@@ -496,7 +542,8 @@ def main():
                      ("sweep_few", lambda: bench_sweep_few(SWEEP_FEW_F1, repeats)),
                      ("chord", lambda: bench_chord(repeats)),
                      ("study", lambda: study_bench.bench_study(repeats)),
-                     ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8)))):
+                     ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
+                     ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()
