@@ -77,8 +77,9 @@ CRITERION = "remainder of a geometric transient relative to the oscillation"
 OSCILLATION_FLOOR = 1.0e-6
 
 #: changes of the extremes at or below this, relative to the mean tension, are
-#: the integrator's round-off, not a transient (the sweep's steps change T by
-#: ~1e-9 T a period at the orbit, with full Newton at rtol 1e-8)
+#: round-off, not a transient.  (The sweep's Newton at rtol 1e-8 leaves changes
+#: of ~8e-9 T a period at 1 Hz, N = 4; that noise is judged like a transient, so
+#: a tolerance finer than it ends at max_periods, flagged.)
 ROUNDOFF = 1.0e-10
 
 
