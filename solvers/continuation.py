@@ -77,7 +77,6 @@ import time
 import numpy as np
 import scipy.linalg
 
-from rawehelix.solvers import floquet
 from rawehelix.solvers.floquet import Orbit, PeriodMap
 from rawehelix.solvers.snes import SolverError
 
@@ -248,7 +247,6 @@ class Branch:
         if not 0 < tension_step < 1:
             raise SolverError(f"continuation: tension_step {tension_step} must be in (0, 1)")
         self.m = alpha_map
-        self.carried = floquet.carried_of(alpha_map)  # entries the shooting carries (floquet.py)
         self.ds, self.ds_min, self.ds_max, self.tol, self.max_it = ds, ds_min, ds_max, tol, max_it
         self.tension_step = tension_step
         self.sites, self.angle_step = tuple(sites), angle_step  # superharmonic sites
@@ -265,7 +263,7 @@ class Branch:
 
     def _G_f1(self, X, f1, steps, eps=1e-5):
         gf = (self._G(X, f1 + eps, steps)[0] - self._G(X, f1 - eps, steps)[0]) / (2 * eps)
-        gf[self.carried] = 0.0  # carried entries (floquet.py): not on the tangent
+        gf[self.m.carried] = 0.0  # carried entries (floquet.py): not on the tangent
         return gf
 
     def _bordered(self, A, gf, tau):
@@ -273,7 +271,7 @@ class Branch:
         return np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
 
     def _tangent(self, orbit: Orbit, tau_prev, steps):
-        A = floquet.newton_matrix(orbit.monodromy, self.carried)
+        A = self.m.newton_matrix(orbit.monodromy)
         gf = self._G_f1(orbit.X, orbit.f1_Hz, steps)
         K = self._bordered(A, gf, tau_prev)
         rhs = np.zeros(K.shape[0])
@@ -303,15 +301,14 @@ class Branch:
                 log.debug("corrector %d: the period map failed at f1 = %.6f Hz: %s", its, f1, err)
                 return None
             if slow:  # Newton: the monodromy and G_f1 here
-                A = floquet.newton_matrix(Phi, self.carried)
+                A = self.m.newton_matrix(Phi)
                 gf = self._G_f1(X, f1, steps)
                 K, lu, refreshed = self._bordered(A, gf, tau), None, True
-            last, res = res, floquet.shooting_norm(G, X, self.carried)
+            last, res = res, self.m.shooting_norm(G, X)
             log.debug("corrector %d: f1 = %.6f Hz, |G|/|X| = %.3g, ds %.3g%s", its, f1, res,
                       ds, " (fresh monodromy)" if slow else "")
             if res <= self.tol:
-                return (floquet.settle(X, G, self.carried), f1, its, res, tension,
-                        refreshed)
+                return self.m.settle(X, G), f1, its, res, tension, refreshed
             if lu is None:
                 lu = scipy.linalg.lu_factor(K)
             r = np.concatenate([G, [(self.w**2 * tau) @ (Y - Y0) - ds]])

@@ -50,37 +50,6 @@ from rawehelix.errors import SolverError
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
 
 
-def carried_of(period_map) -> np.ndarray:
-    """The map's carried entries (none for a map without the attribute)."""
-    return getattr(period_map, "carried", PeriodMap.carried)
-
-
-def newton_matrix(Phi, carried):
-    """M - I, the carried entries' rows of the monodromy M set to zero."""
-    if carried.size:
-        Phi = Phi.copy()
-        Phi[carried, :] = 0.0
-    return Phi - np.eye(Phi.shape[0])
-
-
-def shooting_norm(G, X, carried) -> float:
-    """|G| / max(1, |X|) over the entries the Newton solves for."""
-    if carried.size:
-        keep = np.ones(X.size, dtype=bool)
-        keep[carried] = False
-        G, X = G[keep], X[keep]
-    return np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
-
-
-def settle(X, G, carried):
-    """X with its carried entries replaced by P's, X_c + G_c (G at X)."""
-    if not carried.size:
-        return X
-    X = X.copy()
-    X[carried] += G[carried]
-    return X
-
-
 @dataclasses.dataclass
 class Orbit:
     """A periodic orbit at one f1 (normalised state, SI outputs)."""
@@ -135,13 +104,27 @@ class PeriodMap:
     carried = np.zeros(0, dtype=int)
 
     def newton_matrix(self, Phi):
-        return newton_matrix(Phi, self.carried)
+        """M - I, the carried entries' rows of the monodromy M set to zero."""
+        if self.carried.size:
+            Phi = Phi.copy()
+            Phi[self.carried, :] = 0.0
+        return Phi - np.eye(Phi.shape[0])
 
     def shooting_norm(self, G, X) -> float:
-        return shooting_norm(G, X, self.carried)
+        """|G| / max(1, |X|) over the entries the Newton solves for."""
+        if self.carried.size:
+            keep = np.ones(X.size, dtype=bool)
+            keep[self.carried] = False
+            G, X = G[keep], X[keep]
+        return np.linalg.norm(G) / max(1.0, np.linalg.norm(X))
 
     def settle(self, X, G):
-        return settle(X, G, self.carried)
+        """X with its carried entries replaced by P's, X_c + G_c (G at X)."""
+        if not self.carried.size:
+            return X
+        X = X.copy()
+        X[self.carried] += G[self.carried]
+        return X
 
     #: the largest defect allowed at an orbit, by name (:meth:`defects`)
     defect_tolerances: dict = {}

@@ -8,6 +8,7 @@ from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.solvers.forced import FEBackend
+from rawehelix.solvers.floquet import PeriodMap
 from rawehelix.solvers.orbits import AlphaMap
 from rawehelix.solvers.periodic import periodic_response
 
@@ -497,7 +498,7 @@ def _rotation(theta):
     return np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
 
 
-class _LinearMap:
+class _LinearMap(PeriodMap):
     """A stand-in for AlphaMap with a period map whose fixed point X*(f1) and
     monodromy M(f1) are known: P(X) = X* + M (X - X*).  ``kind`` picks the
     crossing at f1 = 10.5 Hz: a real multiplier -(0.9 + 0.2 (f1 - 10)) or the
