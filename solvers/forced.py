@@ -67,13 +67,26 @@ class FEBackend:
         acceleration) instead of restarting."""
         return self._last is not None and state is self._last[0] and self._last[1] == self._motion
 
+    def _begin(self, state: RodState, t0: float) -> bool:
+        """Start an advance from ``state`` at t0: the solver set to it and to the
+        circle, unless it :meth:`continues`; True if it restarts.  Until the advance
+        ends (:meth:`_end`), nothing continues (a failed advance leaves the solver
+        elsewhere)."""
+        restart = not self.continues(state)
+        self._last = None
+        if restart:
+            self.solver.set_state(dataclasses.replace(state, t=t0))
+            self.solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
+        return restart
+
+    def _end(self, out: RodState) -> RodState:
+        """The state an advance returns, which the next one may continue."""
+        self._last = (out, self._motion)
+        return out
+
     def advance(self, state: RodState, t0: float, t1: float, t_out):
         solver = self.solver
-        restart = not self.continues(state)
-        self._last = None  # until this advance has succeeded
-        if restart:
-            solver.set_state(dataclasses.replace(state, t=t0))
-            solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
+        restart = self._begin(state, t0)
         ts = solver.ts
         ts.setTime(t0)  # (the sum of the steps may differ from t0 by round-off)
         # uniform steps of at most time.dt_s that end exactly at t1: no step is
@@ -94,9 +107,7 @@ class FEBackend:
         times = np.array([t for t, _ in samples])
         values = np.array([v for _, v in samples])
         tension = np.interp(np.asarray(t_out), times, values) if len(times) else np.full(len(t_out), np.nan)
-        out = solver.state()
-        self._last = (out, self._motion)
-        return out, tension
+        return self._end(solver.state()), tension
 
     @staticmethod
     def pack(state: RodState) -> dict:
@@ -126,11 +137,7 @@ class ChordBackend(FEBackend):
 
     def advance(self, state: RodState, t0: float, t1: float, t_out):
         solver, form = self.solver, self.solver.form
-        a = self.stepper.acceleration if self.continues(state) else None
-        self._last = None  # until this advance has succeeded
-        if a is None:
-            solver.set_state(dataclasses.replace(state, t=t0))
-            solver.set_end_motion(*self._motion)  # the end's velocity: that of the circle now
+        a = None if self._begin(state, t0) else self.stepper.acceleration
         steps = math.ceil((t1 - t0) / self.dt - 1e-9)
         h = (t1 - t0) / steps
         u, v, tension = self.stepper.run(t0, h, steps, form.u.x.array.copy(), form.v.x.array.copy(),
@@ -140,5 +147,4 @@ class ChordBackend(FEBackend):
         times = t0 + h * np.arange(steps + 1)
         out = solver.rod.get_state(form.u, form.v, t1)
         out.offset = float(form.offset.value)
-        self._last = (out, self._motion)
-        return out, np.interp(np.asarray(t_out), times, tension)
+        return self._end(out), np.interp(np.asarray(t_out), times, tension)
