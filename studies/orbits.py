@@ -36,6 +36,7 @@ Not yet: the free twist rotation without a controller
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import time
@@ -117,14 +118,11 @@ def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
     stable = np.array([p["stable"] for p in branch])
     # a segment is solid where both its ends are stable; each run of like segments is
     # one line, so that the dashes of a densely traced unstable branch still show
-    solid = stable[:-1] & stable[1:]
     k = 0
-    while k < len(solid):
-        end = k
-        while end + 1 < len(solid) and solid[end + 1] == solid[k]:
-            end += 1
-        ax.plot(f[k:end + 2], T[k:end + 2], "-" if solid[k] else "--", color="C0", lw=1.6)
-        k = end + 1
+    for solid, run in itertools.groupby(stable[:-1] & stable[1:]):
+        n = len(list(run))  # segments k .. k + n - 1: points k .. k + n
+        ax.plot(f[k:k + n + 1], T[k:k + n + 1], "-" if solid else "--", color="C0", lw=1.6)
+        k += n
     ax.plot([], [], "-", color="C0", label="stable orbits")
     ax.plot([], [], "--", color="C0", label="unstable orbits")
     if folds:
@@ -140,6 +138,16 @@ def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
     return writers._finish(fig, path, title)
 
 
+def _pairs(values) -> list:
+    """Complex numbers as [re, im] pairs (JSON)."""
+    return [[float(m.real), float(m.imag)] for m in values]
+
+
+def _complex(pairs) -> np.ndarray:
+    """The complex numbers of :func:`_pairs`."""
+    return np.array([complex(re, im) for re, im in pairs])
+
+
 class WindowStore:
     """The points of one window in ``DIR/window<k>``: per point ``p<i>.json``
     (entry, multipliers, events) and ``p<i>.npz`` (X), the continuation's state
@@ -153,10 +161,9 @@ class WindowStore:
     def save(self, orbit, events, state):
         k = len(list(self.dir.glob("p*.json")))
         record = {"entry": orbit.entry(), "delta": orbit.delta, "events": events,
-                  "multipliers": [[float(m.real), float(m.imag)] for m in orbit.multipliers]}
+                  "multipliers": _pairs(orbit.multipliers)}
         if orbit.internal_multipliers is not None:  # the carried variables' (floquet.py)
-            record["internal_multipliers"] = [[float(m.real), float(m.imag)]
-                                              for m in orbit.internal_multipliers]
+            record["internal_multipliers"] = _pairs(orbit.internal_multipliers)
         writers.write_npz(self.dir / f"p{k:04d}.npz", {"X": orbit.X})
         writers.write_json(self.dir / f"p{k:04d}.json", record)
         writers.write_npz(self.dir / "state.npz", {**state.arrays(), "index": np.array(k)})
@@ -181,10 +188,10 @@ class WindowStore:
             with np.load(self.dir / f"p{k:04d}.npz") as data:
                 X = data["X"]
             e = record["entry"]
-            mu = np.array([complex(re, im) for re, im in record["multipliers"]])
+            mu = _complex(record["multipliers"])
             internal = record.get("internal_multipliers")
             if internal is not None:
-                internal = np.array([complex(re, im) for re, im in internal])
+                internal = _complex(internal)
             orbits.append(Orbit(f1_Hz=e["f1_Hz"], X=X, delta=record["delta"],
                                 tension_max_N=e["tension_max_N"], tension_min_N=e["tension_min_N"],
                                 multipliers=mu, newton_iterations=e["newton_iterations"],
