@@ -51,6 +51,7 @@ import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
+RAWEHELIX = str(Path(sys.executable).with_name("rawehelix"))  # the venv's command
 FE_SWEEP = {"elements": 8, "degree": 3}  # converged within 1 % (README, Sec. 5.3)
 SWEEP_F1 = [0.5 * k for k in range(1, 31)]  # Fig. 8: 30 points, 0.5-15 Hz
 SWEEP_FEW_F1 = [9.0, 9.5, 10.0]  # a few Fig. 8 points near the resonance
@@ -74,9 +75,8 @@ def _sweep_command(ranks: int, scheme: str, elements: int, f1: list[float], outd
                    petsc: tuple = ()) -> float:
     """Wall time of the whole ``rawehelix sweep`` command (start-up included)."""
     env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
-    exe = str(Path(sys.executable).with_name("rawehelix"))
     spec = f"{f1[0]}:{f1[-1]}:{f1[1] - f1[0]}"
-    cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", exe, "sweep", "mobile_end",
+    cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", RAWEHELIX, "sweep", "mobile_end",
            "--scheme", scheme, "--elements", str(elements), "--f1", spec, "-o", str(outdir),
            *petsc]
     if shutil.which("mpirun") is None:
@@ -410,7 +410,6 @@ def _cpu_of(cmd: list[str]) -> float:
 def bench_curve(elements: int, repeats: int) -> dict:
     """Section 11: the whole curve by continuation against the brute-force sweep,
     one process each, in turn, CPU time of the whole command."""
-    exe = str(Path(sys.executable).with_name("rawehelix"))
     out = HERE / "curve"
     cases = {"orbits": ["orbits", "mobile_end", "--elements", str(elements), "--f1", "15:0.5"],
              "sweep": ["sweep", "mobile_end", "--elements", str(elements), "--f1", "0.5:15:0.5"]}
@@ -418,7 +417,7 @@ def bench_curve(elements: int, repeats: int) -> dict:
     for _ in range(repeats):
         for key, args in cases.items():
             shutil.rmtree(out / key, ignore_errors=True)
-            cpu[key].append(_cpu_of([exe, *args, "-o", str(out / key)]))
+            cpu[key].append(_cpu_of([RAWEHELIX, *args, "-o", str(out / key)]))
     orbits = json.loads((out / "orbits" / "summary.json").read_text())
     sweep = json.loads((out / "sweep" / "summary.json").read_text())
     shutil.rmtree(out, ignore_errors=True)
