@@ -44,10 +44,49 @@ import dataclasses
 import time
 
 import numpy as np
+import scipy.linalg
 
 from rawehelix.errors import SolverError
 
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
+#: a Newton iteration on a held monodromy (a chord) that leaves more than this fraction of
+#: the residual asks for a fresh monodromy at the next iterate
+SLOW_RATE = 0.1
+#: the same for the linear monodromy (PeriodMap.linear_monodromy): a period costs about what
+#: it costs to build, a tenth of a fresh one (N = 8, 4.34 Hz; 1/50 at 0.6 Hz)
+LINEAR_RATE = 0.5
+
+
+class Broyden:
+    """The inverse of a Newton matrix B0 (LU) with Broyden's rank-one updates
+    (the "good" method, Broyden 1965): after a step s that changed the
+    residual by y, B_{k+1} s = y, B_{k+1} - B_k of rank one in the direction s,
+    and by Sherman-Morrison
+
+        H_{k+1} = H_k + (s - H_k y) (s^T H_k) / (s^T H_k y),   H = B^-1,
+
+    kept as H_0 plus the sum of the rank-one terms.  A held monodromy (the
+    last point's, or one from an earlier iterate) is a chord; its updates learn
+    the directions the steps take, where a period of the map costs a tenth of
+    a fresh monodromy (a tangent period of 3n columns)."""
+
+    def __init__(self, B: np.ndarray):
+        self.lu = scipy.linalg.lu_factor(B)
+        self.terms: list[tuple[np.ndarray, np.ndarray]] = []  # (u, v): H += u v^T
+
+    def solve(self, r: np.ndarray, transpose: bool = False) -> np.ndarray:
+        """H r (or H^T r)."""
+        x = scipy.linalg.lu_solve(self.lu, r, trans=1 if transpose else 0)
+        for u, v in self.terms:
+            x += v * (u @ r) if transpose else u * (v @ r)
+        return x
+
+    def update(self, s: np.ndarray, y: np.ndarray):
+        """The secant condition B s = y for the step s that changed the residual by y."""
+        Hy, sH = self.solve(y), self.solve(s, transpose=True)
+        d = s @ Hy
+        if abs(d) > 1e-12 * np.linalg.norm(s) * np.linalg.norm(Hy):
+            self.terms.append((s - Hy, sH / d))
 
 
 @dataclasses.dataclass
@@ -71,6 +110,8 @@ class Orbit:
     defects: dict = dataclasses.field(default_factory=dict)
     #: multipliers of the carried variables, set aside (``PeriodMap.set_aside``; None: none)
     internal_multipliers: np.ndarray | None = dataclasses.field(default=None, repr=False)
+    #: G = P(X) - X - Delta e_alpha at X, from the Floquet period (None: not kept)
+    G: np.ndarray | None = dataclasses.field(default=None, repr=False)
 
     @property
     def max_multiplier(self) -> float:
@@ -154,6 +195,11 @@ class PeriodMap:
                on_step=None):
         raise NotImplementedError
 
+    def linear_monodromy(self, X, f1_Hz: float, steps: int | None = None) -> np.ndarray:
+        """An approximation of the monodromy at X for a first chord (:meth:`orbit`,
+        ``linear``); this scheme has none: a tangent period at X."""
+        return self.period(X, f1_Hz, tangent=True, steps=steps)[2]
+
     def rotation(self, f1_Hz: float) -> float:
         """Delta = alpha_dot* T1: the twist's rotation per period fixed by the
         controller (k1 > 0, Eq. 40); T1 = 1 / (f1 t_scale), normalised."""
@@ -168,12 +214,20 @@ class PeriodMap:
 
     # -- shooting ----------------------------------------------------------------
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
-              steps: int | None = None) -> Orbit:
-        """Newton on G(X) = P(X) - X - Delta e_alpha = 0 (chord: the monodromy is
-        refreshed when an iteration contracts |G| by less than 10x), backtracking:
-        where |G| does not fall after a step (or the period map fails), a chord step
-        is redone from its start with a fresh monodromy and a Newton step is
-        halved, down to BACKTRACK_MIN of itself."""
+              steps: int | None = None, linear: bool = False) -> Orbit:
+        """Newton on G(X) = P(X) - X - Delta e_alpha = 0 with a held monodromy
+        (a chord), improved by Broyden's updates (:class:`Broyden`; with the
+        controller and no carried entries) and refreshed at the next iterate when an
+        iteration leaves more than SLOW_RATE of |G| (the updates only after the
+        others).  ``linear``: the first chord is the scheme's
+        :meth:`linear_monodromy` at X0 (a tenth of a tangent period or less), held
+        while iterations leave at most LINEAR_RATE of |G|.  A neighbouring orbit's
+        monodromy is no chord: between two f1 a shooting is asked for, the lightly
+        damped multipliers rotate by 2 pi f_n d(1/f1), and Newton on it diverged
+        (N = 8, 4.54 -> 4.34 Hz).  Backtracking: where |G| does not fall after a step
+        (or the period map fails), a step on a held monodromy is redone from its
+        start with a fresh one, and a step on a fresh one is halved, down to
+        BACKTRACK_MIN of itself."""
         start = time.perf_counter()
         self.newton_iterations = 0
         X = X0.copy()
@@ -181,10 +235,16 @@ class PeriodMap:
             X, _, _ = self.period(X, f1_Hz)
         e = self.e_alpha
         delta = self.rotation(f1_Hz) if self.controller else 0.0
-        mono, last, its = None, np.inf, 0
+        broyden = self.controller and not self.carried.size
+        held = None  # the Newton matrix's inverse, Broyden-updated (H), or
+        mono = None  # the fresh monodromy (no Broyden)
+        approx = linear and broyden  # the chord is the linear monodromy, not a fresh one
+        if approx:
+            held = Broyden(self.newton_matrix(self.linear_monodromy(X, f1_Hz, steps)))
+        last, its, G_last = np.inf, 0, None
         back = None  # (X, delta, step, fraction, fresh monodromy) of the last step taken
         for its in range(1, max_it + 1):
-            need = mono is None
+            need = held is None and mono is None
             try:
                 G, _, Phi = self.shooting_residual(X, f1_Hz, delta, tangent=need, steps=steps)
                 res = self.shooting_norm(G, X)
@@ -192,8 +252,9 @@ class PeriodMap:
                 G, res = None, np.inf
             if back is not None and not res < last:  # no descent
                 X0_, d0, step, frac, fresh = back
-                if not fresh:  # the chord's monodromy was stale: Newton from there
-                    X, delta, mono, back, last = X0_, d0, None, None, np.inf
+                if not fresh:  # the held monodromy was stale: Newton from there
+                    X, delta, mono, held, back, last = X0_, d0, None, None, None, np.inf
+                    approx = False
                     continue
                 if frac < BACKTRACK_MIN:  # half the Newton step, down to this
                     raise SolverError(f"orbits: shooting at f1 = {f1_Hz} Hz found no descent "
@@ -206,21 +267,28 @@ class PeriodMap:
             if G is None:
                 raise SolverError(f"orbits: the period map failed from the shooting's "
                                   f"start at f1 = {f1_Hz} Hz")
-            if need:
-                mono = Phi
             if res <= tol:
                 X = self.settle(X, G)
                 break
-            A = self.newton_matrix(mono)
-            if res > 0.1 * last and not need:
-                mono = None  # slow: a fresh monodromy at the next iteration
-            last = res
-            if self.controller:
-                step = np.append(np.linalg.solve(A, G), 0.0)
+            if need:
+                mono, approx = Phi, False
+                if broyden:
+                    held, mono = Broyden(self.newton_matrix(Phi)), None
+            stale = res > (LINEAR_RATE if approx else SLOW_RATE) * last and not need  # slow
+            if held is not None and back is not None and not need and not stale:
+                held.update(-back[3] * back[2][:-1], G - G_last)  # the secant of the last step
+            if held is not None:
+                step = np.append(held.solve(G), 0.0)
+            elif self.controller:
+                step = np.append(np.linalg.solve(self.newton_matrix(mono), G), 0.0)
             else:  # unknowns (X, Delta); phase: e . (X - X_prev) = 0.  Without torque
                 # the spin is free too (a family of orbits): the least-squares step
-                K = np.block([[A, -e[:, None]], [e[None, :], np.zeros((1, 1))]])
+                K = np.block([[self.newton_matrix(mono), -e[:, None]],
+                              [e[None, :], np.zeros((1, 1))]])
                 step = np.linalg.lstsq(K, np.concatenate([G, [0.0]]), rcond=None)[0]
+            if stale:
+                mono, held, approx = None, None, False
+            last, G_last = res, G
             back = (X, delta, step, 1.0, need)
             X, delta = X - step[:-1], delta - step[-1]
         else:
@@ -232,7 +300,8 @@ class PeriodMap:
         """The orbit through X: one more period with the tangent gives the
         Floquet multipliers at the orbit itself, and the tension over it."""
         PX, tension, Phi = self.period(X, f1_Hz, tangent=True, steps=steps)
-        defects = self.defects(PX - X - delta * self.e_alpha, X, Phi)
+        G = PX - X - delta * self.e_alpha
+        defects = self.defects(G, X, Phi)
         for name, value in defects.items():
             limit = self.defect_tolerances.get(name)
             if limit is not None and not value <= limit:
@@ -264,5 +333,5 @@ class PeriodMap:
                       residual=float(res), steps=steps or self.steps_per_period(f1_Hz),
                       wall_s=time.perf_counter() - start, monodromy=Phi,
                       symmetry_multiplier=symmetry, defects=defects,
-                      internal_multipliers=internal)
+                      internal_multipliers=internal, G=G)
         return orbit

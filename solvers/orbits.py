@@ -489,6 +489,23 @@ class AlphaMap(PeriodMap):
         period = 1.0 / (f1_Hz * self.q_base.t_scale)  # normalised
         return max(8, math.ceil(period / (self.params.time.dt_s / self.q_base.t_scale) - 1e-9))
 
+    def linear_monodromy(self, X, f1_Hz: float, steps: int | None = None) -> np.ndarray:
+        """S^M: the tangent S of the period's first step from X (at t = 0, h = T1 / M)
+        to the M-th power (by squaring), the monodromy of the scheme on the
+        time-invariant linearisation about that step.  A chord for the shooting
+        (:meth:`PeriodMap.orbit`, ``linear``) where the orbit hardly varies over the
+        period: it turns each lightly damped multiplier by that mode's angle over
+        this T1, which a neighbouring orbit's monodromy does not.  Measured (N = 8,
+        from the orbit at the f1 before): at 4.34 Hz it costs 0.13 s against a
+        tangent period's 1.22 s, its largest multiplier 0.96502 is the exact one
+        to 5 digits, and Newton takes 9 periods instead of 5; at 0.6 Hz 0.16 s
+        against 8.54 s, 0.940 against 0.960, and 8 periods instead of 6."""
+        self.set_frequency(f1_Hz)
+        M = steps or self.steps_per_period(f1_Hz)
+        self._lu = {}
+        _, S = self.step(0.0, 2 * math.pi / self.q.omega1 / M, X, np.eye(3 * self.n))
+        return np.linalg.matrix_power(S, M)
+
     def period(self, X, f1_Hz: float, tangent: bool = False, steps: int | None = None,
                on_step=None):
         """P(X) over one period at f1 (phase 0 at t = 0), the tension at s = 0 at
