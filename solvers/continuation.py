@@ -75,7 +75,6 @@ import logging
 import time
 
 import numpy as np
-import scipy.linalg
 
 from rawehelix.solvers.floquet import SLOW_RATE, Broyden, Orbit, PeriodMap
 from rawehelix.solvers.snes import SolverError

@@ -52,8 +52,8 @@ BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting 
 #: a Newton iteration on a held monodromy (a chord) that leaves more than this fraction of
 #: the residual asks for a fresh monodromy at the next iterate
 SLOW_RATE = 0.1
-#: the same for the linear monodromy (PeriodMap.linear_monodromy): a period costs about what
-#: it costs to build, a tenth of a fresh one (N = 8, 4.34 Hz; 1/50 at 0.6 Hz)
+#: the same for the linear monodromy (PeriodMap.linear_monodromy), which costs about one
+#: period of the map to build, a tenth of a fresh monodromy (N = 8, 4.34 Hz; 1/50 at 0.6 Hz)
 LINEAR_RATE = 0.5
 
 
@@ -197,7 +197,8 @@ class PeriodMap:
 
     def linear_monodromy(self, X, f1_Hz: float, steps: int | None = None) -> np.ndarray:
         """An approximation of the monodromy at X for a first chord (:meth:`orbit`,
-        ``linear``); this scheme has none: a tangent period at X."""
+        ``linear``); a scheme without a cheaper one (the spline reference) gives its
+        tangent period at X, the exact monodromy."""
         return self.period(X, f1_Hz, tangent=True, steps=steps)[2]
 
     def rotation(self, f1_Hz: float) -> float:
