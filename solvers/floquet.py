@@ -195,11 +195,11 @@ class PeriodMap:
                on_step=None):
         raise NotImplementedError
 
-    def linear_monodromy(self, X, f1_Hz: float, steps: int | None = None) -> np.ndarray:
+    def linear_monodromy(self, X, f1_Hz: float, steps: int | None = None):
         """An approximation of the monodromy at X for a first chord (:meth:`orbit`,
-        ``linear``); a scheme without a cheaper one (the spline reference) gives its
-        tangent period at X, the exact monodromy."""
-        return self.period(X, f1_Hz, tangent=True, steps=steps)[2]
+        ``linear``), or None: a scheme without one (the spline reference) shoots
+        from a fresh monodromy, whose tangent period also gives G."""
+        return None
 
     def rotation(self, f1_Hz: float) -> float:
         """Delta = alpha_dot* T1: the twist's rotation per period fixed by the
@@ -217,10 +217,10 @@ class PeriodMap:
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
               steps: int | None = None, linear: bool = False) -> Orbit:
         """Newton on G(X) = P(X) - X - Delta e_alpha = 0 with a held monodromy
-        (a chord), improved by Broyden's updates (:class:`Broyden`; with the
-        controller and no carried entries) and refreshed at the next iterate when an
-        iteration leaves more than SLOW_RATE of |G| (the updates only after the
-        others).  ``linear``: the first chord is the scheme's
+        (a chord; with the controller its LU is held), improved by Broyden's
+        updates (:class:`Broyden`; with the controller and no carried entries) and
+        refreshed at the next iterate when an iteration leaves more than SLOW_RATE
+        of |G| (the updates only after the others).  ``linear``: the first chord is the scheme's
         :meth:`linear_monodromy` at X0 (a tenth of a tangent period or less), held
         while iterations leave at most LINEAR_RATE of |G|.  A neighbouring orbit's
         monodromy is no chord: between two f1 a shooting is asked for, the lightly
@@ -236,12 +236,13 @@ class PeriodMap:
             X, _, _ = self.period(X, f1_Hz)
         e = self.e_alpha
         delta = self.rotation(f1_Hz) if self.controller else 0.0
-        broyden = self.controller and not self.carried.size
-        held = None  # the Newton matrix's inverse, Broyden-updated (H), or
-        mono = None  # the fresh monodromy (no Broyden)
-        approx = linear and broyden  # the chord is the linear monodromy, not a fresh one
+        updates = self.controller and not self.carried.size  # Broyden's, on the held chord
+        held = None  # the Newton matrix's inverse, as a Broyden (with the controller), or
+        mono = None  # the fresh monodromy (without: the bordered least-squares step)
+        chord = self.linear_monodromy(X, f1_Hz, steps) if linear and updates else None
+        approx = chord is not None  # the chord is the linear monodromy, not a fresh one
         if approx:
-            held = Broyden(self.newton_matrix(self.linear_monodromy(X, f1_Hz, steps)))
+            held = Broyden(self.newton_matrix(chord))
         last, its, G_last = np.inf, 0, None
         back = None  # (X, delta, step, fraction, fresh monodromy) of the last step taken
         for its in range(1, max_it + 1):
@@ -272,16 +273,16 @@ class PeriodMap:
                 X = self.settle(X, G)
                 break
             if need:
-                mono, approx = Phi, False
-                if broyden:
-                    held, mono = Broyden(self.newton_matrix(Phi)), None
+                approx = False
+                if self.controller:
+                    held = Broyden(self.newton_matrix(Phi))
+                else:
+                    mono = Phi
             stale = res > (LINEAR_RATE if approx else SLOW_RATE) * last and not need  # slow
-            if held is not None and back is not None and not need and not stale:
+            if updates and back is not None and not need and not stale:
                 held.update(-back[3] * back[2][:-1], G - G_last)  # the secant of the last step
             if held is not None:
                 step = np.append(held.solve(G), 0.0)
-            elif self.controller:
-                step = np.append(np.linalg.solve(self.newton_matrix(mono), G), 0.0)
             else:  # unknowns (X, Delta); phase: e . (X - X_prev) = 0.  Without torque
                 # the spin is free too (a family of orbits): the least-squares step
                 K = np.block([[self.newton_matrix(mono), -e[:, None]],
