@@ -118,15 +118,16 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
     return computed
 
 
-#: estimated simulated time for one point to become periodic after
-#: continuation, beyond its minimum periods [s]; measured on Sec. 5.3 (N = 8):
-#: 1-6 s, longest past the resonance where the response jumps branch
-SETTLE_S = 3.0
+#: estimated forcing periods for one point to become periodic after
+#: continuation, beyond its minimum periods; measured on Sec. 5.3 (N = 8, the
+#: periodicity test of issue 13, 2026-12-03): 200-260 below 3 Hz, 30-130 over
+#: 4.5-12.5 Hz, 180-280 past the resonance where the response jumps branch
+SETTLE_PERIODS = 150
 
 
 def point_cost(f1: float, sweep: Sweep) -> float:
     """Estimated simulated time of one point [s]: the cost model of :func:`chunks`."""
-    return sweep.min_periods / f1 + SETTLE_S
+    return (sweep.min_periods + SETTLE_PERIODS) / f1
 
 
 def chunks(frequencies: list[float], k: int, sweep: Sweep | None = None) -> list[list[float]]:
