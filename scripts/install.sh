@@ -8,6 +8,7 @@ cd "$(dirname "$0")/.."
 
 PKGS="python3-dolfinx python3-petsc4py python3-slepc4py python3-scipy python3-pytest
 python3-venv python3-gmsh python3-meshio python3-h5py python3-matplotlib python3-tqdm
+python3-hypothesis python3-sphinx python3-myst-parser furo
 openmpi-bin make"
 missing=$(dpkg-query -W -f='${Package} ${Status}\n' $PKGS 2>/dev/null \
           | awk '$NF != "installed" {print $1}'; \

@@ -36,7 +36,8 @@ HOST_CA=${SSL_CERT_FILE:-/etc/ssl/certs/ca-certificates.crt}
 
 PKGS="python3-dolfinx python3-slepc4py python3-petsc4py python3-scipy python3-pytest
 python3-meshio python3-gmsh python3-matplotlib python3-h5py python3-tqdm openmpi-bin
-python3-pandas python3-multiprocess python3-pip"
+python3-pandas python3-multiprocess python3-pip python3-hypothesis python3-sphinx
+python3-myst-parser furo"
 stamp="$ROOT/var/lib/rawehelix-packages"
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$PKGS" ]; then
   chroot "$ROOT" /usr/bin/env DEBIAN_FRONTEND=noninteractive bash -c \

@@ -16,6 +16,7 @@ part that does not solve; ``tests/test_report.py`` runs it on synthetic data.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from pathlib import Path
 
@@ -41,7 +42,9 @@ def main(outdir="results", log=print) -> Path:
     """Run the five studies into ``outdir`` and write ``outdir/report.html``."""
     import rawehelix as rh
 
-    outdir = Path(outdir)
+    # Absolute from here on: the pictures are listed from the working directory and
+    # the page resolves them against its own folder, so a relative outdir would count twice.
+    outdir = Path(os.path.abspath(outdir))
     summaries, wall = {}, {}
 
     def step(name, compute):

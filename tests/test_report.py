@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html.parser
+import os
 from pathlib import Path
 
 import pytest
@@ -183,9 +184,12 @@ def test_images_in_lists_pictures(tmp_path):
     assert [p.name for p in demo.images_in(tmp_path)] == ["a.png", "b.gif"]
 
 
-def test_demo_main_runs_the_five_studies(tmp_path, monkeypatch):
+@pytest.mark.parametrize("where", ["absolute", "relative", "relative, from a subfolder"])
+def test_demo_main_runs_the_five_studies(tmp_path, monkeypatch, where):
     """main() against stand-ins for the public API (rh.load_scene, rh.stationary,
-    rh.modes, rh.simulate, rh.sweep): the calls, the folders and the page."""
+    rh.modes, rh.simulate, rh.sweep): the calls, the folders and the page, with the
+    output folder absolute or relative to a working directory that is not its parent
+    (the default ``results`` once failed: every picture got ``results/`` twice)."""
     import rawehelix as rh
     outdir, summaries, _ = _synthetic_demo(tmp_path)
     calls = []
@@ -216,7 +220,14 @@ def test_demo_main_runs_the_five_studies(tmp_path, monkeypatch):
                      }.items():
         monkeypatch.setattr(rh, name, fn, raising=False)
     out = tmp_path / "demo"
+    if where != "absolute":
+        cwd = tmp_path / "elsewhere" if "subfolder" in where else tmp_path
+        cwd.mkdir(exist_ok=True)
+        monkeypatch.chdir(cwd)
+        out = Path(os.path.relpath(out, cwd))
+        assert not out.is_absolute()
     path = demo.main(out, log=lambda *a: None)
+    assert path == tmp_path / "demo" / "report.html"
     assert ("load", "stationary_table2", (("elements", 2), ("scheme", "spline"))) in calls
     assert ("sweep", demo.SWEEP_F1_HZ) in calls
     assert [c[1] for c in calls if c[0] == "write"] == list(demo.STEPS)
