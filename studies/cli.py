@@ -184,7 +184,7 @@ def _overrides(args) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from rawehelix.studies import argv as argv_split, logs
+    from rawehelix.studies import argv as argv_split, logs, outdir_lock
 
     argv = sys.argv[1:] if argv is None else argv
     parser = _parser()
@@ -207,9 +207,14 @@ def main(argv: list[str] | None = None) -> int:
         params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                scheme=args.scheme, overrides=_overrides(args))
         outdir = args.output or Path("results") / params.name / args.command
-        return COMMAND[args.command](rh, params, args, outdir, comm)
+        with outdir_lock.hold(outdir, comm):  # one writer per output folder: exit 2 if held
+            return COMMAND[args.command](rh, params, args, outdir, comm)
     except SceneError as err:
         return _fail(str(err))
+    except outdir_lock.OutputFault as err:  # a full disk: one line, exit 1 (outdir_lock.py)
+        print(f"rawehelix: error: {err}", file=sys.stderr)
+        _abort_other_ranks(comm, 1)
+        return 1
     except rh.SolverError as err:
         print(f"rawehelix: {err}", file=sys.stderr)
         _abort_other_ranks(comm, 1)

@@ -10,8 +10,11 @@ worker), and a slow point holds up no other.  With one rank it is a loop.
 
 Resumable: a task's record is written atomically to ``DIR/points/<id>.json``
 as soon as it is finished; a run started again (after SIGKILL too) skips
-every task whose record exists, and ``DIR/computed.log`` gets one line per
-task computed.  A failed task (the stage raised one of
+every task whose record exists and passes its checks (studies/checkpoints.py:
+checksum, schema, the fingerprint of the study and of the PETSc options; a
+record that fails is set aside into ``DIR/corrupt/`` and computed again),
+and ``DIR/computed.log`` gets one line per task computed.  The directory is
+locked by the run (studies/outdir_lock.py).  A failed task (the stage raised one of
 ``quantities.POINT_ERRORS``) is recorded with its reason and counts as
 finished; so does one that ran past ``point_timeout`` (:func:`time_limit`),
 unless a later run allows it more time.  Any other exception on a rank is a
@@ -22,7 +25,6 @@ end.
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import sys
@@ -35,7 +37,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError
-from rawehelix.studies import writers
+from rawehelix.studies import checkpoints, outdir_lock, writers
 
 HEADER = "study.json"
 
@@ -47,15 +49,27 @@ class Task:
     kind: str = "design"
 
 
+#: what a stored task's record must hold (checkpoints.check_schema)
+SCHEMA = {"id": str, "kind": str, "overrides": dict, "values": dict, "errors": dict,
+          "status": str, "cpu_s": dict, "wall_s": dict}
+
+
 class Store:
-    """The finished tasks of one study in ``outdir`` (see the module docstring)."""
+    """The finished tasks of one study in ``outdir`` (see the module docstring):
+    the directory locked from :meth:`open` on (studies/outdir_lock.py), each
+    record sealed with the header's and the PETSc options' fingerprint and
+    checked when read (studies/checkpoints.py)."""
 
     def __init__(self, outdir, header: dict):
         self.outdir, self.header = Path(outdir), header
         self.points = self.outdir / "points"
+        self.options = checkpoints.petsc_options()
+        self.fingerprint = checkpoints.fingerprint(writers.digest(header), self.options)
 
     def open(self, comm):
-        """Refuse a directory that holds another study, then create it (collective)."""
+        """Lock the directory, refuse one that holds another study, then create it
+        (collective)."""
+        self._lock = outdir_lock.hold(self.outdir, comm)
         path = self.outdir / HEADER
         if writers.claim_directory(path, self.header, comm) is not None:
             raise SceneError("-o", str(self.outdir),
@@ -66,13 +80,26 @@ class Store:
         return self
 
     def finished(self, task_id: str) -> dict | None:
+        """The checked record of the task, or None: not stored, or set aside
+        (corrupt, another run's, other PETSc options: computed again)."""
         path = self.points / f"{task_id}.json"
-        return json.loads(path.read_text()) if path.exists() else None
+        if not path.exists():
+            return None
+        try:
+            record, _ = checkpoints.read(path, self.fingerprint, self.options, SCHEMA)
+            if record["id"] != task_id or record["status"] not in ("ok", "failed"):
+                raise checkpoints.Corrupt(f"holds task {record['id']!r} with status "
+                                          f"{record['status']!r}, not task {task_id!r}")
+        except checkpoints.Corrupt as err:
+            checkpoints.set_aside([path], self.outdir, str(err))
+            return None
+        return record
 
     def save(self, record: dict):
-        writers.write_json(self.points / f"{record['id']}.json", record)
-        with open(self.outdir / "computed.log", "a") as fh:
-            fh.write(f"{record['id']} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}\n")
+        writers.write_json(self.points / f"{record['id']}.json",
+                           checkpoints.seal(record, self.fingerprint, self.options))
+        writers.append_line(self.outdir / "computed.log",
+                            f"{record['id']} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}")
 
 
 def computed(outdir) -> list[str]:
@@ -219,10 +246,13 @@ def run(tasks: list[Task], load, wanted: list[str], store: Store, comm=MPI.COMM_
                 "loop_start_unix": t0, "loop_end_unix": time.time(), "loop_points": len(mine)}
         if counter:
             counter.free()
-    except Exception:  # the machinery failed on this rank: stop every rank
+    except Exception as err:  # the machinery failed on this rank: stop every rank
         if comm.size == 1:
             raise
-        traceback.print_exc()
+        if isinstance(err, outdir_lock.OutputFault):  # a full disk: one line, not a traceback
+            print(f"rawehelix: error: {err}", file=sys.stderr)
+        else:
+            traceback.print_exc()
         sys.stderr.flush()
         comm.Abort(1)
     idle_barrier(comm)

@@ -34,16 +34,84 @@ def digest(data) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def write_text(path: Path, text: str) -> Path:
-    """Write a text file atomically: a reader never sees half a file."""
-    path = Path(path)
+#: a temporary file of write_text or write_npz: ``.NAME.<random>.tmp`` next to NAME
+#: (``.NAME.<pid>.tmp.npz``: write_npz before issue 27); a killed run leaves it
+#: behind and :func:`remove_stale_temps` takes it away when the folder is locked
+TEMP_SUFFIXES = (".tmp", ".tmp.npz")
+
+
+def _temp(path: Path) -> tuple[int, str]:
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    os.chmod(tmp, 0o644)  # mkstemp makes it private; a results file is for everyone to read
-    with os.fdopen(fd, "w", encoding="utf-8") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    return tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_SUFFIXES[0])
+
+
+def _atomic(path: Path, fill) -> Path:
+    """``fill(file)`` writes a temporary file beside ``path``, which then replaces
+    ``path``: a reader never sees half a file.  On any failure (a full disk,
+    Ctrl-C) the temporary file is removed; an OSError of the disk becomes an
+    :class:`OutputFault` naming ``path``."""
+    from rawehelix.studies.outdir_lock import OutputFault
+    path = Path(path)
+    tmp = None
+    try:
+        fd, tmp = _temp(path)
+        os.chmod(tmp, 0o644)  # mkstemp makes it private; a results file is for everyone to read
+        with os.fdopen(fd, "wb") as f:
+            fill(f)
+        os.replace(tmp, path)
+        tmp = None
+    except OSError as err:
+        raise OutputFault.of(err, path) from err
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
     return path
+
+
+def write_text(path: Path, text: str) -> Path:
+    """Write a text file atomically (:func:`_atomic`)."""
+    return _atomic(path, lambda f: f.write(text.encode("utf-8")))
+
+
+def append_line(path: Path, line: str) -> Path:
+    """Append one line to a log file in one write() (a full disk: no half line
+    is left for the next run to append to; :class:`OutputFault`)."""
+    from rawehelix.studies.outdir_lock import OutputFault
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        try:
+            os.write(fd, (line.rstrip("\n") + "\n").encode("utf-8"))
+        finally:
+            os.close(fd)
+    except OSError as err:
+        raise OutputFault.of(err, path) from err
+    return path
+
+
+def remove_stale_temps(folder: Path) -> list[Path]:
+    """Remove the temporary files (TEMP_SUFFIXES) that a killed run left in
+    ``folder`` and its subfolders (points/, window<k>/; no deeper: ``-o .`` must
+    not walk a whole tree); only for the holder of the folder's lock.  Returns them."""
+    removed = []
+    folder = Path(folder)
+    for path in [*folder.glob(".*"), *folder.glob("*/.*")]:
+        if path.is_file() and path.name.endswith(TEMP_SUFFIXES) and path.name.count(".") >= 3:
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    return removed
+
+
+def file_sha256(path: Path) -> str:
+    """The SHA-256 of a file's bytes (hex)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def write_json(path: Path, data: dict) -> Path:
@@ -54,16 +122,24 @@ def write_json(path: Path, data: dict) -> Path:
 def claim_directory(path: Path, header: dict, comm) -> dict | None:
     """A run's header file ``path``: written on rank 0 if absent; if it holds
     another header, that one is returned on every rank (the caller refuses the
-    directory), else None.  Collective."""
+    directory), else None.  A header file that is not JSON (damaged outside a
+    run: its writes are atomic) is set aside with a warning and written again.
+    Collective; the caller holds the folder's lock (studies/outdir_lock.py)."""
     old = None
     if comm.rank == 0:
         path = Path(path)
+        stored = None
         if path.exists():
-            stored = json.loads(path.read_text())
-            if stored != _jsonable(header):
-                old = stored
-        else:
+            try:
+                stored = json.loads(path.read_text())
+            except (ValueError, UnicodeDecodeError) as err:
+                from rawehelix.studies import checkpoints
+                checkpoints.set_aside([path], path.parent, f"not JSON ({err})",
+                                      then="written again")
+        if stored is None:
             write_json(path, header)
+        elif stored != _jsonable(header):
+            old = stored if isinstance(stored, dict) else {"header": stored}
     return comm.bcast(old, root=0)
 
 
@@ -84,8 +160,13 @@ def _finish(fig, path: Path, title: str, dpi: int = 110) -> Path:
     import matplotlib.pyplot as plt
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    try:
+        fig.savefig(path, dpi=dpi)
+    except OSError as err:
+        from rawehelix.studies.outdir_lock import OutputFault
+        raise OutputFault.of(err, path) from err
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -199,13 +280,8 @@ def dynamics_png(path: Path, rows: np.ndarray, target_rpm: float, title: str) ->
 
 
 def write_npz(path: Path, arrays: dict) -> Path:
-    """Write arrays to an .npz atomically."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp.npz")
-    np.savez(tmp, **arrays)
-    os.replace(tmp, path)
-    return path
+    """Write arrays to an .npz atomically (:func:`_atomic`)."""
+    return _atomic(path, lambda f: np.savez(f, **arrays))
 
 
 def frames_xdmf(path: Path, frames) -> Path:
