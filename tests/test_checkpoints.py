@@ -114,10 +114,12 @@ def test_under_mpi_rank_0_holds_the_lock_and_every_rank_gets_the_verdict(tmp_pat
             proc.send_signal(signal.SIGKILL)
             proc.wait()
     comm.Barrier()
-    with outdir_lock.hold(folder / "out", comm):
+    pid = comm.bcast(os.getpid(), root=0)
+    with outdir_lock.hold(folder / "out", comm) as held:
         text = (folder / "out" / outdir_lock.LOCK).read_text()
-        assert text.startswith(f"pid {comm.bcast(os.getpid(), root=0)} ")
-    comm.Barrier()
+        comm.Barrier()  # read on both ranks before rank 0 lets go
+    assert text.startswith(f"pid {pid} ")
+    assert (held._release is not None) == (comm.rank == 0)  # rank 0 alone held the flock
 
 
 # -- writes that fail -------------------------------------------------------------------------
