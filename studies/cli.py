@@ -201,7 +201,8 @@ def main(argv: list[str] | None = None) -> int:
     comm = MPI.COMM_WORLD
     try:
         if args.command == "extremes":
-            return _extremes(args)
+            with outdir_lock.hold(args.output, comm):
+                return _extremes(args)
         if args.command == "labtest":
             return _labtest(rh, args, comm)
         params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,

@@ -33,7 +33,8 @@ class SweepError(ValueError):
 def fingerprint(params: Parameters) -> str:
     """A hash of everything that changes the points: not f1 itself, the f1
     list, the end time nor the output sampling (the time step and the
-    periodicity test do count)."""
+    periodicity test do count).  The directory's identity: each point's own
+    fingerprint folds in the run's PETSc options too (:class:`DirectoryStore`)."""
     data = params.as_dict()
     data["ends"].pop("circle_frequency_Hz")
     data["time"] = {"dt_s": data["time"]["dt_s"]}
