@@ -154,6 +154,10 @@ def set_aside(paths, outdir: Path, reason: str, then: str = "computed again") ->
         except ValueError:
             relative = Path(path.name)
         target = outdir / CORRUPT / stamp / relative
+        n = 1
+        while target.exists():  # set aside twice in one second: keep both
+            target = outdir / CORRUPT / f"{stamp}-{n}" / relative
+            n += 1
         try:
             target.parent.mkdir(parents=True, exist_ok=True)
             os.replace(path, target)

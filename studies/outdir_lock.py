@@ -61,7 +61,7 @@ class OutputFault(OSError):
         return cls(err.errno, err.strerror or str(err), str(err.filename or path))
 
     def __str__(self):
-        return (f"{self.filename}: cannot write it: {self.strerror} (errno {self.errno}); "
+        return (f"{self.filename}: not written: {self.strerror} (errno {self.errno}); "
                 f"free space or use another -o directory, then run the same command again "
                 f"(every point stored so far is kept)")
 

@@ -133,7 +133,7 @@ def test_a_failed_write_leaves_no_temporary_file_and_names_the_file(tmp_path, mo
         raise OSError(errno.ENOSPC, "No space left on device")
     with monkeypatch.context() as m:
         m.setattr(writers.os, "replace", full)
-        with pytest.raises(outdir_lock.OutputFault, match="a.json: cannot write it: No space"):
+        with pytest.raises(outdir_lock.OutputFault, match="a.json: not written: No space"):
             writers.write_json(target, {"new": 2})
     assert json.loads(target.read_text()) == {"old": 1}
 
