@@ -520,3 +520,22 @@ def test_two_sweeps_started_together_on_one_folder(tmp_path):
     peak = json.loads((out / "summary.json").read_text())["peak_tension_N"]
     assert f"{peak:.1f} N" in winner[1]
     assert not (out / outdir_lock.LOCK).exists() and temps(out) == []
+
+
+def test_the_command_line_ends_a_full_disk_with_one_line_and_status_1(tmp_path, monkeypatch,
+                                                                       capsys):
+    """An OSError of the disk inside a command (here raised by the command
+    itself, as matplotlib's savefig would) is one line naming the file, exit 1,
+    and the folder's lock is let go."""
+    from rawehelix.studies import cli
+
+    def full(rh, params, args, outdir, comm):
+        raise OSError(errno.ENOSPC, "No space left on device", str(outdir / "sweep.png"))
+    monkeypatch.setitem(cli.COMMAND, "stationary", full)
+    out = tmp_path / "out"
+    assert cli.main(["stationary", "mobile_end", "--elements", "2", "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"rawehelix: error: {out}/sweep.png: not written: No space left on device "
+                   f"(errno 28); free space or use another -o directory, then run the same "
+                   f"command again (every point stored so far is kept)\n")
+    assert not out.exists()  # the lock made it, nothing was written: removed again
