@@ -354,7 +354,8 @@ def _labtest(rh, args, comm) -> int:
 
 
 def _extremes(args) -> int:
-    from rawehelix.studies import extremes
+    from rawehelix.studies import extremes, outdir as outdir_check
+    outdir_check.check(args.output, "extremes")
     unknown = [c for c in args.cases if c not in extremes.CASES]
     if unknown:
         raise SceneError("extremes", ", ".join(unknown),
