@@ -20,7 +20,7 @@ from rawehelix.studies import outdir, resources
 
 CLI = [sys.executable, "-m", "rawehelix.studies.cli"]
 HUGE = ["--elements", "100000000", "--set", 'discretisation.bending="mixed"']
-FAST_S = 20.0  # a refusal: the imports (~2 s) and no work, on a loaded 2-core machine
+FAST_S = 10.0  # a refusal: the imports (~2 s) and no work, on a loaded 2-core machine
 SMALL_RSS_KB = 400_000  # a refusal's peak RSS: the interpreter and its imports
 
 
@@ -123,6 +123,18 @@ def test_the_shipped_scenes_pass_the_check(name, command):
     """The check refuses nothing that runs: every shipped scene at its own resolution."""
     from rawehelix.studies import scene
     resources.check_run(scene.load(name), command)
+
+
+# -- calibrate's bad input -------------------------------------------------------------
+@pytest.mark.parametrize("args, words", [
+    (["--target", "lateral_frequency_Hz=-5"], ("--target", "must be > 0")),
+    (["--bounds", "helix.EI_Nm2=-100:200", "--target", "lateral_frequency_Hz=5"],
+     ("--bounds", "LO is outside the key's allowed range")),
+    (["--bounds", "helix.EI_Nm2=-100:200", "--target", "lateral_frequency_Hz=1"],
+     ("--bounds", "LO is outside the key's allowed range"))])
+def test_calibrate_bad_input_is_refused_before_any_evaluation(tmp_path, args, words):
+    assert_refused(tmp_path, ["calibrate", "stationary_table2", "--elements", "4", "--fit",
+                              "helix.EI_Nm2", *args, "-o", str(tmp_path / "o")], *words)
 
 
 # -- the output folder -----------------------------------------------------------------
