@@ -35,6 +35,13 @@ def _world(comm):
     return MPI.COMM_WORLD
 
 
+def _resources(scene: Parameters, command: str, f1_Hz=None):
+    """Refuse, before anything is allocated, a run past this machine's memory
+    (:mod:`rawehelix.studies.resources`: one estimate for every command)."""
+    from rawehelix.studies import resources
+    resources.check_run(scene, command, f1_Hz)
+
+
 def load_scene(name_or_path, elements: int | None = None, degree: int | None = None,
                scheme: str | None = None, overrides: dict | None = None) -> Parameters:
     """The validated scene: a TOML file, or the name of a shipped scene
@@ -52,6 +59,7 @@ def stationary(scene: Parameters, comm=None):
     """The stationary state with fixed ends (Sec. 5.1), checked against the
     shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
     with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``."""
+    _resources(scene, "stationary")
     from rawehelix.studies import stationary as study
     return study.compute(scene, _world(comm))
 
@@ -64,6 +72,7 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
     Default: the lowest 3 of each family and the rigid rotation; ``count``:
     the ``count`` slowest modes.  ``scene.discretisation.scheme`` picks FE
     (SLEPc) or the paper's spline scheme."""
+    _resources(scene, "modes")
     from rawehelix.studies import modes as study
     return study.compute(scene, count=count, comm=_world(comm))
 
@@ -78,6 +87,7 @@ def response(scene: Parameters, f1_Hz=None, comm=None):
     the nearest natural mode, ``natural`` (the modes of the same
     linearisation) and ``summary``.  One f1's complex response vector:
     :class:`rawehelix.solvers.response.HarmonicResponse`."""
+    _resources(scene, "response", f1_Hz)
     from rawehelix.studies import response as study
     return study.compute(scene, f1_Hz, comm=_world(comm))
 
@@ -90,6 +100,7 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
     ``tension_s0_N``, ``tension_s1_N``, ``lateral_mid_m``, ``final_state`` and
     ``summary``.  ``options``: PETSc options of the integrator without the
     prefix, e.g. ``{"ts_type": "cn"}``."""
+    _resources(scene, "simulate")
     from rawehelix.studies import simulate as study
     return study.compute(scene, until_s=until_s, comm=_world(comm), options=options,
                          progress=progress)
@@ -103,6 +114,7 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
     ``tension_mean_N``, ``periods``, ``periodic``) and ``summary``.
     ``checkpoint``: a directory that keeps finished points, so that the same
     call resumes a stopped sweep."""
+    _resources(scene, "sweep", f1_Hz)
     from rawehelix.studies import sweep as study
     return study.compute(scene, f1_Hz, comm=_world(comm), checkpoint=checkpoint)
 
@@ -121,6 +133,7 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     ``peaks`` and ``summary``.  ``progress(orbit)`` is called at every point.
     Each rank of ``comm`` traces one f1 window (joined on rank 0); with
     ``outdir`` every point is stored as found and a rerun resumes after the last."""
+    _resources(scene, "orbits")
     from rawehelix.studies import orbits as study
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
@@ -139,8 +152,10 @@ def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=N
     ``fit`` (bending): the intrinsic law EI = a T + b whose simulated test
     reproduces Eq. (64) (``summary["law"]``); ``rod_EI_Nm2``: the rod's constant
     EI (default Eq. (64) at each T_e)."""
-    from rawehelix.studies import labtest as study
+    from rawehelix.studies import labtest as study, resources
     scene = scene if scene is not None else load_scene("stationary_table2")
+    resources.check(study.lab_parameters(scene, elements, degree), "labtest")
+    resources.check_count("--tension/--loads", len(tensions_N or ()) * max(len(loads or ()), 1))
     return study.compute(scene, test, tensions_N=tensions_N, loads=loads, fit=fit,
                          rod_EI_Nm2=rod_EI_Nm2, elements=elements, degree=degree,
                          gravity=gravity, comm=_world(comm))

@@ -95,11 +95,21 @@ def default_segments(normalised: Normalised) -> int:
     return max(1, math.ceil(k / 4.0))
 
 
-def _top_conditions(normalised: Normalised) -> np.ndarray:
+def not_applicable(normalised: Normalised) -> str | None:
+    """Why the planar shooting reference does not apply to a scene, or None."""
     top = normalised.top_position(0.0)  # Eq. (66)
     if abs(top[1]) > 0:
-        raise ValueError("the shooting reference is planar: the top end must have y = 0 "
-                         "(no circle, r1 = 0)")
+        return ("the scene is not planar (the upper end is off the x-z plane, y = "
+                f"{top[1]:.3g} L0: the circle of Eq. (70), r1 > 0); the shooting "
+                "reference needs y = 0")
+    return None
+
+
+def _top_conditions(normalised: Normalised) -> np.ndarray:
+    why = not_applicable(normalised)
+    if why:
+        raise ValueError(f"the shooting reference is planar: {why}")
+    top = normalised.top_position(0.0)  # Eq. (66)
     return np.array([top[0], top[2]])
 
 

@@ -18,6 +18,16 @@ the scaled Jacobian E_ji = d ln Q_j / d ln p_i at the fit (large: the targets
 do not identify the keys), and the linearised standard uncertainty of the
 fitted keys for a relative standard uncertainty u of the targets:
 Cov(ln p) = u^2 (E^T E)^-1 (Gauss-Newton, targets independent).
+
+Success is every target met: |r_j| <= ``tolerance`` (default TOLERANCE =
+1e-3, relative; ``--tolerance``).  The summary's ``status`` is "targets met"
+or "targets missed", ``missed`` names each missed target with its residual,
+and ``active_bounds`` the fitted keys that ended on a bound.  Exit status:
+0 targets met; 3 (``EXIT_UNMET``, "ran, but did not meet its targets"; the
+summary is written); 2 bad input, before any evaluation (an unknown key, a
+bound outside the key's allowed range, which the scene loader checks at
+both ends of each bound, a negative target of a quantity that cannot be
+negative); 1 a scene of the fit failed to solve.
 """
 
 from __future__ import annotations
@@ -32,10 +42,13 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.studies import pool, quantities, writers
-from rawehelix.studies.study import Source, base_value, key_type
+from rawehelix.studies.study import EXIT_UNMET, Source, base_value, key_type
 
 FD_STEP = 1e-3  # forward-difference step of the Jacobian, relative to the scene's value
-RANGE = 1e3  # default bounds: [p0 / RANGE, RANGE p0]
+RANGE = 1e3  # default bounds: [p0 / RANGE, RANGE p0], within the key's allowed range
+TOLERANCE = 1e-3  # a target is met when |Q / target - 1| <= TOLERANCE
+#: units of the quantities that are >= 0 by definition (frequencies, lengths, times)
+NON_NEGATIVE_UNITS = {"Hz": "a frequency", "m": "a length", "s": "a time"}
 
 
 def parse_fit(text: str) -> list[str]:
@@ -56,7 +69,11 @@ def parse_targets(text: str) -> dict:
         if not sep or not math.isfinite(v) or v == 0:
             raise SceneError("--target", item, "must be Q=VALUE with a finite VALUE != 0, e.g. "
                              "lateral_frequency_Hz=5")
-        quantities.parse(name.strip(), "--target")
+        quantity, _ = quantities.parse(name.strip(), "--target")
+        if v < 0 and quantity.unit in NON_NEGATIVE_UNITS:
+            raise SceneError("--target", item, f"{name.strip()} is "
+                             f"{NON_NEGATIVE_UNITS[quantity.unit]} [{quantity.unit}]: "
+                             f"its target must be > 0")
         targets[name.strip()] = v
     return targets
 
@@ -81,6 +98,11 @@ def parse_bounds(items: list[str], fit: list[str]) -> dict:
 class CalibrationResult:
     scene: str
     summary: dict
+
+    @property
+    def exit_status(self) -> int:
+        """0: every target met; EXIT_UNMET: ran, but missed a target."""
+        return 0 if self.summary["success"] else EXIT_UNMET
 
     def write(self, outdir) -> Path:
         outdir = Path(outdir)
@@ -136,21 +158,76 @@ class _Evaluator:
         return np.column_stack([(r - r0) / h[i] for i, r in enumerate(rs)])
 
 
+def _refusal(source: Source, key: str, value: float) -> str | None:
+    """None if the scene loader takes ``value`` for ``key``, else what it allows."""
+    try:
+        source.load({key: float(value)})
+    except SceneError as err:
+        return err.allowed
+    return None
+
+
+def check_bounds(source: Source, bounds: dict):
+    """Both ends of each bound within the key's allowed range (the scene
+    validation of parameters.py, through the loader), before any evaluation."""
+    for key, (lo, hi) in bounds.items():
+        for end, value in (("LO", lo), ("HI", hi)):
+            why = _refusal(source, key, value)
+            if why is not None:
+                raise SceneError("--bounds", f"{key}={lo:g}:{hi:g}",
+                                 f"{end} is outside the key's allowed range ({why})")
+
+
+def default_bounds(source: Source, key: str, p0: float) -> tuple[float, float]:
+    """[p0 / RANGE, RANGE p0] (ordered), each end that the loader refuses moved
+    towards p0 (geometric bisection, 50 halvings) to the last value it takes."""
+    ends = []
+    for end in sorted((p0 / RANGE, p0 * RANGE)):
+        if _refusal(source, key, end) is not None:
+            good, bad = 0.0, 1.0  # exponents t of p0 (end / p0)^t
+            for _ in range(50):
+                mid = 0.5 * (good + bad)
+                good, bad = (mid, bad) if _refusal(source, key, p0 * (end / p0) ** mid) is None \
+                    else (good, mid)
+            end = p0 * (end / p0) ** good
+        ends.append(float(end))
+    return ends[0], ends[1]
+
+
+def active_bounds(x, lower, upper, fit) -> dict:
+    """The fitted keys that ended on a bound (within 1e-6 of the scaled range)."""
+    out = {}
+    for k, xi, lo, hi in zip(fit, x, lower, upper):
+        gap = 1e-6 * (hi - lo)
+        if xi <= lo + gap:
+            out[k] = "lower"
+        elif xi >= hi - gap:
+            out[k] = "upper"
+    return out
+
+
 def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict | None = None,
             uncertainty: float = 0.01, fd_step: float | None = None, comm=MPI.COMM_WORLD,
-            log=None) -> CalibrationResult:
+            log=None, tolerance: float | None = None) -> CalibrationResult:
     """Fit ``fit`` to ``targets`` (collective; the result on every rank);
-    ``fd_step`` None is FD_STEP."""
+    ``fd_step`` None is FD_STEP, ``tolerance`` None is TOLERANCE.  Bad input
+    (SceneError) is refused before any evaluation."""
     from scipy.optimize import least_squares
+
+    from rawehelix.studies import resources
 
     start = time.perf_counter()
     fd_step = FD_STEP if fd_step is None else fd_step
+    tolerance = TOLERANCE if tolerance is None else tolerance
     bounds = bounds or {}
     if not 0 < fd_step < 0.5:
         raise SceneError("--fd-step", fd_step, "must be in (0, 0.5)")
     if not uncertainty > 0:
         raise SceneError("--uncertainty", uncertainty, "must be > 0")
+    if not (0 < tolerance < 1 and math.isfinite(tolerance)):
+        raise SceneError("--tolerance", tolerance, "must be a relative tolerance in (0, 1)")
     params = source.load()
+    resources.check_quantities(params, list(targets), copies=comm.size)
     p0 = []
     for key in fit:
         source.load({key: 1.0})  # an unknown key: the loader's message
@@ -160,10 +237,10 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
                              f"(the unknowns are scaled by it); it is {value!r}")
         p0.append(float(value))
     p0 = np.array(p0)
-    lo = np.array([bounds.get(k, (min(p / RANGE, p * RANGE), max(p / RANGE, p * RANGE)))[0]
-                   for k, p in zip(fit, p0)])
-    hi = np.array([bounds.get(k, (min(p / RANGE, p * RANGE), max(p / RANGE, p * RANGE)))[1]
-                   for k, p in zip(fit, p0)])
+    check_bounds(source, bounds)
+    ranges = [bounds[k] if k in bounds else default_bounds(source, k, p)
+              for k, p in zip(fit, p0)]
+    lo, hi = np.array([r[0] for r in ranges]), np.array([r[1] for r in ranges])
     lower, upper = np.minimum(lo / p0, hi / p0), np.maximum(lo / p0, hi / p0)
     x0 = np.clip(np.ones(len(fit)), lower + 1e-12, upper - 1e-12)
     disc = params.discretisation
@@ -189,18 +266,25 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
     else:
         confidence = {k: None for k in fit}
     values = {q: float(targets[q] * (1 + rj)) for q, rj in zip(ev.wanted, r)}
+    residuals = {q: {"absolute": values[q] - targets[q], "relative": float(rj)}
+                 for q, rj in zip(ev.wanted, r)}
+    missed = {q: rr for q, rr in residuals.items() if not abs(rr["relative"]) <= tolerance}
+    active = active_bounds(res.x, lower, upper, fit)
     summary = {**header, "targets": targets, "start": dict(zip(fit, p0.tolist())),
                "bounds": {k: [float(a), float(b)] for k, a, b in zip(fit, lo, hi)},
-               "fitted": fitted, "values": values,
-               "residuals": {q: {"absolute": values[q] - targets[q], "relative": float(rj)}
-                             for q, rj in zip(ev.wanted, r)},
+               "fitted": fitted, "values": values, "residuals": residuals,
+               "tolerance": tolerance,
+               "tolerance_meaning": "a target is met when |Q / target - 1| <= tolerance",
+               "status": "targets missed" if missed else "targets met",
+               "missed": missed, "active_bounds": active,
                "scaled_jacobian": E.tolist(),
                "scaled_jacobian_meaning": "d ln Q_j / d ln p_i (rows: quantities, columns: "
                                           "fitted keys), forward differences",
                "condition_number": cond,
                "target_uncertainty": uncertainty, "confidence": confidence,
                "confidence_meaning": "linearised 1-sigma: Cov(ln p) = u^2 (E^T E)^-1",
-               "fd_step": fd_step, "success": bool(res.success), "message": res.message,
+               "fd_step": fd_step, "success": not missed,
+               "optimizer_success": bool(res.success), "message": res.message,
                "nfev": int(res.nfev), "njev": int(res.njev or 0),
                "evaluations_now": ev.evaluations, "ranks": comm.size,
                "wall_s": time.perf_counter() - start}
@@ -225,4 +309,13 @@ def report(result: CalibrationResult) -> str:
         lines.append(f"  {q} = {s['values'][q]:.6g} (target {s['targets'][q]:g}, "
                      f"relative residual {rr['relative']:+.2e})")
     lines.append(f"  condition number of the scaled Jacobian: {s['condition_number']:.3g}")
+    for q, rr in s["missed"].items():
+        lines.append(f"  missed: {q} is {rr['relative']:+.3g} relative ({rr['absolute']:+.4g}) "
+                     f"from its target, past the tolerance {s['tolerance']:g}")
+    for k, side in s["active_bounds"].items():
+        lo, hi = s["bounds"][k]
+        lines.append(f"  bound active: {k} = {s['fitted'][k]:.6g} ended on the {side} end of "
+                     f"the scaled range, bounds [{lo:g}, {hi:g}]")
+    lines.append(f"  status: {s['status']}" + (f" (exit status {EXIT_UNMET})" if s["missed"]
+                                                else f" within {s['tolerance']:g}"))
     return "\n".join(lines)

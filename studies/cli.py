@@ -12,7 +12,7 @@
     rawehelix study SCENE --vary KEY=START:STOP:COUNT [--vary ...] [--sample grid|lhs|sobol
                     --points N] --quantity Q[,Q...] [--fd-step h] [--point-timeout S] [-o DIR]
     rawehelix calibrate SCENE --fit KEY[,KEY...] --target Q=VALUE[,...] [--bounds KEY=LO:HI]
-                    [--uncertainty REL] [-o DIR]
+                    [--uncertainty REL] [--tolerance REL] [-o DIR]
 
 SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
 ``nominal_operation``, ``mobile_end``).  ``--set KEY=VALUE`` sets any dotted
@@ -20,7 +20,11 @@ scene key.  Options that argparse does not know go to PETSc, with or without
 a value (``-rawehelix_snes_monitor``, ``-rawehelix_snes_linesearch_type bt``);
 put them after the scene.  ``-v`` shows more (``-vv`` everything).  Bad input
 exits with status 2 and one message naming file, key and what is allowed;
-nothing is written.  A failed solve exits with status 1.
+nothing is written (the output folder, the memory and the disk a run needs
+are checked before it starts: studies/outdir.py, studies/resources.py).  A
+failed solve exits with status 1.  A study with failed points, or a
+calibration that missed a target by more than its tolerance, writes its
+results and exits with status 3.
 """
 
 from __future__ import annotations
@@ -100,6 +104,9 @@ def _parser() -> argparse.ArgumentParser:
             p.add_argument("--uncertainty", type=float, default=0.01, metavar="REL",
                            help="relative standard uncertainty of the targets, for the "
                                 "linearised confidence (default 0.01)")
+            p.add_argument("--tolerance", type=float, default=None, metavar="REL",
+                           help="a target is met within this relative residual (default "
+                                "1e-3); missed: exit status 3")
         if name == "orbits":
             p.add_argument("--f1", required=True, metavar="START:STOP",
                            help="the f1 window in Hz, traced from START towards STOP")
@@ -184,7 +191,7 @@ def _overrides(args) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from rawehelix.studies import argv as argv_split, logs, outdir_lock
+    from rawehelix.studies import argv as argv_split, logs, outdir as outdir_check, outdir_lock
 
     argv = sys.argv[1:] if argv is None else argv
     parser = _parser()
@@ -208,6 +215,7 @@ def main(argv: list[str] | None = None) -> int:
         params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                scheme=args.scheme, overrides=_overrides(args))
         outdir = args.output or Path("results") / params.name / args.command
+        outdir_check.check(outdir, args.command)
         with outdir_lock.hold(outdir, comm):  # one writer per output folder: exit 2 if held
             return COMMAND[args.command](rh, params, args, outdir, comm)
     except SceneError as err:
@@ -251,7 +259,8 @@ def _modes(rh, params, args, outdir, comm) -> int:
 
 
 def _simulate(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import simulate
+    from rawehelix.studies import resources, simulate
+    resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
 
     def checkpoint(partial):  # the last good state and the series so far, every minute
         partial.write(outdir, pictures=False)
@@ -291,6 +300,8 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     except ValueError:
         raise SceneError("--superharmonics", args.superharmonics,
                          "must be integers K[,K...] >= 2 or 'none'") from None
+    if args.sweep is not None:
+        orbits.check_sweep_dir(args.sweep)
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
@@ -335,20 +346,22 @@ def _numbers(option: str, text: str | None):
 
 
 def _labtest(rh, args, comm) -> int:
-    from rawehelix.studies import labtest
+    from rawehelix.studies import labtest, outdir as outdir_check
     scene = rh.load_scene(args.scene, overrides=_overrides(args))
+    outdir = args.output or Path("results") / "labtest" / (args.test + "_fit" * args.fit)
+    outdir_check.check(outdir, "labtest")
     result = rh.labtest(args.test, scene, tensions_N=_numbers("--tension", args.tension),
                         loads=_numbers("--loads", args.loads), fit=args.fit,
                         rod_EI_Nm2=args.rod_EI, elements=args.elements, degree=args.degree,
                         gravity=not args.no_gravity, comm=comm)
-    outdir = args.output or Path("results") / "labtest" / (args.test + "_fit" * args.fit)
     result.write(outdir)
     _say(comm, labtest.report(result) + f"\n  wrote {outdir}/")
     return 0
 
 
 def _extremes(args) -> int:
-    from rawehelix.studies import extremes
+    from rawehelix.studies import extremes, outdir as outdir_check
+    outdir_check.check(args.output, "extremes")
     unknown = [c for c in args.cases if c not in extremes.CASES]
     if unknown:
         raise SceneError("extremes", ", ".join(unknown),
@@ -377,16 +390,16 @@ def _calibrate(rh, params, args, outdir, comm) -> int:
     result = calibrate.compute(_source(args), fit, calibrate.parse_targets(args.target), outdir,
                                bounds=calibrate.parse_bounds(args.bounds, fit),
                                uncertainty=args.uncertainty, fd_step=args.fd_step, comm=comm,
-                               log=log.info)
+                               log=log.info, tolerance=args.tolerance)
     return _write_and_say(comm, result, calibrate.report(result), outdir)
 
 
 def _write_and_say(comm, result, text: str, outdir) -> int:
-    """A study's or a calibration's files (rank 0) and its report."""
+    """A study's or a calibration's files (rank 0) and its report; its exit status."""
     if comm.rank == 0:
         result.write(outdir)
     _say(comm, text + f"\n  wrote {outdir}/")
-    return 0
+    return result.exit_status
 
 
 COMMAND = {"stationary": _stationary, "modes": _modes, "simulate": _simulate, "sweep": _sweep,

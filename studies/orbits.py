@@ -105,6 +105,22 @@ class OrbitsResult:
         return outdir
 
 
+def check_sweep_dir(sweep_dir):
+    """Refuse (SceneError, before any orbit) a ``--sweep`` folder without a
+    sweep's summary.json and its points."""
+    from rawehelix.errors import SceneError
+    path = Path(sweep_dir) / "summary.json"
+    try:
+        points = json.loads(path.read_text())["points"]
+        if not all("f1_Hz" in p and "tension_max_N" in p for p in points):
+            raise KeyError("f1_Hz, tension_max_N")
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        why = ("no such file" if isinstance(err, FileNotFoundError)
+               else f"not a sweep's summary ({type(err).__name__}: {err})")
+        raise SceneError("--sweep", str(sweep_dir), f"{path}: {why}; give the -o folder of a "
+                         f"finished 'rawehelix sweep'") from None
+
+
 def _sweep_points(sweep_dir) -> list[dict]:
     with open(Path(sweep_dir) / "summary.json") as fh:
         return json.load(fh)["points"]

@@ -33,6 +33,12 @@ COMM_SELF, taken by the ranks from a shared counter and stored as it ends
 quantities, then id, kind, status and the reason of a failure; the same
 bytes for any number of ranks), ``summary.json``, ``study.png`` (each
 quantity against each key) and ``tornado.png`` (the sensitivities).
+
+The summary's ``status`` is "all done" or "done with failures" (``failed``
+lists each failed point and its reasons).  Exit status: 0 all done; 3
+(``EXIT_UNMET``, "done with failures"; the outputs are written); 2 bad
+input, refused before any point runs (a design past the memory or time
+limits of :mod:`rawehelix.studies.resources` too).
 """
 
 from __future__ import annotations
@@ -58,6 +64,10 @@ from rawehelix.studies import pool, quantities, scene, writers
 SAMPLES = ("grid", "lhs", "sobol")
 FD_STEP = 1e-2  # relative step of the central differences at the base point
 SEED = 0  # of the LHS and Sobol' designs and SALib's bootstrap
+#: exit status of a study or a calibration that ran to its end but did not do all it
+#: was asked: failed points ("done with failures"), missed targets (calibrate)
+EXIT_UNMET = 3
+STATUS = {False: "all done", True: "done with failures"}
 
 
 @dataclass(frozen=True)
@@ -171,8 +181,18 @@ def fd_points(base: dict, fd_step: float) -> tuple[list, dict]:
     return tasks, skipped
 
 
-def make_tasks(source: Source, variables: list[Variable], sample: str, points, fd_step: float):
-    """(tasks, design (n, d), base values, skipped keys), every scene validated."""
+def design_size(variables: list[Variable], sample: str, points) -> int:
+    """The number of design points, before the design is built."""
+    if sample == "grid":
+        return math.prod(v.count or 1 for v in variables)
+    return (points or 0) * (len(variables) + 2 if sample == "sobol" else 1)
+
+
+def make_tasks(source: Source, variables: list[Variable], sample: str, points, fd_step: float,
+               check=None):
+    """(tasks, design (n, d), base values, skipped keys), every scene validated
+    (and passed to ``check(params)``, e.g. the resources' check)."""
+    from rawehelix.studies import resources
     keys = [v.key for v in variables]
     if len(set(keys)) != len(keys):
         raise SceneError("--vary", ", ".join(keys), "each key once")
@@ -181,13 +201,16 @@ def make_tasks(source: Source, variables: list[Variable], sample: str, points, f
     for v in variables:
         source.load({v.key: cast(v.key, v.start)})  # an unknown key: the loader's message
         base[v.key] = base_value(base_params, v.key)
+    resources.check_count("--vary/--points", design_size(variables, sample, points))
     X = design(variables, sample, points)
     tasks = [pool.Task(f"p{k:05d}", {key: cast(key, x) for key, x in zip(keys, row)})
              for k, row in enumerate(X)]
     extra, skipped = fd_points(base, fd_step)
     tasks += extra
     for task in tasks:  # every point's scene, validated before anything runs
-        source.load(task.overrides)
+        params = source.load(task.overrides)
+        if check:
+            check(params)
     return tasks, X, base, skipped
 
 
@@ -243,6 +266,11 @@ class StudyResult:
     sample: str
     records: dict  # id -> record, in point order
     summary: dict
+
+    @property
+    def exit_status(self) -> int:
+        """0: all done; EXIT_UNMET: done with failures."""
+        return EXIT_UNMET if self.summary["failed"] else 0
 
     def column(self, name: str, kind: str = "design") -> np.ndarray:
         return np.array([np.nan if r["values"][name] is None else r["values"][name]
@@ -358,7 +386,10 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
         raise SceneError("--point-timeout", point_timeout, "must be a number of seconds > 0")
     if point_timeout is not None and threading.current_thread() is not threading.main_thread():
         raise SceneError("--point-timeout", point_timeout, "needs the main thread (SIGALRM)")
-    tasks, X, base, skipped = make_tasks(source, variables, sample, points, fd_step)
+    from rawehelix.studies import resources
+    tasks, X, base, skipped = make_tasks(
+        source, variables, sample, points, fd_step,
+        check=lambda p: resources.check_quantities(p, wanted, copies=comm.size))
     params = source.load()
     store = pool.Store(outdir, header(source, params, variables, sample, points, wanted,
                                       fd_step)).open(comm)
@@ -378,14 +409,15 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
     for r in records.values():
         for stage, c in r["cpu_s"].items():
             cost.setdefault(stage, []).append(c)
-    summary = {**store.header, "base": base, "design_points": len(X),
+    failed = {r["id"]: r["errors"] for r in records.values() if r["status"] == "failed"}
+    summary = {**store.header, "status": STATUS[bool(failed)], "base": base,
+               "design_points": len(X),
                "points_total": len(tasks),
                "sensitivity": "d ln Q / d ln p = (Q(p0 (1 + h)) - Q(p0 (1 - h))) / "
                               "(Q(p0) ln((1 + h) / (1 - h))), h = fd_step",
                "sensitivities": sens, "sensitivities_skipped": skipped,
                "variance_indices": indices if sample != "grid" else None,
-               "failed": {r["id"]: r["errors"] for r in records.values()
-                          if r["status"] == "failed"},
+               "failed": failed,
                "cpu_s_per_point_by_stage": {s: float(np.median(c)) for s, c in cost.items()},
                "point_timeout_s": point_timeout,
                "computed_now": out["computed"], "ranks": comm.size, "loops": loops,
@@ -398,7 +430,7 @@ def report(result: StudyResult) -> str:
     s = result.summary
     lines = [f"{result.title}: {s['design_points']} design points + {s['points_total'] - s['design_points']} "
              f"for the sensitivities ({s['computed_now']} computed now, {s['ranks']} rank(s), "
-             f"{s['wall_s']:.1f} s); {len(s['failed'])} failed"]
+             f"{s['wall_s']:.1f} s); {len(s['failed'])} failed: {s['status']}"]
     for name, row in s["sensitivities"].items():
         shown = ", ".join(f"{k} {v:+.3f}" for k, v in row.items() if v is not None)
         if shown:
