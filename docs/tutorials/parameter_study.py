@@ -101,3 +101,4 @@ k, m, omega = math.pi / h.length_m, h.mass_kg / h.length_m, 2 * math.pi * 5.0
 closed = (m * omega**2 - T * k**2) / k**4
 print(f"fitted EI = {EI:.3f} N m^2, closed form {closed:.3f} N m^2 ({EI / closed - 1:+.1e})")
 assert abs(EI / closed - 1) < 1e-2
+print("written:", OUT)
