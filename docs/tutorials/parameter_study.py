@@ -26,7 +26,7 @@
 # their output folder, so a killed run resumes.
 #
 # Run it with `.venv/bin/python docs/tutorials/parameter_study.py` (N = 16,
-# about a minute); `RAWEHELIX_TUTORIAL_SMALL=1`: N = 4 and a coarser grid.
+# about 15 s of CPU); `RAWEHELIX_TUTORIAL_SMALL=1`: N = 4 and a coarser grid.
 
 # %%
 import math
