@@ -21,8 +21,8 @@
 #   the branch goes round its folds, onto the unstable branch and back.
 #
 # Run it with `.venv/bin/python docs/tutorials/frequency_response.py` (about
-# 2 minutes of CPU at N = 4); `RAWEHELIX_TUTORIAL_SMALL=1` runs N = 2, whose
-# branch has the same shape (both folds) in about 35 s.
+# a minute of CPU at N = 4: 49 orbits); `RAWEHELIX_TUTORIAL_SMALL=1` runs N = 2, whose
+# branch has the same shape (both folds) in about 50 s.
 
 # %%
 import os

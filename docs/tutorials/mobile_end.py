@@ -19,7 +19,7 @@
 # sweep with the converged FE model (N = 8, p = 3) and with the paper's scheme,
 # around the resonance, and see that the paper's curve is not converged in N.
 #
-# Run it with `.venv/bin/python docs/tutorials/mobile_end.py`: about 4 minutes
+# Run it with `.venv/bin/python docs/tutorials/mobile_end.py`: about 2.5 minutes
 # of CPU for the 11 default f1 on both schemes (the whole 30-point Fig. 8 is
 # `rawehelix sweep mobile_end --elements 8`, about 9 minutes per scheme).
 # `RAWEHELIX_TUTORIAL_SMALL=1`: two f1 at N = 4 and a short lead-in.
