@@ -9,7 +9,7 @@ For the Table 2 helix (``stationary_table2``, gamma off as in the scene):
 2. the lowest eigenvalue |lambda| of each family, relative deviation from
    the mixed form at N = 256, p = 4.
 
-    .venv/bin/python benchmarks/large_n.py [-o docs/large_n.md]
+    .venv/bin/python benchmarks/large_n.py [-o docs/explanation/large_n.md]
 
 Serial (COMM_SELF); a benchmark, not a test (a few minutes).
 """

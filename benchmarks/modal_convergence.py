@@ -9,7 +9,7 @@ eigensolve.  The gamma coupling (Eq. 34) is off in the main tables, as in the
 classical models of tests/test_modal.py; one table shows what the regularised
 coupling changes, and a last one the round-off floor of fine meshes.
 
-    .venv/bin/python benchmarks/modal_convergence.py [-o docs/modal_convergence.md]
+    .venv/bin/python benchmarks/modal_convergence.py [-o docs/explanation/modal_convergence.md]
 
 Serial (COMM_SELF); a benchmark, not a test.
 """
@@ -60,7 +60,7 @@ def fmt_rate(e0, e1):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("-o", "--output", type=Path, default=Path("docs/modal_convergence.md"))
+    ap.add_argument("-o", "--output", type=Path, default=Path("docs/explanation/modal_convergence.md"))
     args = ap.parse_args()
     for p in DEGREES:  # JIT warm-up: compile the forms once per degree
         lowest(2, p)
