@@ -18,7 +18,6 @@ The functions return Markdown text and import neither FEniCSx nor PETSc:
 from __future__ import annotations
 
 import ast
-import contextlib
 import dataclasses
 import inspect
 import io
@@ -303,5 +302,4 @@ def setup(app):
 
 
 if __name__ == "__main__":
-    with contextlib.redirect_stderr(sys.stdout):
-        print(GENERATORS[sys.argv[1]]())
+    print(GENERATORS[sys.argv[1]]())
