@@ -43,7 +43,7 @@ exclude_patterns += ["_build", "**/summary.json", "**/runs"]
 
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
-autodoc_default_options = {"members": True, "undoc-members": False}
+autodoc_default_options = {}
 # the heavy modules are imported lazily inside the functions; nothing to mock
 nitpicky = False
 
