@@ -10,11 +10,34 @@ argparse parser, the scene keys from the parameter dataclasses) or by autodoc
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
 import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE / "_ext"))
+
+
+def _markdown_it_beside_myst():
+    """Import the markdown-it-py that sits beside myst-parser (Debian's 2.1).
+
+    The venv may hold a newer one (pyvista brings rich, rich markdown-it-py
+    4.x), which shadows Debian's and breaks myst-parser 0.18: its footnote and
+    deflist plugins call the older ParserBlock.tokenize.  Importing the package
+    once from myst-parser's folder makes every later ``import markdown_it`` of
+    this build use it; nothing else is taken from there."""
+    spec = importlib.util.find_spec("myst_parser")
+    if spec is None or "markdown_it" in sys.modules:
+        return
+    sys.path.insert(0, str(Path(spec.origin).parents[1]))
+    try:
+        importlib.import_module("markdown_it")
+    finally:
+        sys.path.pop(0)
+
+
+_markdown_it_beside_myst()
 
 import rawehelix  # noqa: E402  (the worktree's editable install)
 
@@ -30,7 +53,7 @@ extensions = [
     "rawehelix_reference",
 ]
 source_suffix = {".md": "markdown"}
-myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
+myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]  # Debian 12 myst-parser 0.18
 myst_heading_anchors = 3
 
 # The site's pages are index.md and the four folders of its toctree.  Everything

@@ -58,6 +58,24 @@ def test_site_builds_and_every_local_reference_exists(site):
     assert not {k: v for k, v in missing.items() if v}
 
 
+def test_myst_plugins_work_with_the_docs_configuration(tmp_path):
+    """Footnotes and definition lists parse under docs/conf.py, whatever
+    markdown-it-py the venv holds (conf.py takes the one beside myst-parser)."""
+    pytest.importorskip("myst_parser", reason="myst-parser is not installed")
+    (tmp_path / "conf.py").write_text(
+        "import runpy\n"
+        f"globals().update(runpy.run_path({str(DOCS / 'conf.py')!r}))\n"
+        "extensions = ['myst_parser']\nexclude_patterns = []\nhtml_static_path = []\n")
+    (tmp_path / "index.md").write_text("# Page\n\nA claim[^1].\n\n[^1]: its source\n\n"
+                                       "term\n: its definition\n")
+    run = subprocess.run([sys.executable, "-m", "sphinx", "-W", "-q", "-b", "html",
+                          str(tmp_path), str(tmp_path / "html")],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    page = (tmp_path / "html" / "index.html").read_text()
+    assert "footnote" in page and "<dl" in page
+
+
 def test_site_has_the_four_parts(site):
     index = (site / "index.html").read_text()
     for part in ("tutorials/index.html", "howto/index.html", "explanation/index.html",
