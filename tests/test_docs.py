@@ -129,6 +129,18 @@ def test_readme_is_a_front_page():
         assert command in text
 
 
+def test_readme_commands_are_the_parsers():
+    """Each command line of the README names a real command and only its options."""
+    text = (ROOT / "README.md").read_text().split("## Commands", 1)[1]
+    lines = re.findall(r"^    rawehelix (\S+)(.*)$", text, re.M)
+    subs = {name: sub for name, _, sub in reference._subparsers(cli._parser())}
+    assert sorted(name for name, _ in lines) == sorted(subs)
+    for name, rest in lines:
+        known = {flag for action in subs[name]._actions for flag in action.option_strings}
+        for flag in re.findall(r"(?<![\w-])(--?[a-z][\w-]*)", rest):
+            assert flag in known, f"rawehelix {name} {flag}"
+
+
 # -- the scene keys generator ---------------------------------------------------
 
 def test_scene_key_rows_cover_every_key_with_range_and_unit():
