@@ -1,6 +1,7 @@
 # rawehelix: two commands on a fresh Debian 12 machine (root or sudo):
 #   make demo   installs what is missing, then runs Secs. 5.1-5.3 and writes results/report.html
 #   make test   installs what is missing, then runs the tests serially and under mpirun -n 2
+#   make docs   builds the documentation (Sphinx, MyST) into docs/_build/html
 
 VENV    := .venv
 PY      := $(VENV)/bin/python
@@ -13,7 +14,7 @@ MPIRUN  := mpirun -n $(NP) --oversubscribe
 PYTEST_ARGS ?=
 MARKS   ?= not long
 
-.PHONY: install demo test test-long test-debian13 bench clean
+.PHONY: install demo test test-long test-debian13 bench clean docs
 
 install:
 	@bash scripts/install.sh
@@ -34,6 +35,9 @@ test-debian13:
 
 clean:
 	rm -rf results .pytest_cache
+
+docs: install
+	$(PY) -m sphinx -W --keep-going -b html docs docs/_build/html
 
 bench: install
 	$(PY) benchmarks/run.py

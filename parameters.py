@@ -262,9 +262,9 @@ KINEMATICS = ("paper", "extensible")  # forms/rod.py (Eqs. 30-33), forms/extensi
 class Model:
     """Which physics terms a scene switches on."""
 
-    gravity: bool = True
-    drag: bool = True
-    bending: bool = True
+    gravity: bool = True  # gravity, the weight term of Eq. (30)
+    drag: bool = True  # air drag, Eq. (14)
+    bending: bool = True  # the bending stiffness EI, Eqs. (32)-(33)
     # the twist field alpha and its equation (31); false (a torque-free scene,
     # FE scheme) holds alpha = 0: no torsional modes, no twist coupling
     twist: bool = True
