@@ -10,9 +10,11 @@ PETSc refuses (``-rawehelix_snes_type nonexistent``) is an error with
 PETSc's own reason.  Both are :class:`SceneError` (bad input, exit 2), raised
 on every rank alike (the database is the same on every rank).
 
-Options that only a factorisation reads (``-rawehelix_mat_mumps_icntl_14``),
-after the set-up, cannot be checked before the work: :func:`left_after_run`
-lists those still unused at the end of a run.
+Options that only a solve or a factorisation reads (the viewers
+``-rawehelix_snes_converged_reason``, ``-rawehelix_ksp_view``, MUMPS'
+``-rawehelix_mat_mumps_icntl_14``) cannot be checked before the work
+(:data:`AT_SOLVE`): :func:`left_after_run` lists those still unused at the
+end of a run, for a warning.
 
 The solvers' prefixes: the stationary Newton solver and the modes' PEP
 ``rawehelix_`` (``-rawehelix_snes_*``, ``-rawehelix_pep_*``, ``-rawehelix_st_*``),
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import difflib
 import logging
+import re
 
 from petsc4py import PETSc
 
@@ -36,8 +39,11 @@ RESPONSE_PREFIX = "rawehelix_response_"
 #: options that PETSc itself reads at PetscFinalize, never during a run
 AT_FINALIZE = ("options_left", "objects_dump", "malloc_dump", "memory_view", "options_view",
                "log_view", "log_summary", "log_trace", "log_all", "malloc_view")
-#: options read only when a matrix is factorised (MUMPS' ICNTL, ...): after the set-up
-AT_FACTORISATION = ("mat_",)
+#: options read only by a solve or a factorisation, after the set-up: the viewers
+#: (-rawehelix_snes_converged_reason, -rawehelix_ksp_view) and the matrices' own
+#: (-rawehelix_mat_mumps_icntl_14); checked at the end of the run (left_after_run)
+AT_SOLVE = re.compile(r"_(view|converged_reason|final_residual|error_(absolute|relative|"
+                      r"backward))(_|$)|(^|_)mat_")
 #: the answer "did you mean" looks in besides the options used: common ones of each prefix
 COMMON = ("snes_monitor", "snes_converged_reason", "snes_view", "snes_max_it", "snes_rtol",
           "snes_atol", "snes_stol", "snes_type", "snes_linesearch_type", "snes_linesearch_monitor",
@@ -126,8 +132,7 @@ def check(unused_policy: str = "error", ours: tuple = ()):
         probe()
     except PETSc.Error as err:
         raise _petsc_error(err, options) from None
-    left = [n for n in unused(options) if n not in AT_FINALIZE
-            and not any(n.startswith(p) or f"_{p}" in n for p in AT_FACTORISATION)]
+    left = [n for n in unused(options) if n not in AT_FINALIZE and not AT_SOLVE.search(n)]
     if not left:
         return
     used = [n for n in options if n not in left]
@@ -142,6 +147,6 @@ def check(unused_policy: str = "error", ours: tuple = ()):
 
 
 def left_after_run() -> list[str]:
-    """The options still unused at the end of a run (those a factorisation reads,
-    which :func:`check` passes over), for a warning."""
+    """The options still unused at the end of a run (those only a solve reads,
+    :data:`AT_SOLVE`, which :func:`check` passes over), for a warning."""
     return [n for n in unused() if n not in AT_FINALIZE]
