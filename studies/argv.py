@@ -90,7 +90,7 @@ def _refuse(parser: argparse.ArgumentParser, name: str):
         meant = " or ".join(by_normal[c] for c in close)
     hint = f"did you mean {meant}?" if meant else "known: " + ", ".join(
         s for s in ours if s.startswith("--"))
-    raise ArgvError(parser.prog, name, f"is not an option of this command; {hint} "
+    raise ArgvError(parser.prog.split()[-1], name, f"is not an option of this command; {hint} "
                     "(PETSc options have one dash: -rawehelix_snes_monitor)")
 
 

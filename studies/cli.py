@@ -185,9 +185,9 @@ def _fail(message: str) -> int:
     return BAD_INPUT
 
 
-def _interrupted(command: str, outdir) -> int:
+def _interrupted(command: str, outdir, comm) -> int:
     """Ctrl-C: one line saying what was kept (rank 0), no traceback."""
-    if _rank() == 0:
+    if comm.rank == 0:
         if command in KEPT and outdir is not None:
             n = len(list(Path(outdir).glob(KEPT[command])))
             said = (f"{n} finished point{'s' * (n != 1)} kept in {outdir}/; run the same "
@@ -198,11 +198,6 @@ def _interrupted(command: str, outdir) -> int:
             said = "nothing was written"
         print(f"rawehelix: interrupted: {said}", file=sys.stderr, flush=True)
     return INTERRUPTED
-
-
-def _rank() -> int:
-    from mpi4py import MPI
-    return MPI.COMM_WORLD.rank
 
 
 def _overrides(args) -> dict:
@@ -241,7 +236,7 @@ def main(argv: list[str] | None = None) -> int:
     logs.configure(args.verbose)
     # PETSc reads its options once, at initialisation: before any import of PETSc.
     import petsc4py
-    petsc4py.init([sys.argv[0], *petsc_args])
+    petsc4py.init(["rawehelix", *petsc_args])  # argv[0] may be "-c": never an option
     from mpi4py import MPI
 
     import rawehelix as rh
@@ -252,14 +247,15 @@ def main(argv: list[str] | None = None) -> int:
     try:
         petsc_options.check(args.petsc_unused, argv_split.option_strings(parser, args.command))
         if args.command == "extremes":
-            return _extremes(args)
-        if args.command == "labtest":
-            return _labtest(rh, args, comm)
-        params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
-                               scheme=args.scheme, overrides=_overrides(args))
-        outdir = args.output or Path("results") / params.name / args.command
-        status = COMMAND[args.command](rh, params, args, outdir, comm)
-        _warn_unused_after_run(petsc_options)
+            status = _extremes(args)
+        elif args.command == "labtest":
+            status = _labtest(rh, args, comm)
+        else:
+            params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
+                                   scheme=args.scheme, overrides=_overrides(args))
+            outdir = args.output or Path("results") / params.name / args.command
+            status = COMMAND[args.command](rh, params, args, outdir, comm)
+        _warn_unused_after_run(petsc_options, comm)
         return status
     except SceneError as err:
         return _fail(str(err))
@@ -268,7 +264,7 @@ def main(argv: list[str] | None = None) -> int:
         _abort_other_ranks(comm, FAILED)
         return FAILED
     except KeyboardInterrupt:
-        return _interrupted(args.command, outdir)
+        return _interrupted(args.command, outdir, comm)
     except Exception:
         if comm.size == 1:
             raise
@@ -277,10 +273,11 @@ def main(argv: list[str] | None = None) -> int:
         raise
 
 
-def _warn_unused_after_run(petsc_options):
-    """PETSc options only a factorisation reads (not checked before the work)."""
+def _warn_unused_after_run(petsc_options, comm):
+    """PETSc options only a solve reads (a viewer, MUMPS' ICNTL: not checked before
+    the work) that none read, on rank 0."""
     left = petsc_options.left_after_run()
-    if left:
+    if left and comm.rank == 0:
         log.warning("PETSc options %s: no solver read them", ", ".join("-" + n for n in left))
 
 
@@ -341,7 +338,7 @@ def _orbits(rh, params, args, outdir, comm) -> int:
         start, stop = (float(x) for x in args.f1.split(":"))
     except ValueError:
         raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
-    if not (0 < start != stop > 0 and math.isfinite(start + stop)):
+    if not (start > 0 and stop > 0 and start != stop and math.isfinite(start + stop)):
         raise SceneError("--f1", args.f1, "must be START:STOP with START != STOP, both > 0 Hz "
                          "(an empty or negative window)")
     try:
