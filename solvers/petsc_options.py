@@ -149,4 +149,4 @@ def check(unused_policy: str = "error", ours: tuple = ()):
 def left_after_run() -> list[str]:
     """The options still unused at the end of a run (those only a solve reads,
     :data:`AT_SOLVE`, which :func:`check` passes over), for a warning."""
-    return [n for n in unused() if n not in AT_FINALIZE]
+    return [n for n in unused() if n not in AT_FINALIZE and AT_SOLVE.search(n)]

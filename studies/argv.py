@@ -88,8 +88,10 @@ def _refuse(parser: argparse.ArgumentParser, name: str):
     if meant is None:
         close = difflib.get_close_matches(_normal(name), list(by_normal), n=3, cutoff=0.6)
         meant = " or ".join(by_normal[c] for c in close)
-    hint = f"did you mean {meant}?" if meant else "known: " + ", ".join(
-        s for s in ours if s.startswith("--"))
+    commands = _subcommands(parser)
+    hint = (f"did you mean {meant}?" if meant
+            else f"the command comes first: {', '.join(commands)}" if commands
+            else "known: " + ", ".join(s for s in ours if s.startswith("--")))
     raise ArgvError(parser.prog.split()[-1], name, f"is not an option of this command; {hint} "
                     "(PETSc options have one dash: -rawehelix_snes_monitor)")
 
