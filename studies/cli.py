@@ -197,6 +197,7 @@ def _interrupted(command: str, outdir, comm) -> int:
         else:
             said = "nothing was written"
         print(f"rawehelix: interrupted: {said}", file=sys.stderr, flush=True)
+    _abort_other_ranks(comm, INTERRUPTED)  # a rank that was not interrupted would wait
     return INTERRUPTED
 
 
