@@ -41,6 +41,7 @@ FAULTS = [
     (["extremes", "-rawehelix_pep_type", "nonexistent"], 2, "nonexistent"),
     # each command's own checks
     (["labtest", "axial", "--degree", "9"], 2, "discretisation.degree: 9 must be an integer from 2 to 8"),
+    (["labtest", "axial", "--elements", "0"], 2, "discretisation.elements: 0 must be an integer >= 1"),
     (["response", "mobile_end", "--degree", "9"], 2, "must be an integer from 2 to 8"),
     (["orbits", "mobile_end", "--f1", "11:11"], 2, "START != STOP"),
     (["sweep", "mobile_end", "--f1", "1:2"], 2, "is not START:STOP:STEP"),
