@@ -5,6 +5,8 @@ Nothing else in rawehelix may test the DOLFINx version.
 
 from __future__ import annotations
 
+import ctypes
+
 import numpy as np
 
 import dolfinx
@@ -228,3 +230,32 @@ def assemble_vector_array(b: np.ndarray, form) -> np.ndarray:
     b[:] = 0.0
     dolfinx.fem.assemble_vector(b, form)
     return b
+
+
+def petsc_option_used(name: str) -> bool:
+    """Whether anything has read the option ``name`` (without '-') of PETSc's
+    database: petsc4py 3.18 has no call for it, so PetscOptionsUsed of the
+    libpetsc already loaded (ctypes), or ``Options.used`` where petsc4py has it."""
+    from petsc4py import PETSc
+    if hasattr(PETSc.Options, "used"):
+        return bool(PETSc.Options().used(name))
+    flag = ctypes.c_int()
+    err = _libpetsc().PetscOptionsUsed(None, name.encode(), ctypes.byref(flag))
+    if err:
+        raise RuntimeError(f"PetscOptionsUsed({name!r}) returned error {err}")
+    return bool(flag.value)
+
+
+def _libpetsc():
+    """The libpetsc this process has loaded (petsc4py's), its C calls by ctypes."""
+    global _LIBPETSC
+    if _LIBPETSC is None:
+        with open("/proc/self/maps") as maps:
+            paths = {ln.split()[-1] for ln in maps if "/libpetsc" in ln and ".so" in ln}
+        if len(paths) != 1:
+            raise RuntimeError(f"cannot tell which libpetsc is loaded: {sorted(paths)}")
+        _LIBPETSC = ctypes.CDLL(paths.pop())
+    return _LIBPETSC
+
+
+_LIBPETSC = None

@@ -33,6 +33,7 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.forms import cantilever, extensible, kinematics
 from rawehelix.parameters import Parameters
+from rawehelix.solvers import petsc_options
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.snes import NewtonSolver, SolverError
 
@@ -85,7 +86,7 @@ class CantileverSolver:
         U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)
-        self.newton = NewtonSolver(F, w, r.bcs, prefix="rawehelix_labtest_")
+        self.newton = NewtonSolver(F, w, r.bcs, prefix=petsc_options.LABTEST_PREFIX)
         alpha = ufl.split(w)[1]
         tau = kinematics.twist(x, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
         T = kinematics.tension(x, c.sigma)  # (29)

@@ -60,6 +60,7 @@ import dolfinx.fem.petsc
 from rawehelix import compat
 from rawehelix.forms.kinematics import d
 from rawehelix.parameters import Parameters
+from rawehelix.solvers import petsc_options
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.probes import middle_vertex
@@ -263,7 +264,7 @@ class HarmonicResponse:
         x = A.createVecRight()
         if self.ksp is None:
             self.ksp = direct_solver(self.comm)
-            self.ksp.setOptionsPrefix("rawehelix_response_")
+            self.ksp.setOptionsPrefix(petsc_options.RESPONSE_PREFIX)
             self.ksp.setFromOptions()
         self.ksp.setOperators(A)
         try:

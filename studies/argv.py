@@ -9,9 +9,15 @@ cannot tell from a stray positional: ``parse_known_args`` leaves the value
   prefix of a ``--long`` option, as argparse allows) is ours, with as many
   values as its action takes;
 - a subcommand name switches to that subcommand's options;
+- short flags run together (``-vv``) are ours;
+- any other ``--word`` is refused (:class:`ArgvError`): PETSc's options have
+  one dash, so a double dash is always meant for us (``--elemnts`` a typo);
+- a single-dash token that is one of our options but for case and dashes
+  (``-O``, ``-output``, ``-Elements``) is refused too, naming ours;
 - any other token that starts with ``-`` (and is not a number) starts a
   PETSc option; the token after it is its value when it does not start with
-  ``-`` or is a number (``-1``, ``-1e-3``);
+  ``-`` or is a number (``-1``, ``-1e-3``).  Whether PETSc uses it is
+  checked later (:mod:`rawehelix.solvers.petsc_options`);
 - an ambiguous prefix of our ``--long`` options is ours (argparse reports it);
 - any other token is one of our positionals.
 
@@ -24,6 +30,13 @@ matched exactly, never as ``-oDIR``, so that ``-options_file`` stays PETSc's.
 from __future__ import annotations
 
 import argparse
+import difflib
+
+from rawehelix.errors import SceneError
+
+
+class ArgvError(SceneError):
+    """An option of ours mistyped: ``command: token: did you mean ...``."""
 
 
 def _is_number(token: str) -> bool:
@@ -47,6 +60,46 @@ def _lookup(parser: argparse.ArgumentParser, token: str) -> list[argparse.Action
     if token.startswith("--") and parser.allow_abbrev:
         return list({a: None for s, a in options.items() if s.startswith(token)})
     return []
+
+
+def _normal(token: str) -> str:
+    """An option as a user may mean it: no dashes, any case, '-' and '_' alike."""
+    return token.lstrip("-").lower().replace("_", "-")
+
+
+def _short_flags(parser: argparse.ArgumentParser, token: str) -> bool:
+    """``-vv``: short options without a value, run together (argparse takes them)."""
+    flags = {s for a in parser._actions if a.nargs == 0 for s in a.option_strings
+             if len(s) == 2 and s[0] == "-" and s[1] != "-"}
+    return (len(token) > 2 and token[0] == "-" and token[1] != "-"
+            and all("-" + c in flags for c in token[1:]))
+
+
+def _refuse(parser: argparse.ArgumentParser, name: str):
+    """Raise ArgvError for ``name``, a mistyped option of ours, or return when
+    it is none (a PETSc option)."""
+    ours = option_strings(parser)
+    by_normal = {}
+    for s in ours:  # the long spelling of each option first
+        by_normal.setdefault(_normal(s), s)
+    meant = by_normal.get(_normal(name))
+    if meant is None and not name.startswith("--"):
+        return  # a PETSc option (checked when the solvers are set up)
+    if meant is None:
+        close = difflib.get_close_matches(_normal(name), list(by_normal), n=3, cutoff=0.6)
+        meant = " or ".join(by_normal[c] for c in close)
+    commands = _subcommands(parser)
+    hint = (f"did you mean {meant}?" if meant
+            else f"the command comes first: {', '.join(commands)}" if commands
+            else "known: " + ", ".join(s for s in ours if s.startswith("--")))
+    raise ArgvError(parser.prog.split()[-1], name, f"is not an option of this command; {hint} "
+                    "(PETSc options have one dash: -rawehelix_snes_monitor)")
+
+
+def option_strings(parser: argparse.ArgumentParser, command: str | None = None) -> list[str]:
+    """The options of ``parser`` (of its subcommand ``command`` if given), for "did you mean"."""
+    parser = _subcommands(parser).get(command, parser)
+    return [s for a in parser._actions for s in a.option_strings if s not in ("-h", "--help")]
 
 
 def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -79,7 +132,8 @@ def split(argv: list[str], parser: argparse.ArgumentParser) -> tuple[list[str], 
     before the PETSc options (see the module docstring).
 
     ``parser.parse_args(ours)`` then parses our part strictly, and ``petsc``
-    goes to ``petsc4py.init``.
+    goes to ``petsc4py.init``.  Raises :class:`ArgvError` for an option of
+    ours mistyped (see the module docstring).
     """
     ours: list[str] = []
     petsc: list[str] = []
@@ -98,6 +152,11 @@ def split(argv: list[str], parser: argparse.ArgumentParser) -> tuple[list[str], 
                 ours += argv[i:i + 1 + n]
                 i += 1 + n
                 continue
+            if _short_flags(current, name):
+                ours.append(token)
+                i += 1
+                continue
+            _refuse(current, name)
             petsc.append(token)
             if i + 1 < len(argv) and not _is_option(argv[i + 1]):
                 petsc.append(argv[i + 1])

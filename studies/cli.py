@@ -18,19 +18,23 @@ SCENE is a TOML file or the name of a shipped scene (``stationary_table2``,
 ``nominal_operation``, ``mobile_end``).  ``--set KEY=VALUE`` sets any dotted
 scene key.  Options that argparse does not know go to PETSc, with or without
 a value (``-rawehelix_snes_monitor``, ``-rawehelix_snes_linesearch_type bt``);
-put them after the scene.  ``-v`` shows more (``-vv`` everything).  Bad input
+put them after the scene.  An option no solver reads, or a value PETSc
+refuses, is bad input (``--petsc-unused warn``: a warning only), as is an
+unknown ``--option``.  ``-v`` shows more (``-vv`` everything).  Bad input
 exits with status 2 and one message naming file, key and what is allowed;
 nothing is written (the output folder, the memory and the disk a run needs
 are checked before it starts: studies/outdir.py, studies/resources.py).  A
 failed solve exits with status 1.  A study with failed points, or a
 calibration that missed a target by more than its tolerance, writes its
-results and exits with status 3.
+results and exits with status 3.  Ctrl-C exits with 130, saying what was kept
+and how to resume.
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import math
 import sys
 import tomllib
 import traceback
@@ -38,13 +42,31 @@ from pathlib import Path
 
 from rawehelix.studies.scene import SceneError
 
+#: exit statuses (README): bad input, a failed solve, Ctrl-C (128 + SIGINT)
+BAD_INPUT, FAILED, INTERRUPTED = 2, 1, 130
+#: a resumable command's finished points in its output directory, for Ctrl-C's message
+KEPT = {"sweep": "points/f1_*.json", "orbits": "window*/p*.json", "study": "points/*.json",
+        "calibrate": "points/*.json", "converge": "runs/*.json"}
 COMMANDS = ("stationary", "modes", "simulate", "sweep", "response", "orbits", "converge",
             "extremes", "labtest", "study", "calibrate")
 log = logging.getLogger("rawehelix")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its refusals on one line, as every other bad input."""
+
+    def error(self, message):
+        self.exit(BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def _petsc_unused(p):
+    p.add_argument("--petsc-unused", choices=("error", "warn"), default="error",
+                   help="a PETSc option that no solver reads: refuse the run (default) "
+                        "or only warn")
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rawehelix", description=__doc__.split("\n\n")[0])
+    parser = _Parser(prog="rawehelix", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
     for name, help_text in (("stationary", "stationary state with fixed ends (Sec. 5.1)"),
                             ("modes", "natural modes about the stationary state (Table 3)"),
@@ -67,6 +89,7 @@ def _parser() -> argparse.ArgumentParser:
                        help="set a dotted scene key, e.g. --set helix.EI_Nm2=9000 (repeatable)")
         p.add_argument("-v", "--verbose", action="count", default=0,
                        help="more messages (-vv: the solvers' and compilers' too)")
+        _petsc_unused(p)
         if name == "modes":
             p.add_argument("--count", type=int, default=None,
                            help="report the k slowest modes (default: the lowest 3 of each family)")
@@ -132,6 +155,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", type=Path, default=Path("results/extremes"),
                    help="output directory (default results/extremes)")
     p.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
+    _petsc_unused(p)
     p.add_argument("cases", nargs="*", help="case names (default: all)")
     p = sub.add_parser("labtest", help="the paper's lab tests (Sec. 4, Fig. 2) as virtual tests")
     p.add_argument("test", choices=("axial", "bending", "torsion"))
@@ -154,6 +178,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", type=Path, default=None,
                    help="output directory (default results/labtest/<test>)")
     p.add_argument("-v", "--verbose", action="count", default=0, help="more messages")
+    _petsc_unused(p)
     return parser
 
 
@@ -164,7 +189,23 @@ def _quantity_names() -> list[str]:
 
 def _fail(message: str) -> int:
     print(f"rawehelix: error: {message}", file=sys.stderr)
-    return 2
+    return BAD_INPUT
+
+
+def _interrupted(command: str, outdir, comm) -> int:
+    """Ctrl-C: one line saying what was kept (rank 0), no traceback."""
+    if comm.rank == 0:
+        if command in KEPT and outdir is not None:
+            n = len(list(Path(outdir).glob(KEPT[command])))
+            said = (f"{n} finished point{'s' * (n != 1)} kept in {outdir}/; run the same "
+                    "command again to resume")
+        elif command == "simulate" and outdir is not None and Path(outdir).is_dir():
+            said = f"the series up to the last checkpoint is in {outdir}/ (no resume)"
+        else:
+            said = "nothing was written"
+        print(f"rawehelix: interrupted: {said}", file=sys.stderr, flush=True)
+    _abort_other_ranks(comm, INTERRUPTED)  # a rank that was not interrupted would wait
+    return INTERRUPTED
 
 
 def _overrides(args) -> dict:
@@ -195,29 +236,38 @@ def main(argv: list[str] | None = None) -> int:
 
     argv = sys.argv[1:] if argv is None else argv
     parser = _parser()
-    ours, petsc_args = argv_split.split(argv, parser)
+    try:
+        ours, petsc_args = argv_split.split(argv, parser)
+    except SceneError as err:  # a mistyped option of ours
+        return _fail(str(err))
     args = parser.parse_args(ours)
     logs.configure(args.verbose)
     # PETSc reads its options once, at initialisation: before any import of PETSc.
     import petsc4py
-    petsc4py.init([sys.argv[0], *petsc_args])
+    petsc4py.init(["rawehelix", *petsc_args])  # argv[0] may be "-c": never an option
     from mpi4py import MPI
 
     import rawehelix as rh
+    from rawehelix.solvers import petsc_options
 
     comm = MPI.COMM_WORLD
+    outdir = None
     try:
+        petsc_options.check(args.petsc_unused, argv_split.option_strings(parser, args.command))
         if args.command == "extremes":
             with outdir_lock.hold(args.output, comm):
-                return _extremes(args)
-        if args.command == "labtest":
-            return _labtest(rh, args, comm)
-        params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
-                               scheme=args.scheme, overrides=_overrides(args))
-        outdir = args.output or Path("results") / params.name / args.command
-        outdir_check.check(outdir, args.command)
-        with outdir_lock.hold(outdir, comm):  # one writer per output folder: exit 2 if held
-            return COMMAND[args.command](rh, params, args, outdir, comm)
+                status = _extremes(args)
+        elif args.command == "labtest":
+            status = _labtest(rh, args, comm)
+        else:
+            params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
+                                   scheme=args.scheme, overrides=_overrides(args))
+            outdir = args.output or Path("results") / params.name / args.command
+            outdir_check.check(outdir, args.command)
+            with outdir_lock.hold(outdir, comm):  # one writer per output folder: exit 2 if held
+                status = COMMAND[args.command](rh, params, args, outdir, comm)
+        _warn_unused_after_run(petsc_options, comm)
+        return status
     except SceneError as err:
         return _fail(str(err))
     except outdir_lock.OutputFault as err:  # a full disk: one line, exit 1 (outdir_lock.py)
@@ -226,14 +276,24 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except rh.SolverError as err:
         print(f"rawehelix: {err}", file=sys.stderr)
-        _abort_other_ranks(comm, 1)
-        return 1
+        _abort_other_ranks(comm, FAILED)
+        return FAILED
+    except KeyboardInterrupt:
+        return _interrupted(args.command, outdir, comm)
     except Exception:
         if comm.size == 1:
             raise
         traceback.print_exc()
         _abort_other_ranks(comm, 1)
         raise
+
+
+def _warn_unused_after_run(petsc_options, comm):
+    """PETSc options only a solve reads (a viewer, MUMPS' ICNTL: not checked before
+    the work) that none read, on rank 0."""
+    left = petsc_options.left_after_run()
+    if left and comm.rank == 0:
+        log.warning("PETSc options %s: no solver read them", ", ".join("-" + n for n in left))
 
 
 def _say(comm, text: str):
@@ -294,6 +354,9 @@ def _orbits(rh, params, args, outdir, comm) -> int:
         start, stop = (float(x) for x in args.f1.split(":"))
     except ValueError:
         raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
+    if not (start > 0 and stop > 0 and start != stop and math.isfinite(start + stop)):
+        raise SceneError("--f1", args.f1, "must be START:STOP with START != STOP, both > 0 Hz "
+                         "(an empty or negative window)")
     try:
         orders = (() if args.superharmonics.strip().lower() == "none"
                   else tuple(int(k) for k in args.superharmonics.split(",")))

@@ -39,7 +39,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SolverError
-from rawehelix.parameters import Parameters
+from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.solvers import analytic
 from rawehelix.studies import writers
 from rawehelix.studies.scene import SceneError
@@ -73,7 +73,7 @@ def lab_parameters(helix_scene: Parameters, elements: int | None = None,
     ``law``: a rod with an EI law (Eq. 64 until the caller sets another), which
     needs the extensible kinematics (parameters.py)."""
     h = helix_scene.helix
-    disc = {"elements": elements or LAB_ELEMENTS}
+    disc = {"elements": LAB_ELEMENTS if elements is None else elements}
     if degree is not None:
         disc["degree"] = degree
     helix = {"length_m": LAB_LENGTH_M, "mass_kg": h.mass_kg / h.length_m * LAB_LENGTH_M}
@@ -82,8 +82,12 @@ def lab_parameters(helix_scene: Parameters, elements: int | None = None,
         model["kinematics"] = "extensible"
         if h.EI_law is None:
             helix["EI_law"] = {"a_Nm2_per_N": EQ64[0], "b_Nm2": EQ64[1]}
-    return helix_scene.replace(helix=helix, environment={"wind_speed_m_s": 0.0}, model=model,
-                               discretisation=disc, name=f"{helix_scene.name}_lab")
+    try:  # --elements and --degree checked as a scene's (exit 2, one line)
+        return helix_scene.replace(helix=helix, environment={"wind_speed_m_s": 0.0},
+                                   model=model, discretisation=disc, name=f"{helix_scene.name}_lab")
+    except ParameterError as err:
+        raise SceneError(f"labtest ({helix_scene.name})", err.key,
+                         f"{err.value!r} {err.allowed}") from None
 
 
 def slope(x, y) -> float:

@@ -45,11 +45,33 @@ S = ["stationary", "stationary_table2"]
      ["modes", "stationary_table2", "--count", "4", "--scheme", "spline"], []),
     (["extremes", "a", "b", "-o", "DIR", "-rawehelix_snes_monitor"],
      ["extremes", "a", "b", "-o", "DIR"], ["-rawehelix_snes_monitor"]),
-    # --count is modes' own: for stationary it is PETSc's (and PETSc reports it unused)
-    (S + ["--count", "4"], S, ["--count", "4"]),
+    # short flags run together are ours (argparse counts them)
+    (S + ["-vv", "-rawehelix_snes_monitor"], S + ["-vv"], ["-rawehelix_snes_monitor"]),
+    # a single-dash word near one of ours but not it is PETSc's (its check names ours)
+    (S + ["-elemnts", "4"], S, ["-elemnts", "4"]),
 ])
 def test_split(tokens, ours, petsc):
     assert argv.split(tokens, cli._parser()) == (ours, petsc)
+
+
+@pytest.mark.parametrize("tokens,hint", [
+    # a double dash is never PETSc's: a typo of ours, or another command's option
+    (S + ["--elemnts", "4"], "--elemnts: is not an option of this command; did you mean --elements?"),
+    (S + ["--count", "4"], "--count: is not an option of this command; known: --output,"),
+    (["sweep", "mobile_end", "--f1", "1:2:1", "--Series"], "did you mean --series?"),
+    # one of ours but for case and dashes
+    (S + ["-O", "DIR"], "-O: is not an option of this command; did you mean -o?"),
+    (S + ["-output", "DIR"], "did you mean --output?"),
+    (S + ["-Elements", "4"], "did you mean --elements?"),
+    (S + ["-set", "helix.EI_Nm2=1"], "did you mean --set?"),
+    (["labtest", "axial", "--no_gravity"], "did you mean --no-gravity?"),
+    (["labtest", "axial", "-V"], "did you mean -v?"),
+    (["--elements", "4", "stationary"], "the command comes first: stationary, modes,"),
+])
+def test_mistyped_options_of_ours_refused(tokens, hint):
+    with pytest.raises(argv.ArgvError) as err:
+        argv.split(tokens, cli._parser())
+    assert hint in str(err.value)
 
 
 def test_ours_parse_strictly():
@@ -89,3 +111,81 @@ def test_ambiguous_prefix_and_double_dash():
     with pytest.raises(SystemExit):
         parser.parse_args(["--alp", "3"])  # "ambiguous option"
     assert argv.split(["--alph", "3", "n", "--", "-x"], parser) == (["--alph", "3", "n", "--", "-x"], [])
+
+
+# -- the PETSc options' check (solvers/petsc_options.py), in this process's database
+
+@pytest.fixture
+def petsc_options():
+    """PETSc's options database with some options set, restored afterwards."""
+    from petsc4py import PETSc
+    opts, added = PETSc.Options(), []
+
+    def put(name, value=""):
+        assert not opts.hasName(name)
+        opts[name] = value
+        added.append(name)
+
+    yield put
+    for name in added:
+        opts.delValue(name)
+
+
+def test_used_flag_is_petscs(petsc_options):
+    """compat.petsc_option_used reads PETSc's own flag: False until something asks."""
+    from petsc4py import PETSc
+
+    from rawehelix import compat
+    petsc_options("rawehelix_test_flag", "3")
+    assert not compat.petsc_option_used("rawehelix_test_flag")
+    assert PETSc.Options().getInt("rawehelix_test_flag") == 3
+    assert compat.petsc_option_used("rawehelix_test_flag")
+
+
+def test_check_refuses_unused_with_what_it_meant(petsc_options):
+    from rawehelix.errors import SceneError
+    from rawehelix.solvers import petsc_options as po
+    petsc_options("rawehelix_snes_maxit", "5")  # a typo of -rawehelix_snes_max_it
+    petsc_options("rawehelix_ts_snes_max_it", "7")  # the dynamics' Newton solver reads it
+    with pytest.raises(SceneError) as err:
+        po.check("error", ("--elements",))
+    text = str(err.value)
+    assert "-rawehelix_snes_maxit (did you mean -rawehelix_snes_max_it" in text
+    assert "rawehelix_ts_snes_max_it" not in text.split("(did you mean")[0]
+    assert "--petsc-unused warn" in text
+
+
+def test_check_warn_only(petsc_options, caplog):
+    from rawehelix.solvers import petsc_options as po
+    petsc_options("rawehelix_elemnts", "4")
+    po.check("warn")
+    assert "-rawehelix_elemnts" in caplog.text and "no solver of rawehelix reads" in caplog.text
+
+
+@pytest.mark.parametrize("name,value,reason", [
+    ("rawehelix_snes_type", "nonexistent", "Unable to find requested SNES type nonexistent"),
+    ("rawehelix_ksp_rtol", "abc", "Input string abc has no numeric value"),
+    ("rawehelix_pep_type", "nonexistent", "nonexistent"),
+])
+def test_check_refuses_bad_values_with_petscs_reason(petsc_options, name, value, reason):
+    from rawehelix.errors import SceneError
+    from rawehelix.solvers import petsc_options as po
+    petsc_options(name, value)
+    with pytest.raises(SceneError) as err:
+        po.check()
+    assert f"-{name} {value}: " in str(err.value) and reason in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+def test_viewers_are_left_to_the_end_of_the_run(petsc_options):
+    """-..._converged_reason is read by a solve, not a set-up: passed by the check,
+    listed by left_after_run until a solver reads it."""
+    from petsc4py import PETSc
+
+    from rawehelix.solvers import petsc_options as po
+    petsc_options("rawehelix_ts_snes_converged_reason")
+    petsc_options("rawehelix_snes_maxit", "5")  # warned before the work, not again
+    po.check("warn")
+    assert po.left_after_run() == ["rawehelix_ts_snes_converged_reason"]
+    PETSc.Options().hasName("rawehelix_ts_snes_converged_reason")  # as TSSolve's SNES does
+    assert "rawehelix_ts_snes_converged_reason" not in po.left_after_run()

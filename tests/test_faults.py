@@ -1,0 +1,99 @@
+"""The command line's fault table (issue 27): every command, bad input refused
+before any work with exit status 2, ONE line on stderr (no traceback) naming
+the option and what is allowed, and nothing written (neither the -o folder
+nor ./results); Ctrl-C during a sweep exits 130 with one line saying what was
+kept, and the same command resumes."""
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+RAWEHELIX = str(Path(sys.executable).parent / "rawehelix")
+OUT = "OUT"  # the -o folder, in the test's own working directory
+
+# (command line, exit status, what the one line must say)
+FAULTS = [
+    # our options mistyped: never passed on to PETSc (which would ignore them)
+    (["stationary", "stationary_table2", "--elemnts", "4"], 2, "did you mean --elements?"),
+    (["stationary", "stationary_table2", "-O", OUT], 2, "did you mean -o?"),
+    (["modes", "stationary_table2", "-output", OUT], 2, "did you mean --output?"),
+    (["sweep", "mobile_end", "-Elements", "3"], 2, "did you mean --elements?"),
+    (["stationary", "stationary_table2", "--count", "4"], 2, "--count: is not an option"),
+    (["labtest", "axial", "--elemnts", "4"], 2, "did you mean --elements?"),
+    (["stationary", "stationary_table2", "--elements", "x"], 2, "invalid int value: 'x'"),
+    # PETSc options no solver reads, and values PETSc refuses
+    (["stationary", "stationary_table2", "-rawehelix_snes_maxit", "5"], 2,
+     "-rawehelix_snes_maxit (did you mean -rawehelix_snes_max_it"),
+    (["stationary", "stationary_table2", "-elemnts", "4"], 2,
+     "-elemnts (did you mean --elements?): no solver of rawehelix reads them"),
+    (["stationary", "stationary_table2", "-rawehelix_snes_type", "nonexistent"], 2,
+     "-rawehelix_snes_type nonexistent: Unable to find requested SNES type nonexistent"),
+    (["simulate", "nominal_operation", "-rawehelix_ts_type", "nonexistent"], 2,
+     "Unknown TS type: nonexistent"),
+    (["response", "mobile_end", "-rawehelix_ksp_rtol", "abc"], 2,
+     "-rawehelix_ksp_rtol abc: Input string abc has no numeric value"),
+    (["labtest", "bending", "-rawehelix_labtest_snes_type", "nonexistent"], 2,
+     "Unable to find requested SNES type nonexistent"),
+    (["extremes", "-rawehelix_pep_type", "nonexistent"], 2, "nonexistent"),
+    # each command's own checks
+    (["labtest", "axial", "--degree", "9"], 2, "discretisation.degree: 9 must be an integer from 2 to 8"),
+    (["labtest", "axial", "--elements", "0"], 2, "discretisation.elements: 0 must be an integer >= 1"),
+    (["response", "mobile_end", "--degree", "9"], 2, "must be an integer from 2 to 8"),
+    (["orbits", "mobile_end", "--f1", "11:11"], 2, "START != STOP"),
+    (["sweep", "mobile_end", "--f1", "1:2"], 2, "is not START:STOP:STEP"),
+    (["converge", "stationary_table2", "--quantity", "nothing"], 2, "--quantity: nothing"),
+    (["extremes", "nosuchcase"], 2, "unknown case(s)"),
+    (["study", "stationary_table2", "--vary", "helix.EI_Nm2=1:2:3", "--quantity", "tension"], 2,
+     "--quantity: tension: unknown quantity"),
+    (["calibrate", "stationary_table2", "--fit", "helix.EI_Nm2", "--target", "nosuch=1"], 2,
+     "--target: nosuch: unknown quantity"),
+]
+
+
+def _ids(case):
+    return "-".join(case[0][:1] + [t for t in case[0][1:] if t.startswith("-")])
+
+
+@pytest.mark.parametrize("argv,status,message", FAULTS, ids=[_ids(c) for c in FAULTS])
+def test_refused_before_work(tmp_path, argv, status, message):
+    argv = [t if t != OUT else str(tmp_path / OUT) for t in argv]
+    if "-o" not in argv and "-O" not in argv and "-output" not in argv:
+        argv += ["-o", str(tmp_path / OUT)]
+    run = subprocess.run([RAWEHELIX, *argv], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=300)
+    lines = run.stderr.splitlines()
+    assert run.returncode == status, run.stderr
+    assert len(lines) == 1 and "Traceback" not in run.stderr, run.stderr
+    assert message in lines[0]
+    assert run.stdout == ""
+    assert list(tmp_path.iterdir()) == []  # no -o folder, no ./results
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_points_and_resumes(tmp_path):
+    """SIGINT after the first of two points: exit 130, one line saying that 1 point
+    was kept and how to resume; the rerun computes only the other point."""
+    argv = [RAWEHELIX, "sweep", "mobile_end", "--elements", "2", "--f1", "5:6:1",
+            "-o", str(tmp_path / OUT)]
+    proc = subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    points = tmp_path / OUT / "points"
+    deadline = time.monotonic() + 900
+    while not list(points.glob("f1_*.json")) and time.monotonic() < deadline:
+        assert proc.poll() is None, proc.communicate()
+        time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    said = [ln for ln in err.splitlines() if "interrupted" in ln]
+    assert said == [f"rawehelix: interrupted: 1 finished point kept in {tmp_path / OUT}/; "
+                    "run the same command again to resume"], err
+    assert len(list(points.glob("f1_*.json"))) == 1
+    again = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True, timeout=900)
+    assert again.returncode == 0, again.stderr
+    assert "2 points (1 computed now)" in again.stdout
