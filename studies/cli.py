@@ -409,15 +409,16 @@ def _numbers(option: str, text: str | None):
 
 
 def _labtest(rh, args, comm) -> int:
-    from rawehelix.studies import labtest, outdir as outdir_check
+    from rawehelix.studies import labtest, outdir as outdir_check, outdir_lock
     scene = rh.load_scene(args.scene, overrides=_overrides(args))
     outdir = args.output or Path("results") / "labtest" / (args.test + "_fit" * args.fit)
     outdir_check.check(outdir, "labtest")
-    result = rh.labtest(args.test, scene, tensions_N=_numbers("--tension", args.tension),
-                        loads=_numbers("--loads", args.loads), fit=args.fit,
-                        rod_EI_Nm2=args.rod_EI, elements=args.elements, degree=args.degree,
-                        gravity=not args.no_gravity, comm=comm)
-    result.write(outdir)
+    with outdir_lock.hold(outdir, comm):  # one writer per output folder, as every command
+        result = rh.labtest(args.test, scene, tensions_N=_numbers("--tension", args.tension),
+                            loads=_numbers("--loads", args.loads), fit=args.fit,
+                            rod_EI_Nm2=args.rod_EI, elements=args.elements, degree=args.degree,
+                            gravity=not args.no_gravity, comm=comm)
+        result.write(outdir)
     _say(comm, labtest.report(result) + f"\n  wrote {outdir}/")
     return 0
 
