@@ -18,7 +18,7 @@ import ufl
 VERSION = tuple(int(x) for x in dolfinx.__version__.split(".")[:2])
 NEW = VERSION >= (0, 7)
 # solvers/chord.py and solvers/orbits.py step TSALPHA2's scheme as PETSc 3.18 has it
-# (Debian 12); PETSc 3.22's (Debian 13) departs from it by ~1e-7 a step (docs/speed.md)
+# (Debian 12); PETSc 3.22's (Debian 13) departs from it by ~1e-7 a step (docs/explanation/speed.md)
 ALPHA2_AS_PETSC_318 = not NEW
 
 if NEW:

@@ -273,7 +273,7 @@ class Model:
     # at the planar stationary states the regularised coupling shifts the
     # out-of-plane and torsional frequencies by ~0.2 % and makes torsional
     # modes grow (Re lambda ~ +1.5e-4 and more), an artefact of the Frenet frame
-    # of an almost straight curve (docs/modal_convergence.md).
+    # of an almost straight curve (docs/explanation/modal_convergence.md).
     gamma: str = "off"
     # "auto": solve a reduced model where the scene allows it (the planar (x, z)
     # rod for a planar, torque-free stationary state); "off": always the full one
@@ -337,7 +337,7 @@ class Discretisation:
     grading: float = 4.0  # graded mesh: ratio of the largest to the smallest element
     penalty: float = 8.0  # interior-penalty factor eta: penalty = eta p^2 mu / h
     # "ip": C0 interior penalty on r'' (fourth order); "mixed": the curvature
-    # kappa = r'' as its own field (Ciarlet-Raviart, second order, docs/large_n.md)
+    # kappa = r'' as its own field (Ciarlet-Raviart, second order, docs/explanation/large_n.md)
     bending: str = "ip"
     quadrature_degree: int = 0  # cell quadrature: 0 the rule 3p, -1 UFL's estimate, > 0 that degree
 
@@ -368,7 +368,7 @@ class Discretisation:
         """The largest N at which the IP bending form is trusted: 512 (3/p)^(4/3).
 
         Its Jacobian entries grow like mu p^4 N^3, and the round-off of the
-        lowest lateral eigenvalue with them: measured at p = 3 (docs/large_n.md)
+        lowest lateral eigenvalue with them: measured at p = 3 (docs/explanation/large_n.md)
         7.7e-4 at N = 512, 1.9e-2 at N = 1000.  The mixed form has no such limit
         up to N = 10^4."""
         return int(512 * (3 / self.degree) ** (4 / 3))

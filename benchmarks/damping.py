@@ -20,7 +20,7 @@ run of ``nominal_operation`` at N = 4 (alpha2, adaptive), median of
 
     .venv/bin/python benchmarks/damping.py [--elements 16] [--tau 1e-3] [--repeats 5]
 
-Prints the markdown of docs/physics.md (section 'structural damping').
+Prints the markdown of docs/explanation/model.md (section 'structural damping').
 Serial (COMM_SELF); a benchmark, not a test.
 """
 

@@ -16,7 +16,7 @@ the forms, with the ratios to ``paper``.
 
     .venv/bin/python benchmarks/eilaw.py [--elements 16] [--repeats 5]
 
-Serial (COMM_SELF); a benchmark, not a test.  docs/physics.md (section
+Serial (COMM_SELF); a benchmark, not a test.  docs/explanation/model.md (section
 'tension-dependent bending') quotes its output.
 """
 

@@ -15,7 +15,7 @@ overrides, as ``--set`` takes them) it measures, through the public API only
   ends (the largest drop of T max) and its largest T max; the only
   measurement of the options whose orbits fail;
 * ``orbits``: the Fig. 8 resonance (``mobile_end``): the branch from
-  ``F1_START`` upward without superharmonic sites (as docs/orbits.md "Issue
+  ``F1_START`` upward without superharmonic sites (as docs/explanation/orbits.md "Issue
   test 4"), stopped at the first point after the first fold; the fold's f1
   and T max and the peak (the first local maximum of T max that the branch
   locates, the vertex of its parabola; else the largest T max on the branch);
@@ -28,7 +28,7 @@ for the paper's model in the same process (orbits: CPU time per point).
 
 ``run`` stores each (part, option) in benchmarks/fidelity/<part>.json as it
 finishes (a rerun skips what is stored unless ``--again``); ``table`` prints
-the markdown of docs/physics.md ("fidelity table").  Serial; a benchmark.
+the markdown of docs/explanation/model.md ("fidelity table").  Serial; a benchmark.
 """
 
 from __future__ import annotations
@@ -47,11 +47,11 @@ from rawehelix.families import FAMILY_LABELS, VIBRATIONS
 
 HERE = Path(__file__).resolve().parent / "fidelity"
 
-#: the intrinsic law identified by `rawehelix labtest bending --fit` (docs/labtest.md)
+#: the intrinsic law identified by `rawehelix labtest bending --fit` (docs/explanation/labtest.md)
 EI_LAW = {"a_Nm2_per_N": 34.88, "b_Nm2": 2303.0}
 #: retardation times [s]: round values that give each family's first Table 3
 #: mode a damping ratio of about 1 % (the paper measures no decay rate; see
-#: docs/physics.md "fidelity table" for the ratios they give)
+#: docs/explanation/model.md "fidelity table" for the ratios they give)
 DAMPING = {"damping.axial_s": 1e-4, "damping.bending_s": 1e-3, "damping.torsion_s": 1e-3}
 EXTENSIBLE = {"model.kinematics": "extensible"}
 LAW = {**EXTENSIBLE, "helix.EI_law": EI_LAW}
@@ -86,7 +86,7 @@ PARTS = ("modes", "simulate", "orbits", "sweep")
 ELEMENTS = {"modes": 16, "simulate": 16, "orbits": 4, "sweep": 4}
 SWEEP_F1 = [round(11.5 + 0.1 * k, 1) for k in range(15)]  # Hz, the sweep's grid
 REPEATS = 3  # modes, simulate: the median CPU time of REPEATS runs after one that compiles
-F1_START = 11.5  # Hz, the start of docs/orbits.md's fold window
+F1_START = 11.5  # Hz, the start of docs/explanation/orbits.md's fold window
 F1_STOP = {"paper": 12.9, "extensible": 12.9, "damping": 12.9}  # else F1_STOP_WIDE
 F1_STOP_WIDE = 14.5  # the EI law stiffens the Sec. 5.3 helix (+10 % EI at 73 N)
 MAX_POINTS = 60

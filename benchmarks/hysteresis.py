@@ -12,7 +12,7 @@ deg.  The figure's data are not in the text we have: (2) is our reading.
 
 ``nominal_operation`` (Sec. 5.2: fixed ends, the rotor's 25 Nm ramp, the PD
 controller to 120 rpm) with the paper's elastic torsion and with the Bouc-Wen
-law of ``FIG5`` (docs/physics.md says how it was chosen): the settling time
+law of ``FIG5`` (docs/explanation/model.md says how it was chosen): the settling time
 (2 % band), the peak ground torque, the final spins and torque, the final
 end-to-end twist alpha(L0) - alpha(0), the largest spin difference between
 the ends (the torsional oscillation), and the CPU
@@ -21,7 +21,7 @@ run that compiles the forms.  Both runs: alpha2, the scene's adaptive steps.
 
     .venv/bin/python benchmarks/hysteresis.py [--elements 16] [--until 30] [--repeats 3] [--fit]
 
-Prints the markdown of docs/physics.md (section 'hysteretic torsion').
+Prints the markdown of docs/explanation/model.md (section 'hysteretic torsion').
 Serial (COMM_SELF); a benchmark, not a test.
 """
 
@@ -38,7 +38,7 @@ from rawehelix.parameters import TorsionHysteresis
 from rawehelix.solvers import bouc_wen
 from rawehelix.studies import scene, simulate, torsion_test
 
-#: the Bouc-Wen law of docs/physics.md (chosen against the torsion test of Fig. 5: fit())
+#: the Bouc-Wen law of docs/explanation/model.md (chosen against the torsion test of Fig. 5: fit())
 FIG5 = {"rho": 0.5, "A": 2.39, "beta_m_n": 4.78, "gamma_m_n": 4.78, "n": 1.0}
 SECANT_AT_TURN_NM2 = 140.0  # the nominal GJ, "consistent with Fig. 5"
 WIDTH_NM2 = 25.0 * torsion_test.LENGTH_M / torsion_test.THETA_MAX_RAD - 140.0  # 194 - 140

@@ -9,7 +9,7 @@ the median of ``--repeats`` runs after one that compiles the forms.
 
     .venv/bin/python benchmarks/kinematics.py [--elements 16] [--repeats 5]
 
-Prints the markdown table of docs/physics.md (section 'kinematics').
+Prints the markdown table of docs/explanation/model.md (section 'kinematics').
 Serial (COMM_SELF); a benchmark, not a test.
 """
 

@@ -1,4 +1,4 @@
-"""The virtual lab tests' numbers in docs/labtest.md that no single command prints.
+"""The virtual lab tests' numbers in docs/explanation/labtest.md that no single command prints.
 
 1. The load dependence of the bending test with the EI law in the rod
    (helix.EI_law, extensible kinematics): the secant EI = F_N L0^3 / (3 y_e)

@@ -9,7 +9,7 @@ the SLEPc solve (PEP/TOAR, shift-and-invert, MUMPS), and the eigenvalues.
 At this resolution the Newton residual has a round-off floor (~3.7, growing
 like N^3), so the step test is relaxed to -rawehelix_snes_stol 1e-8 unless
 given.  The lateral eigenvalues are then ~15 % off (round-off in the
-fourth-order operator, see docs/modal_convergence.md): this measures time,
+fourth-order operator, see docs/explanation/modal_convergence.md): this measures time,
 not accuracy.
 """
 

@@ -12,7 +12,7 @@ with the process-time clock, one point each, by part).
     .venv/bin/python benchmarks/orbits.py [--elements 4,8] [--points 4]
     .venv/bin/python benchmarks/run.py --only orbits
 
-Prints the markdown of docs/orbits.md ("Cost of a point").  A benchmark, not a test.
+Prints the markdown of docs/explanation/orbits.md ("Cost of a point").  A benchmark, not a test.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ sections and keeps the others' last results.
 3. The same FE sweep on 2 MPI ranks against 1 (mpirun, same command).
 4. The modal solve (20 eigenpairs) at N = 2000, p = 3.
 5. Real-time factor of the Sec. 5.2 and 5.3 scenes at converged resolution.
-6. ``levers``: the cheaper step lever by lever (docs/speed.md), back to back:
+6. ``levers``: the cheaper step lever by lever (docs/explanation/speed.md), back to back:
    real-time factor at 10 Hz and the verified numbers (T(0), Table 3, T max).
 7. ``sweep_few``: the FE sweep over the spline N = 2 one on a few points
    (SWEEP_FEW_F1), each the whole command: the issue-12 ratio target.
@@ -223,7 +223,7 @@ def bench_sweep_few(f1: list[float], repeats: int):
     return out
 
 
-#: the levers of docs/speed.md, cumulative: (discretisation.quadrature_degree,
+#: the levers of docs/explanation/speed.md, cumulative: (discretisation.quadrature_degree,
 #: FEBackend options); the lifting skip and the one set_time per time are in
 #: every row (code, not options: see bench_residual_crossings)
 LEVERS = {

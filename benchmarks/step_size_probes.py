@@ -1,4 +1,4 @@
-"""Probes of the FE sweep's time step (docs/step_size.md): one f1 path at one dt.
+"""Probes of the FE sweep's time step (docs/explanation/step_size.md): one f1 path at one dt.
 
     python benchmarks/step_size_probes.py --dt 1e-3 --f1 0.5:7.5:0.5
     python benchmarks/step_size_probes.py --dt 1e-3 --f1 7.5 --lead-in 2

@@ -11,7 +11,7 @@
    this process on COMM_SELF (quantities.evaluate): a stationary quantity
    (``tension_s0_N``), a modal one (``lateral_frequency_Hz``), a sweep one
    (``tension_max_N@10``) and an orbit one (``fold_Hz``: the orbits traced
-   from 11.5 Hz to past the Sec. 5.3 fold at 12.70 Hz, docs/orbits.md; a
+   from 11.5 Hz to past the Sec. 5.3 fold at 12.70 Hz, docs/explanation/orbits.md; a
    trace from 12.4 Hz fails, the shooting from the stationary state does
    not converge there).
 

@@ -59,7 +59,9 @@ myst_heading_anchors = 3
 # The site's pages are index.md and the four folders of its toctree.  Everything
 # else under docs/ is data that pages and tests read (summary.json, CSV, figures,
 # the generated tables of the studies), not a page: leave it out of the build.
-SITE = {"index.md", "tutorials", "howto", "explanation", "reference", "conf.py",
+# Except converge/: its generated tables (converge/Q/converge.md, written by
+# `rawehelix converge`) are pages of explanation/convergence.md's toctree.
+SITE = {"index.md", "tutorials", "howto", "explanation", "reference", "converge", "conf.py",
         "_static", "_templates", "_ext", "_build"}
 exclude_patterns = sorted(p.name for p in HERE.iterdir() if p.name not in SITE)
 exclude_patterns += ["_build", "**/summary.json", "**/runs"]

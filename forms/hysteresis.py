@@ -45,7 +45,7 @@ scipy's solve_ivp: second order in dt, as for the rod.  alpha2's local error
 estimate is not: the start (A_z = 0 while z_tt != 0) and each reversal of
 tau_t (a kink of z_t) inflate it, so solvers/dynamics.py leaves z's dofs out
 of the step-size control (infinite absolute tolerance); z follows tau, whose
-error is controlled (docs/physics.md measures both).  The first-order TS
+error is controlled (docs/explanation/model.md measures both).  The first-order TS
 types (FirstOrder in solvers/ts_forms.py) are refused: they would need z
 once more as a first-order unknown.
 

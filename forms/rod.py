@@ -118,7 +118,7 @@ def quadrature_degree(degree: int, chosen: int = 0) -> int | None:
     2p - 2 times 1/|r'| = 1 + O(strain), so the part that no rule integrates
     exactly is of the order of the strain (2e-3) times a smooth function.
     3p integrates every polynomial part exactly for p <= 6 and the rest to
-    well below the discretisation error (docs/speed.md).  UFL's own estimate
+    well below the discretisation error (docs/explanation/speed.md).  UFL's own estimate
     (``chosen`` = -1) adds the degrees of every factor, 14 for the residual
     and 20 for the Jacobian at p = 3, so the Jacobian is not even the exact
     derivative of the residual; ``chosen`` > 0: that degree."""

@@ -13,7 +13,7 @@ share at a tighter ``tol``):
 - the predictor extrapolates the last three stage values (quadratic in t).  It
   is off by ~5e-5 (normalised) at N = 8 whatever the order (1 to 3; the last
   stage value alone: 4e-4): the correction is spatially oscillating r content the
-  extrapolation cannot follow, so a step takes 3-3.5 iterations (docs/speed.md);
+  extrapolation cannot follow, so a step takes 3-3.5 iterations (docs/explanation/speed.md);
 - the stopping test is Hairer's (Hairer and Wanner, Solving ODEs II, IV.8):
   eta |dz|_inf <= tol with eta = theta / (1 - theta) from the contraction theta
   = |dz_k| / |dz_{k-1}| measured in this step with this LU (so at least two

@@ -209,7 +209,7 @@ class DynamicsSolver:
         alpha2's error estimate on a field obeying a first-order equation sees
         the start's inconsistent A_z = 0 and every reversal of tau_t (where z_t
         has a kink) as large errors: with z in the norm the Sec. 5.2 spin-up at
-        N = 4 takes 10 x the steps (docs/physics.md).  z follows tau, whose error
+        N = 4 takes 10 x the steps (docs/explanation/model.md).  z follows tau, whose error
         is controlled; tests/test_hysteresis.py measures z's accuracy."""
         _, z_dofs = compat.collapse(self.rod.W.sub(2))
         U = self.form.initial_vectors()[0]

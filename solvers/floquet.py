@@ -309,7 +309,7 @@ class PeriodMap:
             if limit is not None and not value <= limit:
                 raise SolverError(
                     f"orbits: at f1 = {f1_Hz} Hz the orbit's {name} defect is "
-                    f"{value:.3g} > {limit:g}: {self.defect_meaning(name)} (docs/orbits.md, "
+                    f"{value:.3g} > {limit:g}: {self.defect_meaning(name)} (docs/explanation/orbits.md, "
                     f"'carried entries')")
         internal = None
         if self.needs_vectors:

@@ -8,7 +8,7 @@ Within one frequency the periods continue the integration: alpha2's restart
 (two half backward-Euler steps for the acceleration, PETSc's TSAlpha_Restart)
 perturbs the state by O(dt), and done every period it moved the periodic state
 below 1.5 Hz, where a transient decays by 4 % a period, by 30 % of the
-oscillation T max - T min (docs/orbits.md, "The sweep against the orbits").
+oscillation T max - T min (docs/explanation/orbits.md, "The sweep against the orbits").
 States are :class:`~rawehelix.solvers.state.RodState`; the backend reads and
 writes no files (``pack``/``unpack`` convert to and from plain arrays)."""
 
@@ -37,7 +37,7 @@ class FEBackend:
     #: rebuilt when an iteration contracts |F| by less than 10x, at rtol 1e-8.
     #: (At 1e-6 its error, ~3e-5 of T a period and not periodic, kept the 1 Hz
     #: point 0.2-0.5 of its oscillation off the orbit for 400 periods; 1e-8 costs
-    #: x1.19 at 10 Hz, N = 8, and the same at 1 Hz, N = 4: docs/orbits.md,
+    #: x1.19 at 10 Hz, N = 8, and the same at 1 Hz, N = 4: docs/explanation/orbits.md,
     #: "The sweep against the orbits".)
     #: ``FULL_NEWTON`` switches it off (the converge study's reference runs).
     OPTIONS = {"ts_adapt_type": "none", "ts_max_snes_failures": -1, "ts_snes_max_it": 25,
@@ -125,7 +125,7 @@ class ChordBackend(FEBackend):
     Where the TS path cuts a step after a Newton failure, this one raises
     SolverError.  Like the TS path it continues within a frequency (alpha2's
     start only at a new state or circle).  Not the sweep's backend: it is 1.8x
-    faster, not the 5x of issue 12 (docs/speed.md, section 5); ``chord``
+    faster, not the 5x of issue 12 (docs/explanation/speed.md, section 5); ``chord``
     options go to ChordAlpha."""
 
     def __init__(self, params: Parameters, comm=MPI.COMM_SELF, options: dict | None = None,

@@ -30,7 +30,7 @@ The rigid rotation alpha = const is the zero eigenvalue of torque-free ends
 
 Accuracy: the fourth-order operator limits the attainable accuracy of the
 lateral modes on fine meshes (round-off ~ eps N^4, 1e-3 at N = 512, p = 3);
-see docs/modal_convergence.md.
+see docs/explanation/modal_convergence.md.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ unit rows and they do not depend on X_n.  The Floquet multipliers are the
 eigenvalues of the monodromy at the orbit; the n spurious roots of the
 scheme (about -rho_inf per step) give multipliers near 0.
 
-How a step is solved (docs/orbits.md, "Cost of a point"):
+How a step is solved (docs/explanation/orbits.md, "Cost of a point"):
 
 - chord Newton (:meth:`AlphaMap.solve_stage`, shared with the chord step loop
   of solvers/chord.py, whose docstring describes it): the dense LU of J (the
@@ -77,7 +77,7 @@ from rawehelix.solvers.snes import SolverError
 
 AXPY = scipy.linalg.blas.get_blas_funcs("axpy", (np.zeros(1),))
 MAX_STATE = 3000  # dense monodromy: (3n)^2 doubles, an LU of n per step
-TOL = 1e-14  # the steps' chord Newton (max norm of z, normalised): see docs/orbits.md
+TOL = 1e-14  # the steps' chord Newton (max norm of z, normalised): see docs/explanation/orbits.md
 ROUNDOFF = 1e-14  # |dz| / max(1, |z|) at which an iterate is round-off, not a correction
 #: weights of the newest-first stage values in the extrapolation of order k
 EXTRAPOLATION = {0: (1.0,), 1: (2.0, -1.0), 2: (3.0, -3.0, 1.0), 3: (4.0, -6.0, 4.0, -1.0)}
@@ -156,7 +156,7 @@ class AlphaMap(PeriodMap):
         w_t = stationary.w_t if stationary.w_t is not None else np.zeros(n)
         self.X_stationary = np.concatenate([stationary.w, w_t, np.zeros(n)])
 
-    #: the defects allowed at an orbit (floquet.py, "Carried entries"; docs/orbits.md)
+    #: the defects allowed at an orbit (floquet.py, "Carried entries"; docs/explanation/orbits.md)
     defect_tolerances = {"carried": CARRIED_TOL, "z": Z_TOL}
 
     def defects(self, G, X, Phi) -> dict:
@@ -183,7 +183,7 @@ class AlphaMap(PeriodMap):
     def set_aside(self, mu, vectors):
         """z's multipliers: real within Z_MULTIPLIER of 1, their eigenvector mostly
         z in U (|v_z| > |v_U| / 2); 1 - mu ~ beta x the twist's travel per period,
-        how much of a change of z a period forgets (docs/orbits.md)."""
+        how much of a change of z a period forgets (docs/explanation/orbits.md)."""
         U = vectors[:self.n]
         share = np.linalg.norm(U[self.z_dofs], axis=0) / np.maximum(
             np.linalg.norm(U, axis=0), 1e-300)

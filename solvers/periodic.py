@@ -9,7 +9,7 @@ oscillation, not T max, is the scale: below 8 Hz it is under 1 % of T, and a
 tolerance relative to T max accepted an oscillation still changing by 20 %.
 The remainder, not the last change, is judged: below 1.5 Hz a transient
 decays by 4 % a period, and a change of 1e-3 of the oscillation left 10-40 %
-of it (docs/orbits.md, "The sweep against the orbits").
+of it (docs/explanation/orbits.md, "The sweep against the orbits").
 A point that reaches ``sweep.max_periods`` first is flagged ``periodic =
 False``, never silently accepted.
 

@@ -19,7 +19,7 @@ The criterion (one, for every fixed-step run):
 that is at least 2 pi / THETA_MAX steps per period of either.  A step past it
 is refused before the run (:class:`~rawehelix.errors.SceneError` naming
 ``time.dt_s``, the limit and why).  THETA_MAX is the measured edge: see
-docs/step_size.md (probes of the Sec. 5.3 sweep paths at dt = 0.5-10 ms).
+docs/explanation/step_size.md (probes of the Sec. 5.3 sweep paths at dt = 0.5-10 ms).
 
 The lateral modes and the torsional ones the scene excites are slower than
 omega_L in every shipped scene (Table 3); the discrete operator's modes above
@@ -38,7 +38,7 @@ from rawehelix.errors import SceneError
 from rawehelix.solvers import analytic
 
 #: the largest omega dt a fixed step may have (2 pi / THETA_MAX ~ 6.3 steps per
-#: period of the fastest excited motion); measured in docs/step_size.md
+#: period of the fastest excited motion); measured in docs/explanation/step_size.md
 THETA_MAX = 1.0
 
 
@@ -88,5 +88,5 @@ def check(params, f1_Hz=None, fixed_steps: bool | None = None):
                          f"{dt:g} s is too long for fixed steps: it must resolve {worst.what}, "
                          f"omega dt <= {THETA_MAX:g} (at least {2 * math.pi / THETA_MAX:.1f} steps "
                          f"per period), so dt <= {worst.dt_max_s:.3g} s; longer steps let "
-                         f"alpha2 go wrong or unstable (docs/step_size.md)")
+                         f"alpha2 go wrong or unstable (docs/explanation/step_size.md)")
     return worst

@@ -17,12 +17,12 @@ theirs:
 Every regression is a least-squares line through the origin, as the
 formulas have no intercept.  ``bending`` with ``fit``: the intrinsic bending
 law EI = a T + b whose simulated test reproduces Eq. (64) at the paper's
-tensions (docs/labtest.md), on the rod with ``helix.EI_law`` (extensible
+tensions (docs/explanation/labtest.md), on the rod with ``helix.EI_law`` (extensible
 kinematics, which the law needs): per tension a 1-D root find of a constant
 EI (secant, from the closed-form inverse of solvers/analytic.py), the line
 through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
 small loads (the law's energy couples the axial force to kappa^2, so its
-test softens with the load: docs/labtest.md).
+test softens with the load: docs/explanation/labtest.md).
 
 :func:`compute` returns a :class:`LabTest`; :meth:`LabTest.write` writes
 summary.json and labtest.png.  Computing writes nothing.
@@ -55,7 +55,7 @@ DEFAULT_TENSIONS_N = {"axial": (50.0, 100.0, 150.0, 200.0, 250.0),
                       "bending": PAPER_BENDING_TENSIONS_N,
                       "torsion": (200.0,)}  # T_e0 ~ 200 N, Fig. 5
 DEFAULT_LOADS = {"bending": (2.5, 5.0, 7.5, 10.0),  # F_N [N]
-                 "fit": (0.1, 0.2, 0.3, 0.4),  # F_N [N]: the small-load limit (docs/labtest.md)
+                 "fit": (0.1, 0.2, 0.3, 0.4),  # F_N [N]: the small-load limit (docs/explanation/labtest.md)
                  "torsion": (5.0, 10.0, 15.0, 20.0, 25.0)}  # M_t [Nm], up to ~25 Nm (Sec. 4)
 FIT_TOLERANCE = 1e-4  # relative: the per-tension root find of the intrinsic EI
 FIT_TARGET = 0.01  # the law's simulated test reproduces Eq. (64) within 1 %
@@ -120,7 +120,7 @@ def bending_test(solver, tension_N: float, loads_N) -> dict:
             tip = solver.solve(tension_N * solver.axis + F * NORMAL)
         except SolverError as err:
             hint = (" With the EI law in the rod the energy 1/2 EI(eps) kappa^2 stops being "
-                    "convex at kappa^2 = EI / (a^2 EA) (docs/labtest.md): try smaller --loads."
+                    "convex at kappa^2 = EI / (a^2 EA) (docs/explanation/labtest.md): try smaller --loads."
                     if solver.rod.c.bending_law else "")
             raise SolverError(f"bending test at T_e = {tension_N:g} N, F_N = {F:g} N: "
                               f"{err}{hint}") from None

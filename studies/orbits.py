@@ -315,7 +315,7 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[flo
     from rawehelix.studies.response import natural_modes
     # the FE linearisation about the circle's centre (R1 = 0), as `rawehelix response`;
     # undamped: a site is f_n / k within a 5 % window, which structural damping moves
-    # by its second order (< 0.1 %, docs/physics.md), and the damped pencil is a PEP
+    # by its second order (< 0.1 %, docs/explanation/model.md), and the damped pencil is a PEP
     # that SLEPc does not always close at small N
     if params.model.damping.active:
         params = params.replace(damping={"axial_s": 0.0, "bending_s": 0.0, "torsion_s": 0.0})

@@ -255,5 +255,5 @@ def evaluate(params: Parameters, wanted: list[str], timed_out: Callable | None =
 
 
 def table() -> str:
-    """The quantities, one a line (for --help and docs/study.md)."""
+    """The quantities, one a line (for --help and docs/explanation/study.md)."""
     return "\n".join(f"  {q.name:<36} [{q.unit}] ({q.stage}) {q.doc}" for q in QUANTITIES.values())

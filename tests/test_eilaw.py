@@ -11,7 +11,7 @@ b = 2290 Nm^2.
   N.t = T + 1/2 mu_a sigma kappa^2.
 * The modes are checked against the string-beam of tests/test_extensible.py,
   omega_n^2 = (T/lambda) k^2 + (mu(T)/lambda^2) k^4 with mu at the mean
-  tension (docs/physics.md says what that neglects).
+  tension (docs/explanation/model.md says what that neglects).
 """
 
 import functools
@@ -233,7 +233,7 @@ def test_lateral_modes_at_the_mean_tension(name, out_tol, in_tol):
     with EI at each model's mean tension, within ``out_tol`` out of plane
     (measured 4e-5 .. 1.3e-4 for Table 2, 6e-7 .. 9e-5 for Sec. 5.3) and
     ``in_tol`` in plane (measured up to 4.5e-3 and 9.7e-4).  What the closed form
-    neglects (docs/physics.md): the variation of T along s, the axial force
+    neglects (docs/explanation/model.md): the variation of T along s, the axial force
     N.t = T + 1/2 EI' kappa^2 of the stationary state, and in plane the coupling
     of stretch and curvature by the law, the Hessian's a^2 EA kappa^2 (the
     in-plane bending stiffness drops by a^2 EA kappa0^2 where the rod is curved),
@@ -370,7 +370,7 @@ def _convexity_ratio(m, orbit, law, EA_N) -> float:
 
 @pytest.mark.slow
 def test_the_paper_resonance_lies_where_the_identified_law_is_not_convex():
-    """Why the identified law has no Fig. 8 resonance (docs/physics.md): on the
+    """Why the identified law has no Fig. 8 resonance (docs/explanation/model.md): on the
     paper model's own orbit near the resonance peak (12.59 Hz, T max 562.6 N,
     N = 4) the curvature passes the law's convexity limit sqrt(EI(T) / EA) / a
     (measured: kappa^2 a^2 EA / EI(T) up to 19.7; 18.0 at 11.5 Hz, 2.9 at

@@ -51,7 +51,7 @@ def test_mixed_centre_line_order(reference, p, rate):
 def test_mixed_tension_order(reference):
     """T(0) (the end value of sigma (|r'| - 1)) converges like h^p: observed
     log2 ratios 2.12, 2.52 for N = 8, 16, 32 at p = 3, tending to 3.0 (N = 2000,
-    docs/large_n.md)."""
+    docs/explanation/large_n.md)."""
     e = np.array([errors(N, 3, reference)[1] for N in (8, 16, 32)])
     rates = np.log2(e[:-1] / e[1:])
     assert np.all(rates > 2.0) and e[-1] < 5e-6, (e, rates)

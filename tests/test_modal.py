@@ -39,7 +39,7 @@ and Re lambda = -c/2.
 
 The 0.5 % agreement for the first three modes of every family holds from
 N = 8 elements of degree p = 3 (the convergence table is in
-docs/modal_convergence.md); these tests run at N = 8, p = 3 with the gamma
+docs/explanation/modal_convergence.md); these tests run at N = 8, p = 3 with the gamma
 coupling off (the classical models have none).  Its effect is measured in
 :func:`test_gamma_coupling`.
 """

@@ -1,4 +1,4 @@
-"""The cheaper time step (issue 12, docs/speed.md): the quadrature rule and the
+"""The cheaper time step (issue 12, docs/explanation/speed.md): the quadrature rule and the
 reused Jacobian leave the verified numbers where they were."""
 
 import math
@@ -38,7 +38,7 @@ def _lowest_eigenvalue(params):
 
 def test_quadrature_rule_keeps_tension_and_eigenvalue():
     """The rule 3p against UFL's estimate (14 and 20 at p = 3): T(0) and the
-    slowest vibration agree to 1e-9 (measured 5e-13 at N = 16, docs/speed.md);
+    slowest vibration agree to 1e-9 (measured 5e-13 at N = 16, docs/explanation/speed.md);
     a degree too low for the inertia term (4 < 2p) moves them by far more."""
     rule, ufl_estimate, low = (_table2(q) for q in (0, -1, 4))
     T_rule, T_ufl, T_low = (_tension0(p) for p in (rule, ufl_estimate, low))
@@ -64,7 +64,7 @@ def _tension_max(options):
 def test_reused_jacobian_gives_the_same_tension_max():
     """Modified Newton (the sweep's default) against full Newton at tight
     tolerance: the same T max at 8 Hz to 5e-5 (measured 1.4e-5; 1.7e-5 at N = 8, p = 3,
-    10 Hz, docs/speed.md), with far fewer Jacobians than
+    10 Hz, docs/explanation/speed.md), with far fewer Jacobians than
     steps, and more (cheaper) Newton iterations."""
     full, full_solver = _tension_max(FEBackend.FULL_NEWTON)
     reused, solver = _tension_max(None)  # the sweep's default
@@ -98,7 +98,7 @@ def _chord_against_ts(rho_inf=None, steps=200):
 
 @pytest.mark.skipif(not compat.ALPHA2_AS_PETSC_318,
                     reason="PETSc 3.22's TSALPHA2 (Debian 13) departs from 3.18's scheme, which "
-                           "the chord loop steps, by ~1e-7 a step (docs/speed.md); not resolved")
+                           "the chord loop steps, by ~1e-7 a step (docs/explanation/speed.md); not resolved")
 def test_chord_step_loop_equals_petsc_alpha2():
     """The chord stepper (solvers/chord.py) is TSALPHA2, start included: over 200
     steps its state and T(0) at every step equal PETSc's to the Newton

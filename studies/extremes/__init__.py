@@ -232,7 +232,7 @@ def dt_x10(until_s: float = 10.0):
 def dt_sweep_10ms():
     """Sec. 5.3 at 7.5 Hz with fixed steps of 10 ms: refused by the one criterion
     of solvers/stepsize.py (omega dt <= 1 for the forcing and the first
-    longitudinal mode, 68.7 Hz).  Run anyway (docs/step_size.md), it stays
+    longitudinal mode, 68.7 Hz).  Run anyway (docs/explanation/step_size.md), it stays
     stable and T max comes out 5 % high: a silent wrong answer."""
     from rawehelix.errors import SceneError
     from rawehelix.studies import sweep
