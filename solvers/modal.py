@@ -35,7 +35,7 @@ a positive tau pushes the cluster on the negative real axis back (its distance
 is tau + 1/tau_d) while the lightly damped wanted modes stay near.  Without
 structural damping that is tau = omega_min / 4 and nev = the modes below
 1.2 x the highest wanted one, as before.  nev is the count in the disk.  After
-the solve every family is checked; a missing one widens the search (nev x 1.5,
+the solve every family is checked; a missing one widens the search (nev x WIDEN_FACTOR,
 WIDENINGS times, never past the estimated count before the nearest real root),
 then raises an error naming the option to raise (``-rawehelix_pep_nev``).
 A real eigenvalue is reported as ``overdamped`` (families.is_overdamped), not
@@ -80,7 +80,7 @@ WINDOW_MARGIN = 1.2
 WINDOW_EXTRA = 4
 #: widenings of the search (nev x WIDEN_FACTOR) when a family has fewer modes than asked
 WIDENINGS = 3
-WIDEN_FACTOR = 1.5
+WIDEN_FACTOR = 2.0
 #: targets tried between omega_min / 4 and this multiple of the highest wanted |lambda|
 TARGET_SPAN, TARGET_STEPS = 4.0, 33
 

@@ -12,11 +12,11 @@ a :class:`ModesResult` for either scheme:
 Computing never writes files; :meth:`ModesResult.write` does.  ``rawehelix
 modes`` is :func:`run`: compute, print the table (:func:`format_table`), write.
 
-Selection: by default the lowest 3 oscillating modes of each family, the
-rigid rotation (the FE scheme reports it once; the spline reference every zero
-eigenvalue, as Table 3 does) and the 3 slowest ``overdamped`` eigenvalues found
-(real roots of a damped spectrum: a decay rate, no frequency, no family's
-mode); with ``count = k`` the k slowest (|lambda|) modes.  Either way in
+Selection: by default the lowest PER_FAMILY oscillating modes of each
+family, the rigid rotation (the FE scheme reports it once; the spline
+reference every zero eigenvalue, as Table 3 does) and the OVERDAMPED_SHOWN
+slowest ``overdamped`` eigenvalues found (real roots of a damped spectrum: a
+decay rate, no frequency, no family's mode); with ``count = k`` the k slowest (|lambda|) modes.  Either way in
 ascending frequency |Im lambda| (then |lambda|), the overdamped ones last by
 decay rate: the order of the table ``rawehelix modes`` prints.  (Table 3 of the
 paper lists them the other way round; studies/report.py pairs rows by family.)
@@ -35,6 +35,7 @@ from rawehelix.families import FAMILY_LABELS, OVERDAMPED, VIBRATIONS
 from rawehelix.parameters import Parameters
 
 PER_FAMILY = 3  # modes of each family in the default selection
+OVERDAMPED_SHOWN = 2 * PER_FAMILY  # real roots in it: both of PER_FAMILY overdamped pairs
 ZERO_TOL = 1e-4  # |Im lambda| (normalised) below which a mode has no period
 
 
@@ -177,12 +178,13 @@ def ascending(modes: list) -> list:
 
 def select(modes: list, count: int | None) -> list:
     """The lowest PER_FAMILY oscillating modes of each family, the rigid ones
-    and the PER_FAMILY slowest overdamped ones (count None), or the ``count``
-    slowest (|lambda|); in :func:`ascending` order."""
+    and the OVERDAMPED_SHOWN slowest overdamped ones (count None), or the
+    ``count`` slowest (|lambda|); in :func:`ascending` order."""
     if count is None:
         keep = [m for m in modes if m.family == "rigid"]
-        for f in (*VIBRATIONS, OVERDAMPED):
+        for f in VIBRATIONS:
             keep += ascending(m for m in modes if m.family == f)[:PER_FAMILY]
+        keep += ascending(m for m in modes if m.family == OVERDAMPED)[:OVERDAMPED_SHOWN]
     else:
         keep = sorted(modes, key=lambda m: abs(m.eigenvalue))[:count]
     return ascending(keep)
