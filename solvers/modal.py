@@ -284,7 +284,7 @@ class ModalSolver:
         is not given and ``require_families``) if a family has fewer than
         ``per_family`` oscillating modes after WIDENINGS widenings;
         ``self.missing`` lists such families either way.  ``zero_tol``
-        (relative to omega_min / 4) separates the rigid zero.  The user's
+        (relative to the lowest estimated omega) separates the rigid zero.  The user's
         -rawehelix_pep_nev and -rawehelix_pep_target (options) win over both."""
         if self.lin.K is None:
             raise RuntimeError(f"{self.scene}: linearise(state) before solve(), or use "
@@ -299,7 +299,7 @@ class ModalSolver:
             window = Window(target=self.default_target(), nev=nev, cap=nev)
         tau = window.target if target is None else target
         nev = window.nev
-        zero_abs = zero_tol * abs(self.default_target()) * 4
+        zero_abs = zero_tol * 4 * self.default_target()  # zero_tol x omega_min
         for widening in range(WIDENINGS + 1):
             pep = pep_solve.solve(self.comm, [self.K, self.C, self.M], nev, tau, finite,
                                   self.scene)

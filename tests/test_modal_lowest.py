@@ -246,3 +246,17 @@ def test_the_window_keeps_the_cluster_out():
     assert np.all(np.abs(real - window.target) > far)
     undamped, _ = solved("mobile_end", 8, damped=False)
     assert undamped.window().target == pytest.approx(undamped.default_target())
+
+
+@pytest.mark.mpi
+def test_same_lowest_modes_on_all_ranks():
+    """The window (estimates from the allreduced mean tension) and the modes
+    are those of one rank: the issue's damped case at N = 16."""
+    serial, _ = solved("mobile_end", 16)
+    parallel = ModalSolver.from_stationary(mobile_end(16), MPI.COMM_WORLD)
+    a, b = parallel.window(), serial.window()
+    assert (a.nev, a.cap) == (b.nev, b.cap) and a.target == pytest.approx(b.target, rel=1e-12)
+    modes = parallel.solve(keep_vectors=False)
+    _, reference = solved("mobile_end", 16)
+    for family in VIBRATIONS:
+        assert np.allclose(lowest(modes, family), lowest(reference, family), rtol=1e-8)
