@@ -16,10 +16,11 @@ Selection: by default the lowest PER_FAMILY oscillating modes of each
 family, the rigid rotation (the FE scheme reports it once; the spline
 reference every zero eigenvalue, as Table 3 does) and the OVERDAMPED_SHOWN
 slowest ``overdamped`` eigenvalues found (real roots of a damped spectrum: a
-decay rate, no frequency, no family's mode); with ``count = k`` the k slowest (|lambda|) modes.  Either way in
-ascending frequency |Im lambda| (then |lambda|), the overdamped ones last by
-decay rate: the order of the table ``rawehelix modes`` prints.  (Table 3 of the
-paper lists them the other way round; studies/report.py pairs rows by family.)
+decay rate, no frequency, no family's mode); with ``count = k`` the k slowest
+(|lambda|) modes.  Either way in ascending frequency |Im lambda| (then
+|lambda|), the overdamped ones last by decay rate: the order of the table
+``rawehelix modes`` prints.  (Table 3 of the paper lists them the other way
+round; studies/report.py pairs rows by family.)
 """
 
 from __future__ import annotations
