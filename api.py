@@ -65,11 +65,14 @@ def stationary(scene: Parameters, comm=None):
 
 
 def modes(scene: Parameters, count: int | None = None, comm=None):
-    """The natural modes about the stationary state (Table 3): a list of modes,
-    each with ``family``, ``frequency_Hz``, ``decay_per_s``, ``period_s``,
+    """The natural modes about the stationary state (Table 3): a list of modes
+    in ascending frequency (the order of ``rawehelix modes``' table), each
+    with ``family``, ``frequency_Hz``, ``decay_per_s``, ``period_s``,
     ``eigenvalue`` (normalised) and its shape in SI; ``.summary``.
 
-    Default: the lowest 3 of each family and the rigid rotation; ``count``:
+    Default: the lowest 3 oscillating modes of each family, the rigid
+    rotation, and the slowest real eigenvalues of a damped spectrum, if found,
+    as family ``overdamped`` (a decay rate, no period; listed last); ``count``:
     the ``count`` slowest modes.  ``scene.discretisation.scheme`` picks FE
     (SLEPc) or the paper's spline scheme."""
     _resources(scene, "modes")

@@ -20,4 +20,19 @@ FAMILY_LABELS = {
     "lateral_out_of_plane": "Lateral (y)",
     "torsional": "Torsional",
     "rigid": "Rigid rotation",
+    "overdamped": "Overdamped",
 }
+
+#: a real eigenvalue (no oscillation) of a damped spectrum, not the rigid zero:
+#: one root of an overdamped pair; it belongs to no family's oscillating modes
+OVERDAMPED = "overdamped"
+
+#: |Im lambda| <= REAL_TOL |lambda|: a real eigenvalue (SLEPc and LAPACK in real
+#: arithmetic return exactly 0 for the real ones)
+REAL_TOL = 1e-10
+
+
+def is_overdamped(eigenvalue: complex) -> bool:
+    """True for a nonzero real eigenvalue: a decay without oscillation."""
+    lam = complex(eigenvalue)
+    return lam != 0 and abs(lam.imag) <= REAL_TOL * abs(lam)

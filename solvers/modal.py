@@ -16,14 +16,30 @@ Sec. 5.1 with :class:`StationarySolver` (alpha(0) = 0 pinned, where the Newton
 matrix is regular) and linearises about it on the same rod (the modal bcs
 leave the twist free).
 
-Target and size.  tau is put on the positive real axis, off the rigid zero
-(where K is singular) and away from every eigenvalue of a stable state
-(Re lambda <= 0): tau = omega_min / 4, omega_min the lowest analytic estimate.
-nev is chosen so that the lowest ``per_family`` modes of *each* family are
-inside the computed set: all families' estimates below the largest per-family
-target are counted (both members of each conjugate pair, plus the rigid pair),
-with a margin.  After the solve every family is checked; a missing one raises
-an error naming the option to raise (``-rawehelix_pep_nev``).
+Target and size (the search window).  Only the lowest ``per_family``
+oscillating modes of each family are wanted, never the whole spectrum.
+:func:`estimates` gives every eigenvalue of the classical models (solvers.
+analytic) with their modal damping (the drag of Eq. 28 and the Kelvin-Voigt
+shares of forms/damping.py, tests/test_damping.py): both roots of
+lambda^2 + c lambda + omega^2 = 0.  Structural damping makes every mode above
+omega ~ 2 / tau overdamped, and their slow roots -omega^2 / c crowd at
+-1 / tau on the negative real axis (hundreds of them at N = 32: a cluster that
+no Krylov method converges in reasonable time, and need not).  PETSc here is
+real, so the target tau is real; shift-and-invert computes the eigenvalues
+nearest it, i.e. those in a disk |lambda - tau| <= rho.  :meth:`ModalSolver.window`
+takes tau >= omega_min / 4 (off the rigid zero, where K is singular, and away
+from every eigenvalue of a stable state, Re lambda <= 0) where the disk that
+holds every wanted estimate with margin (rho = WINDOW_MARGIN x the farthest,
+clipped half-way to the nearest real root beyond) holds the fewest estimates;
+a positive tau pushes the cluster on the negative real axis back (its distance
+is tau + 1/tau_d) while the lightly damped wanted modes stay near.  Without
+structural damping that is tau = omega_min / 4 and nev = the modes below
+1.2 x the highest wanted one, as before.  nev is the count in the disk.  After
+the solve every family is checked; a missing one widens the search (nev x WIDEN_FACTOR,
+WIDENINGS times, never past the estimated count before the nearest real root),
+then raises an error naming the option to raise (``-rawehelix_pep_nev``).
+A real eigenvalue is reported as ``overdamped`` (families.is_overdamped), not
+as a mode of its family.
 
 The rigid rotation alpha = const is the zero eigenvalue of torque-free ends
 (a Jordan pair: alpha = const and alpha = t), reported once as ``rigid``.
@@ -35,6 +51,7 @@ see docs/explanation/modal_convergence.md.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -45,15 +62,77 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.families import VIBRATIONS
+from rawehelix.families import OVERDAMPED, VIBRATIONS, is_overdamped
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import analytic, fields, pep as pep_solve
 from rawehelix.solvers.classify import Classifier
 from rawehelix.solvers.discrete import RodDiscretisation
-from rawehelix.solvers.linearise import Linearisation
+from rawehelix.solvers.linearise import COMPONENTS, Linearisation
 from rawehelix.solvers.snes import SolverError
 from rawehelix.solvers.state import RodState
 from rawehelix.solvers.stationary import StationarySolver
+
+
+#: the search disk holds the farthest wanted estimate with this margin (unless a
+#: real root lies nearer; then half-way to it)
+WINDOW_MARGIN = 1.2
+#: eigenvalues asked for beyond the estimated count when no real root is near
+WINDOW_EXTRA = 4
+#: widenings of the search (nev x WIDEN_FACTOR) when a family has fewer modes than asked
+WIDENINGS = 3
+WIDEN_FACTOR = 2.0
+#: targets tried between omega_min / 4 and this multiple of the highest wanted |lambda|
+TARGET_SPAN, TARGET_STEPS = 4.0, 33
+
+
+def estimates(q, tension: float, count: int, twist: bool = True,
+              kinematics: str = "paper") -> dict:
+    """Eigenvalue estimates, per family an array (count, 2) for n = 1..count:
+    the roots of lambda^2 + c_n lambda + omega_n^2 = 0 (normalised), omega_n
+    of the classical models (solvers.analytic) and c_n the modal damping:
+
+    * drag (28), linearised: c = nu v_w0 (1 + (e.i_E)^2), e the direction of
+      the motion (chord, j_E x chord, j_E), tests/test_modal.py;
+    * Kelvin-Voigt (forms/damping.py): the retardation time x the mechanism's
+      share of omega_n^2 (tests/test_damping.py): tau_a sigma k^2 + tau_b mu k^4
+      (longitudinal; the bending share with the paper's kinematics only),
+      tau_b mu k^4 (lateral), tau_t delta k^2 (torsional).
+
+    An oscillating pair is (lambda, conj lambda), an overdamped one two real roots."""
+    n = np.arange(1, count + 1)
+    k = n * np.pi
+    mu = q.bending * q.mu
+    chord = q.top_position() / np.linalg.norm(q.top_position())
+    direction = {"longitudinal": chord, "lateral_in_plane": np.cross([0.0, 1.0, 0.0], chord),
+                 "lateral_out_of_plane": np.array([0.0, 1.0, 0.0])}
+    omega = analytic.frequencies(q, tension, count, twist)
+    bending = q.tau_bending * mu * k**4
+    kelvin_voigt = {"longitudinal": q.tau_axial * q.sigma * k**2
+                    + (bending if kinematics == "paper" else 0.0),
+                    "lateral_in_plane": bending, "lateral_out_of_plane": bending,
+                    "torsional": q.tau_torsion * q.delta * k**2}
+    out = {}
+    for family, w in omega.items():
+        e = direction.get(family)
+        c = kelvin_voigt[family] + (0.0 if e is None else q.drag * q.nu * q.v_w0 * (1 + e[0]**2))
+        root = np.sqrt((c / 2) ** 2 - w**2 + 0j)
+        out[family] = np.stack([-c / 2 + root, -c / 2 - root], axis=1)
+    return out
+
+
+@dataclass(frozen=True)
+class Window:
+    """Where and how much to search: shift-and-invert about ``target``, ``nev``
+    eigenvalues; ``cap``: the most nev may be widened to (the estimated count
+    before the nearest real root beyond the wanted ones)."""
+
+    target: float
+    nev: int
+    cap: int
+
+    def __post_init__(self):
+        if not (self.target > 0 and 1 <= self.nev <= self.cap):
+            raise ValueError(f"bad search window {self}")
 
 
 @dataclass
@@ -154,41 +233,93 @@ class ModalSolver:
         return 2 * analytic.count_below(self.q, T, omega, self.twist) + 2 + 4
 
     def default_target(self) -> float:
+        """omega_min / 4: off the rigid zero, below every mode."""
         T = max(self.mean_tension_value, 0.0)
         est = analytic.frequencies(self.q, T, 1, self.twist)
         return 0.25 * min(v[0] for v in est.values())
+
+    def window(self, per_family: int = 3) -> Window:
+        """The target and nev that hold the lowest ``per_family`` oscillating
+        modes of each family with the fewest others (module docstring)."""
+        finite = self.finite_eigenvalue_count()
+        per_component = finite // (2 * len(COMPONENTS)) + 1  # modes of one family
+        est = estimates(self.q, max(self.mean_tension_value, 0.0), per_component, self.twist,
+                        self.params.model.kinematics)
+        wanted, every = [], [0.0, 0.0]  # the rigid rotation's Jordan pair
+        for roots in est.values():
+            upper = roots[:, 0]
+            wanted += list(upper[upper.imag > 0][:per_family])
+            every += list(roots.ravel())
+        wanted, every = np.array(wanted), np.array(every)
+        real = every[np.abs(every.imag) == 0]
+        base = self.default_target()
+        top = max(np.abs(wanted).max(), base) if wanted.size else base
+        best = None
+        for tau in base * np.geomspace(1.0, max(TARGET_SPAN * top / base, 1.0), TARGET_STEPS):
+            far = np.abs(wanted - tau).max() if wanted.size else tau
+            beyond = np.abs(real - tau)
+            beyond = beyond[beyond > far]
+            nearest = beyond.min() if beyond.size else math.inf
+            rho = min(WINDOW_MARGIN * far, 0.5 * (far + nearest))
+            inside = int(np.sum(np.abs(every - tau) <= rho))
+            key = (inside, -rho / far)  # fewest eigenvalues, then the widest margin
+            if best is None or key < best[0]:
+                extra = WINDOW_EXTRA if rho == WINDOW_MARGIN * far else 0
+                cap = int(np.sum(np.abs(every - tau) < nearest)) if beyond.size else finite - 2
+                best = (key, tau, inside + extra, cap)
+        _, tau, nev, cap = best
+        cap = min(max(cap, nev), finite - 2)
+        return Window(target=float(tau), nev=min(nev, cap), cap=cap)
 
     # -- the eigenproblem ---------------------------------------------------------------
     def solve(self, nev: int | None = None, per_family: int = 3, target: float | None = None,
               keep_vectors: bool = True, zero_tol: float = 1e-3,
               require_families: bool = True) -> list[Mode]:
-        """The modes nearest the target: at least the lowest ``per_family`` of
-        each family (unless ``nev`` is given), sorted by |lambda|.
+        """The lowest ``per_family`` oscillating modes of each family and
+        what else the search window holds (nev None: :meth:`window`), or the
+        ``nev`` eigenvalues nearest the target (default omega_min / 4: the
+        slowest); sorted by |lambda|.
 
         Raises SolverError if fewer than nev eigenpairs converge, or (when nev
         is not given and ``require_families``) if a family has fewer than
-        ``per_family`` modes; ``self.missing`` lists such families either way.
-        ``zero_tol`` (relative to the target) separates the rigid zero."""
+        ``per_family`` oscillating modes after WIDENINGS widenings;
+        ``self.missing`` lists such families either way.  ``zero_tol``
+        (relative to the lowest estimated omega) separates the rigid zero.  The user's
+        -rawehelix_pep_nev and -rawehelix_pep_target (options) win over both."""
         if self.lin.K is None:
             raise RuntimeError(f"{self.scene}: linearise(state) before solve(), or use "
                                "ModalSolver.from_stationary")
         start = time.perf_counter()
         check_families = nev is None
         finite = self.finite_eigenvalue_count()
-        nev = min(nev or self.default_nev(per_family), finite - 2)
-        tau = self.default_target() if target is None else target
-        pep = pep_solve.solve(self.comm, [self.K, self.C, self.M], nev, tau, finite, self.scene)
-        modes = self._collect(pep, keep_vectors, zero_tol * abs(pep.getTarget()) * 4)
-        nconv = pep.getConverged()
-        pep.destroy()
-        found = {f: sum(m.family == f for m in modes) for f in self.families}
-        self.missing = {f: k for f, k in found.items() if k < per_family} if check_families else {}
+        if check_families:
+            window = self.window(per_family)
+        else:
+            nev = min(nev, finite - 2)
+            window = Window(target=self.default_target(), nev=nev, cap=nev)
+        tau = window.target if target is None else target
+        nev = window.nev
+        zero_abs = zero_tol * 4 * self.default_target()  # zero_tol x omega_min
+        for widening in range(WIDENINGS + 1):
+            pep = pep_solve.solve(self.comm, [self.K, self.C, self.M], nev, tau, finite,
+                                  self.scene)
+            modes = self._collect(pep, keep_vectors, zero_abs)
+            nconv, used = pep.getConverged(), pep.getDimensions()[0]
+            self.search = {"target": pep.getTarget(), "nev": used, "solves": widening + 1}
+            pep.destroy()
+            found = {f: sum(m.family == f for m in modes) for f in self.families}
+            self.missing = ({f: k for f, k in found.items() if k < per_family}
+                            if check_families else {})
+            if not self.missing or used != nev or nev >= window.cap:
+                break  # complete; or the user's -rawehelix_pep_nev; or nothing left to widen
+            nev = min(window.cap, math.ceil(WIDEN_FACTOR * nev))
         if self.missing and require_families:
             raise SolverError(
-                f"{self.scene}: the lowest {per_family} modes of each family were asked for, "
-                f"but only {self.missing} were found among {nconv} eigenpairs (the "
-                f"discretisation may be too coarse: --elements, --degree; or raise "
-                f"-rawehelix_pep_nev).")
+                f"{self.scene}: the lowest {per_family} oscillating modes of each family were "
+                f"asked for, but only {self.missing} were found among {nconv} eigenpairs "
+                f"(target {self.search['target']:.4g}, nev {self.search['nev']}; the "
+                f"discretisation may be too coarse: --elements, --degree; the family may have "
+                f"fewer oscillating modes (overdamped); or raise -rawehelix_pep_nev).")
         self.wall_s = time.perf_counter() - start
         return modes
 
@@ -208,6 +339,8 @@ class ModalSolver:
                     continue  # the Jordan partner of the rigid rotation
                 family = "rigid"
                 lam = complex(lam.real, abs(lam.imag))
+            elif is_overdamped(lam):
+                family = OVERDAMPED  # a real root: no oscillation, no family's mode
             else:
                 family = self.classifier.family(lam, xr, xi, fractions)
             mode = Mode(eigenvalue=lam, family=family, fractions=fractions,

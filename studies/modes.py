@@ -12,10 +12,15 @@ a :class:`ModesResult` for either scheme:
 Computing never writes files; :meth:`ModesResult.write` does.  ``rawehelix
 modes`` is :func:`run`: compute, print the table (:func:`format_table`), write.
 
-Selection: by default the lowest 3 modes of each family and the rigid
-rotation (the FE scheme reports it once; the spline reference every zero
-eigenvalue, as Table 3 does); with ``count = k`` the k slowest modes.  Either
-way in the order of Table 3: decreasing |Im lambda|, then decreasing |lambda|.
+Selection: by default the lowest PER_FAMILY oscillating modes of each
+family, the rigid rotation (the FE scheme reports it once; the spline
+reference every zero eigenvalue, as Table 3 does) and the OVERDAMPED_SHOWN
+slowest ``overdamped`` eigenvalues found (real roots of a damped spectrum: a
+decay rate, no frequency, no family's mode); with ``count = k`` the k slowest
+(|lambda|) modes.  Either way in ascending frequency |Im lambda| (then
+|lambda|), the overdamped ones last by decay rate: the order of the table
+``rawehelix modes`` prints.  (Table 3 of the paper lists them the other way
+round; studies/report.py pairs rows by family.)
 """
 
 from __future__ import annotations
@@ -27,10 +32,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rawehelix.families import FAMILY_LABELS, VIBRATIONS
+from rawehelix.families import FAMILY_LABELS, OVERDAMPED, VIBRATIONS
 from rawehelix.parameters import Parameters
 
 PER_FAMILY = 3  # modes of each family in the default selection
+OVERDAMPED_SHOWN = 2 * PER_FAMILY  # real roots in it: both of PER_FAMILY overdamped pairs
 ZERO_TOL = 1e-4  # |Im lambda| (normalised) below which a mode has no period
 
 
@@ -46,7 +52,7 @@ class ModeResult:
     eigenvalue: complex  # normalised (1 / t_scale), Eq. (25)
     frequency_Hz: float  # |Im lambda| / (2 pi t_scale)
     decay_per_s: float  # -Re lambda / t_scale (> 0: damped)
-    period_s: float | None  # 1 / frequency_Hz; None for the rigid rotation
+    period_s: float | None  # 1 / frequency_Hz; None for the rigid rotation and overdamped
     dominant: list  # dominant components of the eigenvector
     fractions: dict = field(default_factory=dict)  # kinetic-energy fraction per family
     s_m: np.ndarray | None = field(default=None, repr=False)  # arc length of the nodes [m]
@@ -58,7 +64,7 @@ class ModeResult:
         """From a normalised eigenvalue; ``shape`` = (s, u (n, 3), alpha) normalised."""
         lam = complex(eigenvalue)
         frequency = abs(lam.imag) / (2 * math.pi * q.t_scale)
-        oscillatory = family != "rigid" and abs(lam.imag) > ZERO_TOL
+        oscillatory = family not in ("rigid", OVERDAMPED) and abs(lam.imag) > ZERO_TOL
         mode = cls(family=family, eigenvalue=lam, frequency_Hz=frequency,
                    decay_per_s=-lam.real / q.t_scale,
                    period_s=1.0 / frequency if oscillatory else None, dominant=list(dominant),
@@ -85,7 +91,7 @@ class ModeResult:
 
 
 class ModesResult(list):
-    """The selected :class:`ModeResult` objects in Table 3 order, with what
+    """The selected :class:`ModeResult` objects in ascending frequency, with what
     describes the run (``info``) and the stationary centre line ``x0_m`` (n, 3)
     [m, FE only] about which they were computed."""
 
@@ -164,21 +170,25 @@ class ModesResult(list):
         return paths
 
 
-def _table3_order(modes: list) -> list:
-    return sorted(modes, key=lambda m: (-abs(m.eigenvalue.imag), -abs(m.eigenvalue)))
+def ascending(modes: list) -> list:
+    """Ascending frequency |Im lambda|, then |lambda| (the rigid rotation
+    first); the overdamped ones (no frequency) last, by decay rate."""
+    return sorted(modes, key=lambda m: (m.family == OVERDAMPED, abs(m.eigenvalue.imag),
+                                        abs(m.eigenvalue)))
 
 
 def select(modes: list, count: int | None) -> list:
-    """The lowest PER_FAMILY modes of each family and the rigid ones (count
-    None), or the ``count`` slowest; in Table 3 order."""
+    """The lowest PER_FAMILY oscillating modes of each family, the rigid ones
+    and the OVERDAMPED_SHOWN slowest overdamped ones (count None), or the
+    ``count`` slowest (|lambda|); in :func:`ascending` order."""
     if count is None:
         keep = [m for m in modes if m.family == "rigid"]
         for f in VIBRATIONS:
-            keep += sorted((m for m in modes if m.family == f),
-                           key=lambda m: abs(m.eigenvalue))[:PER_FAMILY]
+            keep += ascending(m for m in modes if m.family == f)[:PER_FAMILY]
+        keep += ascending(m for m in modes if m.family == OVERDAMPED)[:OVERDAMPED_SHOWN]
     else:
         keep = sorted(modes, key=lambda m: abs(m.eigenvalue))[:count]
-    return _table3_order(keep)
+    return ascending(keep)
 
 
 def _missing(modes: list, families) -> dict:
@@ -223,7 +233,7 @@ def fe_modes(params: Parameters, count: int | None = None, comm=None,
     q = params.normalised()
     disc = params.discretisation
     solver = ModalSolver.from_stationary(params, comm, scene=scene)
-    nev = None if count is None else max(solver.default_nev(), 2 * count + 4)
+    nev = None if count is None else 2 * count + 4  # both of each pair, the rigid one
     found = solver.solve(nev=nev, require_families=False)
     chosen = select(found, count)
     shapes = [solver.mode_shape(m) for m in chosen]  # collective
@@ -285,8 +295,9 @@ def format_table(result) -> str:
         if len(dom) > 34:
             dom = dom[:31] + "..."
         period = "N/A" if m.period_s is None else f"{m.period_s:.3f}"
+        frequency = "-" if m.family == OVERDAMPED else f"{m.frequency_Hz:.3f}"
         lines.append(f"{ev:>24}  {dom:<34} {FAMILY_LABELS.get(m.family, m.family):<15} "
-                     f"{period:>10} {m.frequency_Hz:>9.3f} {round(m.decay_per_s, 3) + 0.0:>11.3f}")
+                     f"{period:>10} {frequency:>9} {round(m.decay_per_s, 3) + 0.0:>11.3f}")
     return "\n".join(lines)
 
 
@@ -297,12 +308,17 @@ def report(result: ModesResult) -> str:
     disc = (f"N = {info['elements']}, p = {info['degree']} ({info['dofs']} dofs, "
             if info["scheme"] == "fe" else f"N = {info['elements']} (")
     lines = [f"Modes of the stationary state, scheme {info['scheme']}, {disc}"
-             f"{info['wall_s']:.2f} s)", format_table(result)]
+             f"{info['wall_s']:.2f} s), ascending frequency", format_table(result)]
+    if any(m.family == OVERDAMPED for m in result):
+        lines.append("note: 'Overdamped' rows are real eigenvalues (one root each of an "
+                     "overdamped pair): a decay without oscillation, no period, in no family")
     if info["missing_families"]:
-        lines.append(f"note: fewer than {PER_FAMILY} modes found for {info['missing_families']}: "
-                     "try more elements (--elements)" + (" or -rawehelix_pep_nev"
-                                                          if info["scheme"] == "fe" else ""))
+        lines.append(f"note: fewer than {PER_FAMILY} oscillating modes found for "
+                     f"{info['missing_families']}: try more elements (--elements)"
+                     + (" or -rawehelix_pep_nev; a family may have no more oscillating modes "
+                        "(overdamped)" if info["scheme"] == "fe" else ""))
     return "\n".join(lines)
 
 
-__all__ = ["ModeResult", "ModesResult", "compute", "format_table", "report", "select"]
+__all__ = ["ModeResult", "ModesResult", "ascending", "compute", "format_table", "report",
+           "select"]

@@ -280,7 +280,7 @@ def test_cli_writes_outputs(tmp_path):
         assert set(m) == {"family", "eigenvalue", "eigenvalue_per_s", "frequency_Hz",
                           "decay_per_s", "period_s", "dominant"}
     assert len(saved["kinetic_energy_fractions"]) == 6
-    assert saved["modes"][-1]["family"] == "rigid"  # Table 3 order: the zero eigenvalue last
+    assert saved["modes"][0]["family"] == "rigid"  # ascending frequency: the zero eigenvalue first
     assert (tmp_path / "modes.png").stat().st_size > 1000
     assert "lateral_in_plane_displacement" in (tmp_path / "modes.xdmf").read_text()
     assert any("Torsional" in line for line in lines)
@@ -309,10 +309,10 @@ def _check_default_selection(result, families):
     for family in families:
         assert sum(m.family == family for m in result) == 3, [(m.family, m.eigenvalue)
                                                              for m in result]
-    assert result[-1].family == "rigid" and all(m.period_s is None for m in result
-                                                if m.family == "rigid")
+    assert result[0].family == "rigid" and all(m.period_s is None for m in result
+                                               if m.family == "rigid")
     im = [abs(m.eigenvalue.imag) for m in result]
-    assert im == sorted(im, reverse=True)  # Table 3 order
+    assert im == sorted(im)  # ascending frequency, as the table of rawehelix modes
     assert result.summary["missing_families"] == {}
 
 
