@@ -18,7 +18,9 @@ A few examples run the real CLI (``rawehelix modes SCENE --count 1``) in a
 subprocess: exit 0, or exit 2 with one stderr line and nothing written.
 
 The counts (examples tried, refused, loaded) are printed at the end of a ``-s``
-run; ``-m slow`` runs the bigger campaign whose figures are in the docs.
+run.  The default run gives each key 12 examples (about 30 s); ``-m long`` runs
+the bigger campaign whose figures the docs quote (150 a key; several minutes, so
+marked ``long``: ``slow`` tests are part of ``make test``).
 """
 
 from __future__ import annotations
@@ -56,8 +58,8 @@ def schema() -> dict[str, str]:
 
 KEYS = schema()
 #: the words a string key may take: every tuple of strings parameters.py checks against
-CHOICES = sorted({v for v in vars(parameters).values() if isinstance(v, tuple)
-                  for v in v if isinstance(v, str)} | {"auto", "off"})
+CHOICES = sorted({word for value in vars(parameters).values() if isinstance(value, tuple)
+                  for word in value if isinstance(word, str)} | {"auto", "off"})
 LAW_KEYS = [f.name for f in dataclasses.fields(parameters.EILaw)]
 
 COUNTS = collections.Counter()  # (way in, outcome) -> examples, over the whole module
@@ -162,32 +164,31 @@ def test_literal_round_trips():
 known_keys = st.sampled_from(sorted(KEYS))
 law_tables = st.dictionaries(st.sampled_from(LAW_KEYS) | st.text(max_size=6),
                              leaves, max_size=3)
+#: besides the known keys: where a user's key may be wrong
+UNKNOWN = ("<unknown key of a section>", "<unknown section>", "<unknown top-level key>",
+           "<a section as a value>")
+names = st.text(min_size=1, max_size=8)
 
 
 @st.composite
-def edits(draw):
-    """(dotted key, value): a known key, an unknown key of a known section, an
-    unknown section, or a section replaced by a value; and an arbitrary TOML value
-    (helix.EI_law also gets inline tables with its own keys)."""
-    kind = draw(st.sampled_from(["known"] * 6 + ["unknown key", "unknown section", "unknown top",
-                                                 "section"]))
-    if kind == "known":
-        key = draw(known_keys)
-    elif kind == "unknown key":
-        key = f"{draw(st.sampled_from(sorted(scene.SECTIONS)))}.{draw(st.text(min_size=1, max_size=8))}"
-    elif kind == "unknown section":
-        key = f"{draw(st.text(min_size=1, max_size=8))}.{draw(st.text(min_size=1, max_size=8))}"
-    elif kind == "unknown top":
-        key = draw(st.text(min_size=1, max_size=8).filter(lambda k: "." not in k))
-    else:
+def edits(draw, key: str | None = None):
+    """(dotted key, value): ``key``, or one drawn from KEYS and UNKNOWN, with an
+    arbitrary TOML value; a known key gets a number of any size half the time, and
+    helix.EI_law also gets inline tables with its own keys."""
+    key = key or draw(st.sampled_from([*sorted(KEYS), *UNKNOWN]))
+    if key == UNKNOWN[0]:
+        key = f"{draw(st.sampled_from(sorted(scene.SECTIONS)))}.{draw(names)}"
+    elif key == UNKNOWN[1]:
+        key = f"{draw(names)}.{draw(names)}"
+    elif key == UNKNOWN[2]:
+        key = draw(names.filter(lambda k: "." not in k))
+    elif key == UNKNOWN[3]:
         key = draw(st.sampled_from(sorted(scene.SECTIONS)))
-    if key == "helix.EI_law" and draw(st.booleans()):
-        value = draw(law_tables)
-    elif kind == "known" and draw(st.booleans()):  # a number of any size or sign
-        value = draw(magnitudes)
-    else:
-        value = draw(toml_values)
-    return key, value
+    elif key == "helix.EI_law" and draw(st.booleans()):
+        return key, draw(law_tables)
+    elif draw(st.booleans()):
+        return key, draw(magnitudes)
+    return key, draw(toml_values)
 
 
 def apply(data: dict, key: str, value) -> dict:
@@ -259,63 +260,58 @@ def check_set(scene_name: str, key: str, value):
                  [typed, typed.strip()])
 
 
-FAST = settings(max_examples=400, derandomize=True, deadline=None, database=None,
-                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
-BIG = settings(FAST, max_examples=5000)
+PER_KEY = settings(max_examples=12, derandomize=True, deadline=None, database=None,
+                   suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                          HealthCheck.function_scoped_fixture])
+MIXED = settings(PER_KEY, max_examples=300)
+#: the campaign whose figures the docs quote (make test-long; -m long)
+PER_KEY_BIG = settings(PER_KEY, max_examples=150)
+MIXED_BIG = settings(PER_KEY, max_examples=3000)
+scenes = st.sampled_from(SHIPPED)
+every_key = pytest.mark.parametrize("key", [*sorted(KEYS), *UNKNOWN])
 
 
-def _one_key(tmp_path_factory, scene_name, edit):
-    check_file(tmp_path_factory.mktemp("fuzz"), scene_name, [edit])
+@every_key
+@PER_KEY
+@given(data=st.data())
+def test_each_key_in_the_file(tmp_path, key, data):
+    check_file(tmp_path, data.draw(scenes), [data.draw(edits(key))])
 
 
-def _several_keys(tmp_path_factory, scene_name, changes):
+@every_key
+@PER_KEY
+@given(data=st.data())
+def test_each_key_by_set(key, data):
+    check_set(data.draw(scenes), *data.draw(edits(key)))
+
+
+@MIXED
+@given(scene_name=scenes, changes=st.lists(edits(), min_size=2, max_size=5))
+def test_several_keys_in_the_file(tmp_path_factory, scene_name, changes):
     check_file(tmp_path_factory.mktemp("fuzz"), scene_name, changes)
 
 
-def _set_option(scene_name, edit):
-    check_set(scene_name, *edit)
+@pytest.mark.long
+@every_key
+@PER_KEY_BIG
+@given(data=st.data())
+def test_each_key_in_the_file_big(tmp_path, key, data):
+    check_file(tmp_path, data.draw(scenes), [data.draw(edits(key))])
 
 
-scenes = st.sampled_from(SHIPPED)
+@pytest.mark.long
+@every_key
+@PER_KEY_BIG
+@given(data=st.data())
+def test_each_key_by_set_big(key, data):
+    check_set(data.draw(scenes), *data.draw(edits(key)))
 
 
-@FAST
-@given(scene_name=scenes, edit=edits())
-def test_one_key_in_the_file(tmp_path_factory, scene_name, edit):
-    _one_key(tmp_path_factory, scene_name, edit)
-
-
-@FAST
-@given(scene_name=scenes, changes=st.lists(edits(), min_size=2, max_size=5))
-def test_several_keys_in_the_file(tmp_path_factory, scene_name, changes):
-    _several_keys(tmp_path_factory, scene_name, changes)
-
-
-@FAST
-@given(scene_name=scenes, edit=edits())
-def test_one_key_by_set(scene_name, edit):
-    _set_option(scene_name, edit)
-
-
-@pytest.mark.slow
-@BIG
-@given(scene_name=scenes, edit=edits())
-def test_one_key_in_the_file_big(tmp_path_factory, scene_name, edit):
-    _one_key(tmp_path_factory, scene_name, edit)
-
-
-@pytest.mark.slow
-@BIG
+@pytest.mark.long
+@MIXED_BIG
 @given(scene_name=scenes, changes=st.lists(edits(), min_size=2, max_size=5))
 def test_several_keys_in_the_file_big(tmp_path_factory, scene_name, changes):
-    _several_keys(tmp_path_factory, scene_name, changes)
-
-
-@pytest.mark.slow
-@BIG
-@given(scene_name=scenes, edit=edits())
-def test_one_key_by_set_big(scene_name, edit):
-    _set_option(scene_name, edit)
+    check_file(tmp_path_factory.mktemp("fuzz"), scene_name, changes)
 
 
 def test_every_shipped_key_is_in_the_schema():
@@ -359,7 +355,7 @@ def run_cli(tmp_dir: Path, scene_name: str, changes) -> subprocess.CompletedProc
     return proc
 
 
-CLI = settings(FAST, max_examples=6)
+CLI = settings(PER_KEY, max_examples=6)
 
 
 @CLI
@@ -368,7 +364,7 @@ def test_cli_one_line_no_traceback(tmp_path_factory, scene_name, edit):
     run_cli(tmp_path_factory.mktemp("cli"), scene_name, [edit])
 
 
-@pytest.mark.slow
+@pytest.mark.long
 @settings(CLI, max_examples=100)
 @given(scene_name=scenes, edit=edits())
 def test_cli_one_line_no_traceback_big(tmp_path_factory, scene_name, edit):
