@@ -241,8 +241,10 @@ class TorsionHysteresis:
         _positive("torsion_hysteresis", self, "A")
         if not (self.n >= 1 and math.isfinite(self.n)):
             raise ParameterError("torsion_hysteresis.n", self.n, "must be a finite number >= 1")
-        if not math.isfinite(self.beta_m_n) or not math.isfinite(self.gamma_m_n):
-            raise ParameterError("torsion_hysteresis.beta_m_n", self.beta_m_n, "must be finite")
+        for name in ("beta_m_n", "gamma_m_n"):
+            if not math.isfinite(getattr(self, name)):
+                raise ParameterError(f"torsion_hysteresis.{name}", getattr(self, name),
+                                     "must be finite")
         if self.active and not (self.beta_m_n > 0 and abs(self.gamma_m_n) <= self.beta_m_n):
             raise ParameterError(
                 "torsion_hysteresis.gamma_m_n", self.gamma_m_n,

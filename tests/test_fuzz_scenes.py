@@ -341,6 +341,8 @@ def run_cli(tmp_dir: Path, scene_name: str, changes) -> subprocess.CompletedProc
                            "-o", str(out)], capture_output=True, text=True, timeout=300,
                           cwd=tmp_dir, env={**os.environ, "OMP_NUM_THREADS": "1"})
     COUNTS["cli", f"exit {proc.returncode}"] += 1
+    if proc.returncode == 1:
+        print(f"\n  exit 1 with {changes}: {proc.stderr.strip()}")
     assert "Traceback" not in proc.stderr, proc.stderr
     if proc.returncode == 0:
         assert (out / "summary.json").is_file()
@@ -387,6 +389,7 @@ GAPS = [
     ([("torsion_hysteresis.rho", 0.5), ("torsion_hysteresis.beta_m_n", 1.0),
       ("torsion_hysteresis.n", 564033)], "bw_beta = beta/L0^n = 0.0"),  # OverflowError in **
     ([("torsion_hysteresis.rho", 1e-110)], "with torsion_hysteresis.rho = 1e-110"),  # named gamma
+    ([("torsion_hysteresis.gamma_m_n", math.nan)], "torsion_hysteresis.gamma_m_n: nan must"),
 ]
 
 
