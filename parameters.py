@@ -330,6 +330,13 @@ LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Dam
 #: the same for the helix section
 LATER_HELIX_SWITCHES = {"EI_law": None}
 
+#: the largest interior-penalty factor eta: its term's entries grow like eta p^2 mu N^3
+#: and its round-off with them; measured with `modes stationary_table2` (N = 16, p = 3):
+#: eta = 1e2 to 1e5 move the lowest frequencies by < 1e-6, 1e6 by 1e-5, and at 1e8 the
+#: lateral ones come out 20x too high (exit 0); past 1.8e308 / p^2 the form cannot
+#: even be compiled ("inf" in the C code)
+PENALTY_MAX = 1.0e4
+
 SCHEMES = ("fe", "spline")
 MESHES = ("uniform", "graded")
 BENDINGS = ("ip", "mixed")  # the FE bending operator: forms/rod.py, forms/mixed.py
@@ -366,7 +373,10 @@ class Discretisation:
                 "must be an integer from 2 to 8 (the bending term needs second derivatives)")
         if not self.grading >= 1:
             raise ParameterError("discretisation.grading", self.grading, "must be >= 1")
-        _positive("discretisation", self, "penalty")
+        if not (0 < self.penalty <= PENALTY_MAX):
+            raise ParameterError("discretisation.penalty", self.penalty,
+                                 f"must be a number in (0, {PENALTY_MAX:g}]: a larger one spoils "
+                                 "the bending operator by its round-off (parameters.PENALTY_MAX)")
         if self.quadrature_degree < -1:
             raise ParameterError("discretisation.quadrature_degree", self.quadrature_degree,
                                  "must be 0 (the rule 3p), -1 (UFL's estimate) or a degree >= 1")

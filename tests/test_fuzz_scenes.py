@@ -71,8 +71,9 @@ def report_counts():
     ways = sorted({way for way, _ in COUNTS})
     print("\nfuzz counts:")
     for way in ways:
-        print(f"  {way}: " + ", ".join(f"{outcome} {n}" for (w, outcome), n in
-                                       sorted(COUNTS.items()) if w == way))
+        outcomes = ("exit 0", "exit 1", "exit 2") if way == "cli" else (
+            "tried", "loaded", "refused", "traceback")
+        print(f"  {way}: " + ", ".join(f"{o} {COUNTS[way, o]}" for o in outcomes))
 
 
 # -- TOML values ------------------------------------------------------------------
@@ -161,7 +162,6 @@ def test_literal_round_trips():
 
 # -- the edits Hypothesis draws ------------------------------------------------------
 
-known_keys = st.sampled_from(sorted(KEYS))
 law_tables = st.dictionaries(st.sampled_from(LAW_KEYS) | st.text(max_size=6),
                              leaves, max_size=3)
 #: besides the known keys: where a user's key may be wrong
@@ -215,7 +215,10 @@ def check(way: str, load, changed: list[str]):
     COUNTS[way, "tried"] += 1
     try:
         params = load()
-    except scene.SceneError as err:
+    except Exception as err:
+        if not isinstance(err, scene.SceneError):
+            COUNTS[way, "traceback"] += 1  # what a command would have shown
+            raise
         message = str(err)
         assert len(message.splitlines()) == 1 and "\n" not in message, repr(message)
         # the key itself, its section (unknown sections, checks across a section) or a
@@ -390,6 +393,9 @@ GAPS = [
       ("torsion_hysteresis.n", 564033)], "bw_beta = beta/L0^n = 0.0"),  # OverflowError in **
     ([("torsion_hysteresis.rho", 1e-110)], "with torsion_hysteresis.rho = 1e-110"),  # named gamma
     ([("torsion_hysteresis.gamma_m_n", math.nan)], "torsion_hysteresis.gamma_m_n: nan must"),
+    # exit 1 with the C compiler's traceback ("inf" in the form's code); 1e8: wrong modes
+    ([("discretisation.penalty", 1.78e308)], "discretisation.penalty: 1.78e+308 must be"),
+    ([("discretisation.penalty", 1e8)], "discretisation.penalty: 100000000.0 must be"),
 ]
 
 
