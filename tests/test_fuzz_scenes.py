@@ -14,8 +14,10 @@ The property:
 - it raises :class:`SceneError` whose message is one line and names the key;
 - anything else (an uncaught exception) is a failure.
 
-A few examples run the real CLI (``rawehelix modes SCENE --count 1``) in a
-subprocess: exit 0, or exit 2 with one stderr line and nothing written.
+A few examples run the real CLI (``rawehelix modes SCENE --elements 2 --count 1``)
+in a subprocess: exit 0; or exit 2 with one stderr line and nothing written; or exit
+1 with one line of the solver's advice, for a valid scene no range can rule out (a
+helix made slack by a combination of keys); never a traceback.
 
 The counts (examples tried, refused, loaded) are printed at the end of a ``-s``
 run.  The default run gives each key 12 examples (about 30 s); ``-m long`` runs
