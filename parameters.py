@@ -499,11 +499,13 @@ class Parameters:
             value = getattr(q, group)
             if None in scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
                 continue
+            keys = [*numerators, *others]
+            # named: the key of the most extreme size, the likeliest culprit
+            culprit = max(keys, key=lambda k: abs(math.log10(abs(self.value(k)) or 1.0)))
             raise ParameterError(
-                numerators[0], scaled[0],
+                culprit, self.value(culprit),
                 f"makes {group} = {formula} = {value!r} ({equation}), out of a float's range "
-                f"(1e-308 to 1e308): {', '.join([*numerators, *others])} must keep it finite "
-                f"and not 0")
+                f"(1e-308 to 1e308): {', '.join(keys)} must keep it finite and not 0")
 
     def value(self, key: str):
         """The value of a dotted scene key (``damping.axial_s``, ``helix.EI_law.b_Nm2``);
