@@ -110,6 +110,15 @@ class Helix:
     def __post_init__(self):
         _positive("helix", self, "length_m", "mass_kg", "EA_N", "EI_Nm2", "GJ_Nm2", "radius_m")
         _non_negative("helix", self, "drag_length_m", "drag_coefficient")
+        if self.EI_Nm2 / self.EA_N / self.length_m > self.length_m:
+            # a rod (Eqs. 30-34) is slender: the radius of gyration sqrt(EI/EA) of its
+            # sections is far below its length (Table 2: 0.6 m of 16 m); past L0 no
+            # rod model holds, and the solves fail (EI = 1e20: the Newton step's
+            # linear solve diverges)
+            raise ParameterError("helix.EI_Nm2", self.EI_Nm2,
+                                 f"must be at most helix.EA_N x helix.length_m^2 = "
+                                 f"{self.EA_N * self.length_m * self.length_m:.4g} (a slender "
+                                 f"rod: sqrt(EI/EA) <= L0)")
         law = self.EI_law
         if isinstance(law, dict):  # {a_Nm2_per_N, b_Nm2}, as in a scene
             names = [f.name for f in dataclasses.fields(EILaw)]

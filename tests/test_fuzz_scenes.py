@@ -389,7 +389,8 @@ GAPS = [
     ([("helix.col\nour", 1)], "'helix.col\\nour': unknown key"),  # two lines
     ([("environment.g_m_s2", 1e-323)], "t_scale = sqrt(L0/g) = inf"),  # ZeroDivisionError
     ([("helix.mass_kg", 1.7976931348623157e308)], "force_scale = M g = inf"),
-    ([("helix.length_m", 2.2e-311)], "torque_scale = GJ/L0 = inf"),  # ZeroDivisionError
+    ([("ends.circle_frequency_Hz", 1.7e308)], "omega1 = 2 pi f1 sqrt(L0/g) = inf"),
+    ([("helix.length_m", 2.2e-311)], "helix.EI_Nm2: 12800.0 must be at most"),  # ZeroDivision
     ([("environment.air_density_kg_m3", 1.7e308)], "nu = rho0 l_a L0^2 C_D/(2 M) = inf"),
     ([("torsion_hysteresis.rho", 0.5), ("torsion_hysteresis.beta_m_n", 1.0),
       ("torsion_hysteresis.n", 564033)], "bw_beta = beta/L0^n = 0.0"),  # OverflowError in **
@@ -398,6 +399,8 @@ GAPS = [
     # exit 1 with the C compiler's traceback ("inf" in the form's code); 1e8: wrong modes
     ([("discretisation.penalty", 1.78e308)], "discretisation.penalty: 1.78e+308 must be"),
     ([("discretisation.penalty", 1e8)], "discretisation.penalty: 100000000.0 must be"),
+    # exit 1, a singular Jacobian: no rod is that stiff in bending for its stretch
+    ([("helix.EI_Nm2", 5.2e67)], "helix.EI_Nm2: 5.2e+67 must be at most helix.EA_N x"),
 ]
 
 
