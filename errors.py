@@ -7,7 +7,10 @@ class SceneError(ValueError):
 
     def __init__(self, path, key: str, allowed: str):
         self.path, self.key, self.allowed = str(path), key, allowed
-        super().__init__(f"{self.path}: {key}: {allowed}")
+        # a key as typed may hold a newline or another control character (a quoted
+        # TOML key, --set): shown escaped, so that the message stays one line
+        shown = key if str(key).isprintable() else repr(key)
+        super().__init__(f"{self.path}: {shown}: {allowed}")
 
 
 class SolverError(RuntimeError):

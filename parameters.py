@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -109,6 +110,15 @@ class Helix:
     def __post_init__(self):
         _positive("helix", self, "length_m", "mass_kg", "EA_N", "EI_Nm2", "GJ_Nm2", "radius_m")
         _non_negative("helix", self, "drag_length_m", "drag_coefficient")
+        if self.EI_Nm2 / self.EA_N / self.length_m > self.length_m:
+            # a rod (Eqs. 30-34) is slender: the radius of gyration sqrt(EI/EA) of its
+            # sections is far below its length (Table 2: 0.6 m of 16 m); past L0 no
+            # rod model holds, and the solves fail (EI = 1e20: the Newton step's
+            # linear solve diverges)
+            raise ParameterError("helix.EI_Nm2", self.EI_Nm2,
+                                 f"must be at most helix.EA_N x helix.length_m^2 = "
+                                 f"{self.EA_N * self.length_m * self.length_m:.4g} (a slender "
+                                 f"rod: sqrt(EI/EA) <= L0)")
         law = self.EI_law
         if isinstance(law, dict):  # {a_Nm2_per_N, b_Nm2}, as in a scene
             names = [f.name for f in dataclasses.fields(EILaw)]
@@ -119,6 +129,9 @@ class Helix:
             for name in names:
                 if isinstance(law[name], bool) or not isinstance(law[name], (int, float)):
                     raise ParameterError(f"helix.EI_law.{name}", law[name], "must be a number")
+                if abs(law[name]) > sys.float_info.max:  # an int no float can hold
+                    raise ParameterError(f"helix.EI_law.{name}", law[name],
+                                         "must be a finite number")
             object.__setattr__(self, "EI_law", EILaw(**{n: float(law[n]) for n in names}))
         elif law is not None and not isinstance(law, EILaw):
             raise ParameterError("helix.EI_law", law,
@@ -237,12 +250,15 @@ class TorsionHysteresis:
         _positive("torsion_hysteresis", self, "A")
         if not (self.n >= 1 and math.isfinite(self.n)):
             raise ParameterError("torsion_hysteresis.n", self.n, "must be a finite number >= 1")
-        if not math.isfinite(self.beta_m_n) or not math.isfinite(self.gamma_m_n):
-            raise ParameterError("torsion_hysteresis.beta_m_n", self.beta_m_n, "must be finite")
+        for name in ("beta_m_n", "gamma_m_n"):
+            if not math.isfinite(getattr(self, name)):
+                raise ParameterError(f"torsion_hysteresis.{name}", getattr(self, name),
+                                     "must be finite")
         if self.active and not (self.beta_m_n > 0 and abs(self.gamma_m_n) <= self.beta_m_n):
             raise ParameterError(
                 "torsion_hysteresis.gamma_m_n", self.gamma_m_n,
-                f"needs beta_m_n = {self.beta_m_n!r} > 0 and -beta_m_n <= gamma_m_n <= beta_m_n "
+                f"with torsion_hysteresis.rho = {self.rho!r} < 1 (hysteresis on) needs "
+                f"beta_m_n = {self.beta_m_n!r} > 0 and -beta_m_n <= gamma_m_n <= beta_m_n "
                 "(Wen 1976: a bounded, dissipative loop)")
 
     @property
@@ -323,6 +339,13 @@ LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Dam
 #: the same for the helix section
 LATER_HELIX_SWITCHES = {"EI_law": None}
 
+#: the largest interior-penalty factor eta: its term's entries grow like eta p^2 mu N^3
+#: and its round-off with them; measured with `modes stationary_table2` (N = 16, p = 3):
+#: eta = 1e2 to 1e5 move the lowest frequencies by < 1e-6, 1e6 by 1e-5, and at 1e8 the
+#: lateral ones come out 20x too high (exit 0); past 1.8e308 / p^2 the form cannot
+#: even be compiled ("inf" in the C code)
+PENALTY_MAX = 1.0e4
+
 SCHEMES = ("fe", "spline")
 MESHES = ("uniform", "graded")
 BENDINGS = ("ip", "mixed")  # the FE bending operator: forms/rod.py, forms/mixed.py
@@ -359,7 +382,10 @@ class Discretisation:
                 "must be an integer from 2 to 8 (the bending term needs second derivatives)")
         if not self.grading >= 1:
             raise ParameterError("discretisation.grading", self.grading, "must be >= 1")
-        _positive("discretisation", self, "penalty")
+        if not (0 < self.penalty <= PENALTY_MAX):
+            raise ParameterError("discretisation.penalty", self.penalty,
+                                 f"must be a number in (0, {PENALTY_MAX:g}]: a larger one spoils "
+                                 "the bending operator by its round-off (parameters.PENALTY_MAX)")
         if self.quadrature_degree < -1:
             raise ParameterError("discretisation.quadrature_degree", self.quadrature_degree,
                                  "must be 0 (the rule 3p), -1 (UFL's estimate) or a degree >= 1")
@@ -471,6 +497,34 @@ class Parameters:
                                  "discretisation.bending = 'ip' and model.twist = true only "
                                  "(forms/hysteresis.py)")
 
+        self._check_groups()
+
+    def _check_groups(self):
+        """The groups of Eqs. (25)-(29) a solve starts from must be floats: finite,
+        and not 0 where the values they scale are not (:data:`GROUP_KEYS`)."""
+        q = Normalised.from_parameters(self)
+        for group, (formula, equation, numerators, others) in GROUP_KEYS.items():
+            scaled = [self.value(k) for k in numerators]
+            value = getattr(q, group)
+            if None in scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
+                continue
+            keys = [*numerators, *others]
+            # named: the key of the most extreme size, the likeliest culprit
+            culprit = max(keys, key=lambda k: abs(math.log10(abs(self.value(k)) or 1.0)))
+            raise ParameterError(
+                culprit, self.value(culprit),
+                f"makes {group} = {formula} = {value!r} ({equation}), out of a float's range "
+                f"(1e-308 to 1e308): {', '.join(keys)} must keep it finite and not 0")
+
+    def value(self, key: str):
+        """The value of a dotted scene key (``damping.axial_s``, ``helix.EI_law.b_Nm2``);
+        None below an absent EI law."""
+        section, *names = key.split(".")
+        obj = getattr(self, section) if hasattr(self, section) else getattr(self.model, section)
+        for name in names:
+            obj = None if obj is None else getattr(obj, name)
+        return obj
+
     def replace(self, **sections) -> "Parameters":
         """A copy with some fields of some sections changed:
         ``p.replace(discretisation={"elements": 32})``; ``damping={...}`` changes
@@ -506,6 +560,41 @@ class Parameters:
         """:meth:`Model.describe` and the helix's EI law when it has one: summary.json's "model"."""
         text = self.model.describe(planar)
         return text if self.helix.EI_law is None else f"{text}; {self.helix.EI_law.describe()}"
+
+
+_L0, _M, _g, _GJ = "helix.length_m", "helix.mass_kg", "environment.g_m_s2", "helix.GJ_Nm2"
+_T = (_L0, _g)  # t_scale = sqrt(L0/g)
+#: the normalised groups made of more than one scene value, Eqs. (25)-(29): group ->
+#: (formula, equation, the keys whose values it scales, the keys it is scaled by);
+#: Parameters refuses a scene whose group is not finite, or 0 where those it
+#: scales are not (a float's range is exceeded)
+GROUP_KEYS = {
+    "t_scale": ("sqrt(L0/g)", "Eq. 25", (_L0,), (_g,)),
+    "force_scale": ("M g", "Eq. 29", (_M, _g), ()),
+    "torque_scale": ("GJ/L0", "Eqs. 38-39", (_GJ,), (_L0,)),
+    "sigma": ("EA/(M g)", "Eq. 27", ("helix.EA_N",), (_M, _g)),
+    "mu": ("EI/(M g L0^2)", "Eq. 26", ("helix.EI_Nm2",), (_M, _g, _L0)),
+    "beta": ("GJ/(M g L0^2)", "Eq. 26", (_GJ,), (_M, _g, _L0)),
+    "nu": ("rho0 l_a L0^2 C_D/(2 M)", "Eq. 26",
+           ("environment.air_density_kg_m3", "helix.drag_length_m", "helix.drag_coefficient"),
+           (_L0, _M)),
+    "delta": ("beta sigma/(2 mu)", "Eq. 27", (_GJ, "helix.EA_N"), ("helix.EI_Nm2", _M, _g)),
+    "v_w0": ("v_w0/sqrt(g L0)", "Eq. 27", ("environment.wind_speed_m_s",), _T),
+    "r1": ("R1/L0", "Eq. 70", ("ends.circle_radius_m",), (_L0,)),
+    "omega1": ("2 pi f1 sqrt(L0/g)", "Eq. 70", ("ends.circle_frequency_Hz",), _T),
+    "mN0": ("M_N0 L0/GJ", "Eq. 69", ("torque.top_Nm",), (_L0, _GJ)),
+    "t0": ("t0/sqrt(L0/g)", "Eq. 69", ("torque.rise_time_s",), _T),
+    "spin_target": ("alpha_dot* sqrt(L0/g)", "Eq. 40", ("controller.target_rpm",), _T),
+    "tau_axial": ("tau_a/sqrt(L0/g)", "Eq. 25", ("damping.axial_s",), _T),
+    "tau_bending": ("tau_b/sqrt(L0/g)", "Eq. 25", ("damping.bending_s",), _T),
+    "tau_torsion": ("tau_t/sqrt(L0/g)", "Eq. 25", ("damping.torsion_s",), _T),
+    "mu_per_tension": ("a/L0^2", "Eq. 64", ("helix.EI_law.a_Nm2_per_N",), (_L0,)),
+    "mu_at_zero_tension": ("b/(M g L0^2)", "Eq. 64", ("helix.EI_law.b_Nm2",), (_M, _g, _L0)),
+    "bw_beta": ("beta/L0^n", "Eq. 25", ("torsion_hysteresis.beta_m_n",),
+                (_L0, "torsion_hysteresis.n")),
+    "bw_gamma": ("gamma/L0^n", "Eq. 25", ("torsion_hysteresis.gamma_m_n",),
+                 (_L0, "torsion_hysteresis.n")),
+}
 
 
 @dataclass(frozen=True)
@@ -567,10 +656,21 @@ class Normalised:
 
     @classmethod
     def from_parameters(cls, p: Parameters) -> "Normalised":
+        """The groups of ``p``; a group past the float range is inf, 0 or nan here
+        (numpy arithmetic, IEEE as Python's floats), never an exception:
+        :meth:`Parameters.__post_init__` refuses such a scene with :data:`GROUP_KEYS`."""
+        with np.errstate(all="ignore"):
+            q = cls._groups(p)
+        return dataclasses.replace(q, **{f.name: float(getattr(q, f.name))
+                                         for f in dataclasses.fields(q)
+                                         if isinstance(getattr(q, f.name), np.floating)})
+
+    @classmethod
+    def _groups(cls, p: Parameters) -> "Normalised":
         h, e, env = p.helix, p.ends, p.environment
         law = h.EI_law
-        L0, M, g = h.length_m, h.mass_kg, env.g_m_s2
-        t_scale = math.sqrt(L0 / g)  # (25)
+        L0, M, g = np.float64(h.length_m), np.float64(h.mass_kg), np.float64(env.g_m_s2)
+        t_scale = np.sqrt(L0 / g)  # (25)
         mu = h.EI_Nm2 / (M * g * L0**2)  # (26)
         beta = h.GJ_Nm2 / (M * g * L0**2)  # (26)
         sigma = h.EA_N / (M * g)  # (27)
@@ -580,7 +680,7 @@ class Normalised:
             sigma=sigma, mu=mu, beta=beta,
             nu=env.air_density_kg_m3 * h.drag_length_m * L0**2 * h.drag_coefficient / (2 * M),
             delta=beta * sigma / (2 * mu),  # (27)
-            v_w0=env.wind_speed_m_s / math.sqrt(g * L0),
+            v_w0=env.wind_speed_m_s / np.sqrt(g * L0),
             eps0=e.elongation, Gamma0=math.radians(e.elevation_deg),
             r1=e.circle_radius_m / L0, omega1=2 * math.pi * e.circle_frequency_Hz * t_scale,
             phase0=0.0,

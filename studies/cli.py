@@ -218,7 +218,7 @@ def _overrides(args) -> dict:
             raise SceneError("--set", item, "must be KEY=VALUE, e.g. helix.EI_Nm2=9000")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+        except ValueError:  # TOMLDecodeError, or an integer past Python's 4300 digits
             value = text  # a bare word: a string
         over[key.strip()] = value
     if args.command in ("sweep", "response") and args.f1 is not None:

@@ -13,6 +13,8 @@ output is written.
 from __future__ import annotations
 
 import dataclasses
+import re
+import sys
 import tomllib
 from pathlib import Path
 
@@ -47,6 +49,9 @@ def _check_type(path, key: str, value, type_name: str):
     }[type_name]
     if not ok:
         raise SceneError(path, key, f"must be {_TYPE_NAMES[type_name]}, got {value!r}")
+    if type_name == "float" and isinstance(value, int) and abs(value) > sys.float_info.max:
+        raise SceneError(path, key, f"must be a finite number (at most {sys.float_info.max:.4g} "
+                         f"in size), got an integer of {len(str(abs(value)))} digits")
     return float(value) if type_name == "float" else value
 
 
@@ -117,6 +122,14 @@ def apply_overrides(data: dict, overrides: dict, path="<scene>") -> dict:
     return data
 
 
+def _long_integer(text: str) -> str:
+    """Where a TOML text has an integer literal past Python's digit limit: "line N"."""
+    for number, line in enumerate(text.splitlines(), 1):
+        if re.search(r"\d(?:_?\d){%d}" % sys.get_int_max_str_digits(), line):
+            return f"line {number}"
+    return "a line"
+
+
 def resolve(path) -> Path:
     """A scene path, or the name of a scene shipped in ``studies/scenes``."""
     p = Path(path)
@@ -138,9 +151,18 @@ def load(path, elements: int | None = None, degree: int | None = None,
         raise SceneError(p, "file", "no such scene file (nor a shipped scene: "
                          + ", ".join(sorted(f.stem for f in SCENE_DIR.glob("*.toml"))) + ")")
     try:
-        data = tomllib.loads(p.read_text())
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as err:
+        raise SceneError(p, "file", f"is not UTF-8 text, as TOML must be ({err.reason} "
+                         f"at byte {err.start})") from None
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise SceneError(p, "file", f"is not valid TOML ({err})") from None
+    except ValueError:  # Python's int <-> str limit, which tomllib meets unchecked
+        raise SceneError(p, "file", f"{_long_integer(text)}: an integer literal has more than "
+                         f"{sys.get_int_max_str_digits()} digits, more than any key allows "
+                         "(floats reach 1.8e308)") from None
     disc = {f"discretisation.{k}": v for k, v in
             (("elements", elements), ("degree", degree), ("scheme", scheme)) if v is not None}
     data = apply_overrides(data, {**(overrides or {}), **disc}, p)
