@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rawehelix.parameters import Normalised, Parameters
+from rawehelix.errors import SceneError
 
 __all__ = ["uniform_nodes", "graded_nodes", "bending_length", "suggest_grading",
            "write_meshio", "read_meshio", "create", "mesh_nodes", "mesh_from_parameters"]
@@ -83,6 +84,10 @@ class _Gmsh:
         return False
 
 
+class GradingError(ValueError):
+    """A grading that gmsh cannot give N elements (its reach depends on N)."""
+
+
 def _graded_nodes_serial(N: int, grading: float) -> np.ndarray:
     from scipy.optimize import brentq
 
@@ -99,7 +104,8 @@ def _graded_nodes_serial(N: int, grading: float) -> np.ndarray:
         while mismatch(far) < 0:
             far *= 2.0
             if abs(far) > 60:
-                raise RuntimeError(f"gmsh cannot grade {N} elements by {grading}")
+                raise GradingError(f"gmsh cannot grade {N} elements by {grading:g}: "
+                                   "use a smaller grading or more elements")
         lo, hi = sorted((0.0, far))
         log_c = brentq(mismatch, lo, hi, xtol=1e-12, rtol=1e-12)
         x = g.nodes(N, math.exp(log_c))
@@ -251,7 +257,10 @@ def mesh_nodes(params: Parameters, comm=None) -> np.ndarray:
     if disc.mesh == "uniform":
         return uniform_nodes(disc.elements)
     if disc.mesh == "graded":
-        return graded_nodes(disc.elements, disc.grading, comm)
+        try:
+            return graded_nodes(disc.elements, disc.grading, comm)
+        except GradingError as err:  # bad input, known only once N is: exit 2, one line
+            raise SceneError(params.name, "discretisation.grading", str(err)) from None
     raise ValueError(f"discretisation.mesh = {disc.mesh!r}: must be 'uniform' or 'graded'")
 
 
