@@ -230,8 +230,11 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
     resources.check_quantities(params, list(targets), copies=comm.size)
     p0 = []
     for key in fit:
-        source.load({key: 1.0})  # an unknown key: the loader's message
-        value = base_value(params, key)
+        try:
+            value = base_value(params, key)
+        except AttributeError:  # an unknown key: the loader's message
+            source.load({key: 1.0})
+            raise SceneError("--fit", key, "is not a scene key") from None
         if key_type(key) != "float" or value == 0:
             raise SceneError("--fit", key, "must be a real-valued key with a scene value != 0 "
                              f"(the unknowns are scaled by it); it is {value!r}")

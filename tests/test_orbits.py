@@ -205,7 +205,7 @@ def test_sweep_periodicity_test_finds_the_orbit_at_5_hz():
     assert abs(point.tension_min_N - orbit.tension_min_N) <= 1e-3 * oscillation
 
 
-@pytest.mark.slow
+@pytest.mark.long  # 70-95 s: make test-long (make test stays under 12 min)
 def test_sweep_periodicity_test_finds_the_orbit_at_1_hz():
     """Issue 13, the sweep's periodicity test where a transient decays slowest
     (r = 0.964 a period) and the oscillation is smallest (0.037 N, 5e-4 of T):
@@ -692,7 +692,7 @@ def test_shooting_backtracks_to_the_damped_orbit():
     assert o.defects == {} and o.internal_multipliers is None  # nothing carried
 
 
-@pytest.mark.slow
+@pytest.mark.long  # 70-95 s: make test-long (make test stays under 12 min)
 def test_the_branch_crosses_the_quasi_static_band_in_natural_steps(alpha_map):
     """N = 4 from 3 Hz down past 1 Hz.  There the multipliers rotate by
     2 pi f_n d(1/f1) between points, so the last point's monodromy is a poor

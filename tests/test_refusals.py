@@ -24,28 +24,36 @@ FAST_S = 10.0  # a refusal: the imports (~2 s) and no work, on a loaded 2-core m
 SMALL_RSS_KB = 400_000  # a refusal's peak RSS: the interpreter and its imports
 
 
+# The command runs under a small launcher that reports its child's peak RSS:
+# Linux carries a process's high-water mark across fork and exec (getrusage's
+# ru_maxrss), so a child forked straight from this test process (1 GB deep into
+# the suite) would report this process's peak, not its own.
+LAUNCHER = ("import os, subprocess, sys; p = subprocess.Popen(sys.argv[2:]); "
+            "_, status, usage = os.wait4(p.pid, 0); "
+            "open(sys.argv[1], 'w').write(str(usage.ru_maxrss)); "
+            "sys.exit(os.waitstatus_to_exitcode(status))")
+
+
 def run(args, cwd, timeout=120.0):
     """(exit status, stdout, stderr, wall s, peak RSS kB) of the command line,
-    the RSS of this child alone (os.wait4)."""
-    out, err = Path(cwd) / ".stdout", Path(cwd) / ".stderr"
+    the RSS of the command alone (measured by LAUNCHER)."""
+    out, err, rss = (Path(cwd) / name for name in (".stdout", ".stderr", ".rss"))
     with open(out, "w") as fo, open(err, "w") as fe:
         t0 = time.perf_counter()
-        proc = subprocess.Popen([*CLI, *args], cwd=cwd, stdout=fo, stderr=fe)
-        while True:
-            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.perf_counter() - t0 > timeout:
-                os.kill(proc.pid, signal.SIGKILL)
-                os.wait4(proc.pid, 0)
-                pytest.fail(f"still running after {timeout} s: {args}")
-            time.sleep(0.05)
+        proc = subprocess.Popen([sys.executable, "-c", LAUNCHER, str(rss), *CLI, *args],
+                                cwd=cwd, stdout=fo, stderr=fe, start_new_session=True)
+        try:
+            proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            pytest.fail(f"still running after {timeout} s: {args}")
         wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
     texts = out.read_text(), err.read_text()
-    out.unlink()
-    err.unlink()
-    return proc.returncode, *texts, wall, usage.ru_maxrss
+    peak = int(rss.read_text())
+    for path in (out, err, rss):
+        path.unlink()
+    return proc.returncode, *texts, wall, peak
 
 
 def assert_refused(tmp_path, args, *words, written=("o",)):
