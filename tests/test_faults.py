@@ -80,7 +80,8 @@ def test_refused_before_work(tmp_path, argv, status, message):
 def test_ctrl_c_keeps_points_and_resumes(tmp_path):
     """SIGINT after the first of two points: exit 130, one line saying that 1 point
     was kept and how to resume; the rerun computes only the other point."""
-    argv = [RAWEHELIX, "sweep", "mobile_end", "--elements", "2", "--f1", "5:6:1",
+    # 9 and 10 Hz settle in ~40 periods each (5 and 6 Hz need 130-215): ~10 s + 3 s
+    argv = [RAWEHELIX, "sweep", "mobile_end", "--elements", "2", "--f1", "9:10:1",
             "-o", str(tmp_path / OUT)]
     proc = subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
@@ -88,7 +89,7 @@ def test_ctrl_c_keeps_points_and_resumes(tmp_path):
     deadline = time.monotonic() + 900
     while not list(points.glob("f1_*.json")) and time.monotonic() < deadline:
         assert proc.poll() is None, proc.communicate()
-        time.sleep(1.0)
+        time.sleep(0.2)  # the second point takes ~3 s: interrupt well inside it
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err

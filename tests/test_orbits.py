@@ -239,7 +239,7 @@ def converged_map():
                                   overrides={"torque.rise_time_s": 0.05, "sweep.lead_in_s": 1.0}))
 
 
-@pytest.mark.slow
+@pytest.mark.long  # 60 s in all: make test-long (the N = 4 check above stays in make test)
 @pytest.mark.parametrize("f1", [9.0, 11.5, 13.0, 14.5])  # upper branch below the peak; lower above
 def test_stable_branch_is_the_brute_force_sweep_at_the_converged_n(converged_map, f1):
     """Issue 13 test 1 at N = 8: on both sides of the peak (9 and 11.5 Hz on the
