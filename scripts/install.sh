@@ -32,9 +32,11 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ scripts/install.sh 
   numpy_version=$($PY -c 'import numpy; print(numpy.__version__)')
   echo "install: pip install -e . (numpy==$numpy_version)"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e . "numpy==$numpy_version"
-  # pyvista renders off screen; it is optional and must not move numpy.
+  # pyvista renders off screen; it is optional and must not move numpy.  Before 0.46:
+  # later ones bring cyclopts -> rich -> markdown-it-py >= 2.2, which shadows Debian's
+  # 2.1 and breaks Debian's myst-parser (make docs), with a resolver error at install.
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check "numpy==$numpy_version" \
-      pyvista imageio || echo "install: pyvista unavailable; 3D pictures are skipped"
+      "pyvista<0.46" imageio || echo "install: pyvista unavailable; 3D pictures are skipped"
   touch "$stamp"
 fi
 "$VENV/bin/python" -c 'import dolfinx, petsc4py, slepc4py, rawehelix' \
