@@ -12,7 +12,9 @@ from pathlib import Path
 
 import pytest
 
-RAWEHELIX = str(Path(sys.executable).parent / "rawehelix")
+# the command line as `python -m`, so that it runs wherever the package imports (the
+# venv's `rawehelix` script does not exist under make test-debian13's PYTHONPATH)
+RAWEHELIX = [sys.executable, "-m", "rawehelix.studies.cli"]
 OUT = "OUT"  # the -o folder, in the test's own working directory
 
 # (command line, exit status, what the one line must say)
@@ -66,7 +68,7 @@ def test_refused_before_work(tmp_path, argv, status, message):
     argv = [t if t != OUT else str(tmp_path / OUT) for t in argv]
     if "-o" not in argv and "-O" not in argv and "-output" not in argv:
         argv += ["-o", str(tmp_path / OUT)]
-    run = subprocess.run([RAWEHELIX, *argv], cwd=tmp_path, capture_output=True, text=True,
+    run = subprocess.run([*RAWEHELIX, *argv], cwd=tmp_path, capture_output=True, text=True,
                          timeout=300)
     lines = run.stderr.splitlines()
     assert run.returncode == status, run.stderr
@@ -81,7 +83,7 @@ def test_ctrl_c_keeps_points_and_resumes(tmp_path):
     """SIGINT after the first of two points: exit 130, one line saying that 1 point
     was kept and how to resume; the rerun computes only the other point."""
     # 9 and 10 Hz settle in ~40 periods each (5 and 6 Hz need 130-215): ~10 s + 3 s
-    argv = [RAWEHELIX, "sweep", "mobile_end", "--elements", "2", "--f1", "9:10:1",
+    argv = [*RAWEHELIX, "sweep", "mobile_end", "--elements", "2", "--f1", "9:10:1",
             "-o", str(tmp_path / OUT)]
     proc = subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)

@@ -330,7 +330,8 @@ def test_every_shipped_key_is_in_the_schema():
 
 # -- the real command line ------------------------------------------------------------
 
-RAWEHELIX = Path(sys.executable).with_name("rawehelix")
+# `python -m`: make test-debian13 runs the package from PYTHONPATH, with no script
+RAWEHELIX = [sys.executable, "-m", "rawehelix.studies.cli"]
 
 
 def run_cli(tmp_dir: Path, scene_name: str, changes) -> subprocess.CompletedProcess:
@@ -342,7 +343,7 @@ def run_cli(tmp_dir: Path, scene_name: str, changes) -> subprocess.CompletedProc
     path = tmp_dir / f"{scene_name}.toml"
     path.write_text(dump(data))
     out = tmp_dir / "out"
-    proc = subprocess.run([str(RAWEHELIX), "modes", str(path), "--elements", "2", "--count", "1",
+    proc = subprocess.run([*RAWEHELIX, "modes", str(path), "--elements", "2", "--count", "1",
                            "-o", str(out)], capture_output=True, text=True, timeout=300,
                           cwd=tmp_dir, env={**os.environ, "OMP_NUM_THREADS": "1"})
     COUNTS["cli", f"exit {proc.returncode}"] += 1
