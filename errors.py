@@ -15,3 +15,25 @@ class SceneError(ValueError):
 
 class SolverError(RuntimeError):
     """A solve failed; the message says what, where and what to try."""
+
+
+# -- Ctrl-C ------------------------------------------------------------------------------
+# petsc4py >= 3.19 turns a KeyboardInterrupt raised inside a Python callback of a PETSc
+# solve (the residual, a monitor) into a PETSc error (code -1), which a solver would
+# report as a failed solve.  The command line's SIGINT handler records the interrupt
+# here, so that a solver that catches a PETSc error raises the interrupt instead.
+_interrupted = False
+
+
+def on_sigint(signum, frame):
+    """SIGINT handler: record the interrupt, then interrupt as Python does."""
+    global _interrupted
+    _interrupted = True
+    raise KeyboardInterrupt
+
+
+def reraise_if_interrupted():
+    """Raise KeyboardInterrupt if Ctrl-C came (on_sigint): a PETSc error after it is
+    the interrupt, not a failed solve."""
+    if _interrupted:
+        raise KeyboardInterrupt

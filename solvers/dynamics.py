@@ -35,7 +35,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 import dolfinx.fem.petsc
 
-from rawehelix import compat
+from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.fields import set_constant
@@ -381,6 +381,7 @@ class DynamicsSolver:
         except NonFiniteState:
             raise self._failure("the state became NaN or Inf") from None
         except PETSc.Error as err:
+            errors.reraise_if_interrupted()  # Ctrl-C inside a callback (petsc4py >= 3.19)
             if isinstance(getattr(self, "_callback_error", None), NonFiniteState):
                 raise self._failure("the state became NaN or Inf") from None
             raise self._failure(f"PETSc error {err}") from None

@@ -341,6 +341,7 @@ class ModalSolver:
                 lam = complex(lam.real, abs(lam.imag))
             elif is_overdamped(lam):
                 family = OVERDAMPED  # a real root: no oscillation, no family's mode
+                lam = complex(lam.real, 0.0)  # reported as the real root it is
             else:
                 family = self.classifier.family(lam, xr, xi, fractions)
             mode = Mode(eigenvalue=lam, family=family, fractions=fractions,

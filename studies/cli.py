@@ -34,12 +34,14 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import math
 import sys
 import tomllib
 import traceback
 from pathlib import Path
 
+from rawehelix import errors
 from rawehelix.studies.scene import SceneError
 
 #: exit statuses (README): bad input, a failed solve, Ctrl-C (128 + SIGINT)
@@ -245,6 +247,7 @@ def main(argv: list[str] | None = None) -> int:
     # PETSc reads its options once, at initialisation: before any import of PETSc.
     import petsc4py
     petsc4py.init(["rawehelix", *petsc_args])  # argv[0] may be "-c": never an option
+    signal.signal(signal.SIGINT, errors.on_sigint)  # Ctrl-C inside a PETSc solve: errors.py
     from mpi4py import MPI
 
     import rawehelix as rh

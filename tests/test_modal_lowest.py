@@ -84,7 +84,7 @@ def dense_lowest(solver, lam, vectors):
     order = np.argsort(np.abs(lam.imag))
     for i in order:
         l = lam[i]
-        if l.imag <= 0 or abs(l) < 1e-3:
+        if l.imag <= 0 or abs(l) < 1e-3 or is_overdamped(l):
             continue  # conjugates, the real ones and the rigid zero
         xr.array[:], xi.array[:] = vectors[:, i].real, vectors[:, i].imag
         fractions, _ = solver.classifier.energy_fractions(xr, xi)
@@ -93,7 +93,7 @@ def dense_lowest(solver, lam, vectors):
             by_family[family].append(l)
         if all(len(v) == K_LOWEST for v in by_family.values()):
             break
-    real = lam[(lam.imag == 0) & (np.abs(lam) > 1e-3)].real
+    real = np.array([l.real for l in lam if abs(l) > 1e-3 and is_overdamped(l)])
     return by_family, real
 
 
