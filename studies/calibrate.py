@@ -42,7 +42,7 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.studies import pool, quantities, writers
-from rawehelix.studies.study import EXIT_UNMET, Source, base_value, key_type
+from rawehelix.studies.study import EXIT_UNMET, Source, key_type
 
 FD_STEP = 1e-3  # forward-difference step of the Jacobian, relative to the scene's value
 RANGE = 1e3  # default bounds: [p0 / RANGE, RANGE p0], within the key's allowed range
@@ -231,7 +231,7 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
     p0 = []
     for key in fit:
         try:
-            value = base_value(params, key)
+            value = params.value(key)
         except AttributeError:  # an unknown key: the loader's message
             source.load({key: 1.0})
             raise SceneError("--fit", key, "is not a scene key") from None

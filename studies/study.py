@@ -127,13 +127,6 @@ def cast(key: str, value: float):
     return int(round(value)) if key_type(key) == "int" else float(value)
 
 
-def base_value(params: Parameters, key: str):
-    """The scene's value of a dotted key (``damping.*`` lives in ``params.model``)."""
-    section, _, name = key.partition(".")
-    holder = params.model.damping if section == "damping" else getattr(params, section)
-    return getattr(holder, name)
-
-
 def design(variables: list[Variable], sample: str, points: int | None, seed: int = SEED):
     """The design's points, (n, d), in the box of the variables."""
     lo = np.array([v.start for v in variables])
@@ -200,7 +193,7 @@ def make_tasks(source: Source, variables: list[Variable], sample: str, points, f
     base = {}
     for v in variables:
         source.load({v.key: cast(v.key, v.start)})  # an unknown key: the loader's message
-        base[v.key] = base_value(base_params, v.key)
+        base[v.key] = base_params.value(v.key)
     resources.check_count("--vary/--points", design_size(variables, sample, points))
     X = design(variables, sample, points)
     tasks = [pool.Task(f"p{k:05d}", {key: cast(key, x) for key, x in zip(keys, row)})
