@@ -20,7 +20,7 @@ install:
 	@bash scripts/install.sh
 
 demo: install
-	$(PY) -m rawehelix.studies.demo results
+	$(PY) -m rawehelix.cli.demo results
 
 test: install
 	$(PY) -m pytest -q -m "$(MARKS)" $(PYTEST_ARGS)

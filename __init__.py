@@ -24,7 +24,8 @@ Subpackages:
 __version__ = "0.2.0"
 
 from rawehelix.api import (Parameters, SceneError, SolverError, labtest, load_scene,  # noqa: E402
-                           modes, orbits, response, simulate, stationary, sweep)
+                           modes, orbits, response, simulate, stationary, sweep,
+                           torsion_loop)
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "labtest", "SceneError", "SolverError", "Parameters", "__version__"]
+           "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters", "__version__"]

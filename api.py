@@ -23,7 +23,7 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "labtest", "SceneError", "SolverError", "Parameters"]
+           "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters"]
 
 
 def _world(comm):
@@ -162,3 +162,20 @@ def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=N
     return study.compute(scene, test, tensions_N=tensions_N, loads=loads, fit=fit,
                          rod_EI_Nm2=rod_EI_Nm2, elements=elements, degree=degree,
                          gravity=gravity, comm=_world(comm))
+
+
+def torsion_loop(law: dict, period_s: float = 20.0, cycles: int = 4, steps_per_cycle: int = 200,
+                 elements: int = 2, comm=None):
+    """The hysteretic torsion test of Sec. 4 (Fig. 2c, Fig. 5) in time: the lab
+    segment of the Table 2 helix, T_e = 200 N, its end twisted from 0 to 50
+    degrees and back ``cycles`` times in ``period_s`` [s] each, with the Bouc-Wen
+    law ``law`` (the scene's ``[torsion_hysteresis]`` keys).  A dict of arrays:
+    ``t_s``, ``theta_rad``, ``moment_Nm`` (the FE rod's end moment) and
+    ``reference_moment_Nm`` (the Bouc-Wen ODE of the same twist history, scipy)."""
+    from rawehelix.parameters import TorsionHysteresis
+    from rawehelix.studies import torsion_loop as study
+    law = TorsionHysteresis(**law)
+    t, theta, moment = study.run(study.segment(law, elements), period_s, cycles,
+                                 steps_per_cycle, comm=_world(comm))
+    return {"t_s": t, "theta_rad": theta, "moment_Nm": moment,
+            "reference_moment_Nm": study.reference(law, t, period_s)}

@@ -36,18 +36,18 @@ from mpi4py import MPI
 
 from rawehelix.parameters import TorsionHysteresis
 from rawehelix.solvers import bouc_wen
-from rawehelix.studies import scene, simulate, torsion_test
+from rawehelix.studies import scene, simulate, torsion_loop
 
 #: the Bouc-Wen law of docs/explanation/model.md (chosen against the torsion test of Fig. 5: fit())
 FIG5 = {"rho": 0.5, "A": 2.39, "beta_m_n": 4.78, "gamma_m_n": 4.78, "n": 1.0}
 SECANT_AT_TURN_NM2 = 140.0  # the nominal GJ, "consistent with Fig. 5"
-WIDTH_NM2 = 25.0 * torsion_test.LENGTH_M / torsion_test.THETA_MAX_RAD - 140.0  # 194 - 140
+WIDTH_NM2 = 25.0 * torsion_loop.LENGTH_M / torsion_loop.THETA_MAX_RAD - 140.0  # 194 - 140
 PERIOD_S, CYCLES = 20.0, 4
 
 
 def loop_figures(times, theta, M):
     """(ratio at the last turning point, width at 25 deg, energies per cycle) of a loop."""
-    P, L0 = PERIOD_S, torsion_test.LENGTH_M
+    P, L0 = PERIOD_S, torsion_loop.LENGTH_M
     at = lambda f: int(np.argmin(np.abs(times - f * P)))  # noqa: E731
     turn, up, down = at(CYCLES - 0.5), at(CYCLES - 0.75), at(CYCLES - 0.25)
     ratio = bouc_wen.secant(theta, M, L0)
@@ -59,12 +59,12 @@ def fit():
     """A and beta = gamma of FIG5 from the two targets (rho = 0.5, n = 1)."""
     from scipy.optimize import fsolve
     times = np.linspace(0, CYCLES * PERIOD_S, 4000 * CYCLES + 1)
-    theta = bouc_wen.torsion_cycle(torsion_test.THETA_MAX_RAD, PERIOD_S)[0](times)
+    theta = bouc_wen.torsion_cycle(torsion_loop.THETA_MAX_RAD, PERIOD_S)[0](times)
 
     def residual(x):
         A, beta = np.exp(x)
         law = TorsionHysteresis(rho=0.5, A=A, beta_m_n=beta, gamma_m_n=beta, n=1.0)
-        turn, width, _ = loop_figures(times, theta, torsion_test.reference(law, times, PERIOD_S))
+        turn, width, _ = loop_figures(times, theta, torsion_loop.reference(law, times, PERIOD_S))
         return [turn - SECANT_AT_TURN_NM2, width - WIDTH_NM2]
 
     A, beta = np.exp(fsolve(residual, np.log([1.5, 10.0])))
@@ -75,9 +75,9 @@ def torsion_loop(elements: int, steps: int):
     """The torsion test with FIG5, FE against scipy: the markdown rows."""
     law = TorsionHysteresis(**FIG5)
     start = time.process_time()
-    t, theta, M = torsion_test.run(torsion_test.segment(law, elements), PERIOD_S, CYCLES, steps)
+    t, theta, M = torsion_loop.run(torsion_loop.segment(law, elements), PERIOD_S, CYCLES, steps)
     cpu = time.process_time() - start
-    M_ref = torsion_test.reference(law, t, PERIOD_S)
+    M_ref = torsion_loop.reference(law, t, PERIOD_S)
     fe, ref = loop_figures(t, theta, M), loop_figures(t, theta, M_ref)
     print(f"Torsion test, FIG5, N = {elements}, {steps} steps a cycle ({cpu:.1f} s CPU): "
           f"ratio at 50 deg {fe[0]:.2f} (scipy {ref[0]:.2f}) Nm^2, width at 25 deg "

@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
 from rawehelix.families import VIBRATIONS as FAMILIES  # noqa: E402
-from rawehelix.solvers import shooting  # noqa: E402
+from rawehelix.references import shooting  # noqa: E402
 from rawehelix.solvers.modal import ModalSolver  # noqa: E402
 from rawehelix.solvers.snes import SolverError  # noqa: E402
 from rawehelix.solvers.stationary import StationarySolver  # noqa: E402

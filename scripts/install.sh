@@ -31,7 +31,8 @@ stamp="$VENV/.rawehelix-installed"
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ scripts/install.sh -nt "$stamp" ]; then
   numpy_version=$($PY -c 'import numpy; print(numpy.__version__)')
   echo "install: pip install -e . (numpy==$numpy_version)"
-  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e . "numpy==$numpy_version"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e . "numpy==$numpy_version" \
+      "import-linter==2.1"  # lint-imports: the import contracts of .importlinter (tests/test_architecture.py)
   # pyvista renders off screen; it is optional and must not move numpy.  Before 0.46:
   # later ones bring cyclopts -> rich -> markdown-it-py >= 2.2, which shadows Debian's
   # 2.1 and breaks Debian's myst-parser (make docs), with a resolver error at install.

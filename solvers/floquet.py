@@ -9,7 +9,7 @@ its final value), ``q`` (at the current f1) and ``steps_per_period``:
 
 - the FE generalised-alpha map, :class:`rawehelix.solvers.orbits.AlphaMap`;
 - the paper's spline-Galerkin flow,
-  :class:`rawehelix.solvers.spline_galerkin.orbits.SplineMap`.
+  :class:`rawehelix.references.spline_galerkin.orbits.SplineMap`.
 
 Here, with Delta the rotation per period:
 

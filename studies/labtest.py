@@ -210,7 +210,7 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
         raise SceneError(helix_scene.name, "torsion_hysteresis",
                          "the lab tests are static and hold the Bouc-Wen twist at z = 0 "
                          "(forms/hysteresis.py); the hysteretic torsion test runs in time: "
-                         "studies/torsion_test.py")
+                         "rh.torsion_loop (studies/torsion_loop.py)")
     _check(test, tensions_N, loads, fit, rod_EI_Nm2)
     tensions = tuple(float(t) for t in (tensions_N or DEFAULT_TENSIONS_N[test]))
     loads = tuple(float(x) for x in (loads or DEFAULT_LOADS.get("fit" if fit else test, ())))

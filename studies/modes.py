@@ -6,7 +6,7 @@ a :class:`ModesResult` for either scheme:
 * ``fe``: SLEPc on the linearised Eqs. (30)-(31) (:mod:`rawehelix.solvers.modal`),
   with the mode shapes;
 * ``spline``: the paper's spline-Galerkin reference (eigenvalues of the
-  Jacobian of Eq. 61, :mod:`rawehelix.solvers.spline_galerkin.spectrum`),
+  Jacobian of Eq. 61, :mod:`rawehelix.references.spline_galerkin.spectrum`),
   without mode shapes (``s_m``, ``displacement`` and ``alpha_rad`` are None).
 
 Computing never writes files; :meth:`ModesResult.write` does.  ``rawehelix
@@ -205,8 +205,8 @@ def check_count(count):
 
 def spline_modes(params: Parameters, count: int | None = None) -> ModesResult:
     """Stationary state (Newton from the shooting solution) and spectrum, spline scheme."""
-    from rawehelix.solvers.spline_galerkin import spectrum, stationary
-    from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
+    from rawehelix.references.spline_galerkin import spectrum, stationary
+    from rawehelix.references.spline_galerkin.system import SplineGalerkin
 
     start = time.perf_counter()
     q = params.normalised()

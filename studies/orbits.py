@@ -21,7 +21,7 @@ directory per window, whole or not at all and checked when read
 (:class:`WindowStore`); a rerun continues after the last stored point.
 
 Both schemes: the FE generalised-alpha map (:mod:`rawehelix.solvers.orbits`)
-and the paper's spline-Galerkin flow (:mod:`rawehelix.solvers.spline_galerkin.orbits`),
+and the paper's spline-Galerkin flow (:mod:`rawehelix.references.spline_galerkin.orbits`),
 chosen by ``discretisation.scheme`` (``--scheme spline``).
 
 Superharmonic sites: the lateral natural frequencies f_n of the scene's
@@ -291,7 +291,7 @@ def period_map(params: Parameters):
     """The scene's scheme's period map on this rank: the FE generalised-alpha
     map, or the paper's spline-Galerkin flow (``discretisation.scheme``)."""
     if params.discretisation.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin.orbits import SplineMap
+        from rawehelix.references.spline_galerkin.orbits import SplineMap
         return SplineMap(params)
     from rawehelix.solvers.orbits import AlphaMap
     return AlphaMap(params, comm=MPI.COMM_SELF)
@@ -304,7 +304,7 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[flo
     that state's tension at s = 0 [N] (where the sites' predictions hold)."""
     from rawehelix.families import LATERAL
     if params.discretisation.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin import spectrum
+        from rawehelix.references.spline_galerkin import spectrum
         to_Hz = 1.0 / (2 * np.pi * m.q_base.t_scale)
         y0 = m.embed(m.X_stationary)
         f = [abs(x.eigenvalue.imag) * to_Hz

@@ -8,7 +8,7 @@ the next one (its ``.lock`` file stays, and is taken over).  A second run into
 a held folder gets :class:`FolderBusy` at once: bad input, exit status 2,
 naming the folder and the holder.  The lock is not reentrant across
 processes but is within one: the command line holds it around the whole
-command (studies/cli.py) and the stores, which also lock for callers of the
+command (cli/main.py) and the stores, which also lock for callers of the
 Python API, only count up.  Under MPI rank 0 holds it and the other ranks
 learn the verdict by a broadcast.
 

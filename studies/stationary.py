@@ -72,10 +72,10 @@ def sag_m(params: Parameters, result) -> float:
 def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
     allows it), compared with the shooting solution of Sys. (67) (of the extensible
-    elastica, solvers/shooting.py::solve_extensible, with model.kinematics = "extensible")
+    elastica, references/shooting.py::solve_extensible, with model.kinematics = "extensible")
     where it applies: a scene off the x-z plane (the circle of Eq. 70) is solved
     without it, and ``summary["shooting"]`` says why."""
-    from rawehelix.solvers import shooting
+    from rawehelix.references import shooting
 
     if params.discretisation.scheme != "fe":
         raise SceneError(params.name, "discretisation.scheme",

@@ -49,7 +49,7 @@ def make_backend(params: Parameters, comm):
     q = params.normalised()
     disc = params.discretisation
     if disc.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin.forced import SplineBackend
+        from rawehelix.references.spline_galerkin.forced import SplineBackend
         return SplineBackend(q, disc.elements)
     from rawehelix.solvers.forced import FEBackend
     return FEBackend(params, comm)

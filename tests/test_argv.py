@@ -1,11 +1,11 @@
-"""studies.argv.split against the real command-line parser: PETSc's
+"""cli.argv.split against the real command-line parser: PETSc's
 ``-option value`` next to our options, positionals and subcommands."""
 
 import argparse
 
 import pytest
 
-from rawehelix.studies import argv, cli
+from rawehelix.cli import argv, main as cli
 
 S = ["stationary", "stationary_table2"]
 

@@ -497,7 +497,7 @@ def test_two_sweeps_started_together_on_one_folder(tmp_path):
     holder, having written nothing; the folder holds one scene's points, and
     the T max the winner printed is the one stored."""
     out = tmp_path / "out"
-    runs = [subprocess.Popen([sys.executable, "-m", "rawehelix.studies.cli", "sweep",
+    runs = [subprocess.Popen([sys.executable, "-m", "rawehelix.cli.main", "sweep",
                               "mobile_end", "--scheme", "fe", *TINY, "--set",
                               f"helix.EI_Nm2={ei}", "-o", str(out)],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -527,7 +527,7 @@ def test_the_command_line_ends_a_full_disk_with_one_line_and_status_1(tmp_path, 
     """An OSError of the disk inside a command (here raised by the command
     itself, as matplotlib's savefig would) is one line naming the file, exit 1,
     and the folder's lock is let go."""
-    from rawehelix.studies import cli
+    from rawehelix.cli import main as cli
 
     def full(rh, params, args, outdir, comm):
         raise OSError(errno.ENOSPC, "No space left on device", str(outdir / "sweep.png"))

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from rawehelix.studies import cli, scene
+from rawehelix.cli import main as cli
+from rawehelix.studies import scene
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"

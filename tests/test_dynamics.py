@@ -63,7 +63,7 @@ def test_nominal_operation_against_spline_reference(nominal_run):
     The spline scheme at N = 2 resolves the torsional wave of the first
     second only roughly: the curves differ by a few rpm there, and agree
     to 0.1% once the wave has passed (t > 5 s)."""
-    from rawehelix.solvers.spline_galerkin.dynamics import time_series
+    from rawehelix.references.spline_galerkin.dynamics import time_series
     _, _, rows = nominal_run
     ref = time_series(nominal(), elements=2, until_s=30.0, output_every_s=0.05)
     assert np.allclose(rows[:, 0], ref.time_s)

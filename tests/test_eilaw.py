@@ -6,7 +6,7 @@ mu_b = b / (M g L0^2).  The law of the paper, Eq. (64): a = 52.4 Nm^2/N,
 b = 2290 Nm^2.
 
 * The stationary state of Table 2 is checked against the shooting of the
-  planar extensible elastica with the same law (solvers/shooting.py::
+  planar extensible elastica with the same law (references/shooting.py::
   solve_extensible, scipy only, no FE code), whose axial force is
   N.t = T + 1/2 mu_a sigma kappa^2.
 * The modes are checked against the string-beam of tests/test_extensible.py,
@@ -25,7 +25,7 @@ from mpi4py import MPI
 from rawehelix.forms import extensible
 from rawehelix.forms.kinematics import d
 from rawehelix.parameters import PAPER_EI_LAW, EILaw, ParameterError
-from rawehelix.solvers import shooting
+from rawehelix.references import shooting
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene

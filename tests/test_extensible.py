@@ -19,7 +19,7 @@ closed forms are exact; with them (Table 2) they hold at the mean tension
 closed forms to 1 % of itself.
 
 The stationary state is checked against the shooting of the extensible
-elastica (solvers/shooting.py::solve_extensible, no FE code).
+elastica (references/shooting.py::solve_extensible, no FE code).
 """
 
 import functools
@@ -30,7 +30,7 @@ import pytest
 from mpi4py import MPI
 
 from rawehelix.parameters import ParameterError
-from rawehelix.solvers import shooting
+from rawehelix.references import shooting
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene

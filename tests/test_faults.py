@@ -14,7 +14,7 @@ import pytest
 
 # the command line as `python -m`, so that it runs wherever the package imports (the
 # venv's `rawehelix` script does not exist under make test-debian13's PYTHONPATH)
-RAWEHELIX = [sys.executable, "-m", "rawehelix.studies.cli"]
+RAWEHELIX = [sys.executable, "-m", "rawehelix.cli.main"]
 OUT = "OUT"  # the -o folder, in the test's own working directory
 
 # (command line, exit status, what the one line must say)

@@ -43,7 +43,8 @@ from hypothesis import strategies as st
 
 import rawehelix
 from rawehelix import parameters
-from rawehelix.studies import cli, scene
+from rawehelix.cli import main as cli
+from rawehelix.studies import scene
 
 SHIPPED = sorted(p.stem for p in scene.SCENE_DIR.glob("*.toml"))
 
@@ -331,7 +332,7 @@ def test_every_shipped_key_is_in_the_schema():
 # -- the real command line ------------------------------------------------------------
 
 # `python -m`: make test-debian13 runs the package from PYTHONPATH, with no script
-RAWEHELIX = [sys.executable, "-m", "rawehelix.studies.cli"]
+RAWEHELIX = [sys.executable, "-m", "rawehelix.cli.main"]
 
 
 def run_cli(tmp_dir: Path, scene_name: str, changes) -> subprocess.CompletedProcess:

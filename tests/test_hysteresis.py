@@ -13,6 +13,7 @@ and the refusals as for every switch.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -22,6 +23,7 @@ from mpi4py import MPI
 import dolfinx.fem
 import dolfinx.fem.petsc
 
+import rawehelix as rh
 from rawehelix import compat
 from rawehelix.errors import SceneError
 from rawehelix.parameters import ParameterError, TorsionHysteresis
@@ -30,7 +32,7 @@ from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.studies import scene
-from rawehelix.studies.torsion_test import LENGTH_M, reference, run, segment
+from rawehelix.studies.torsion_loop import LENGTH_M, reference, run, segment
 
 LAW = TorsionHysteresis(rho=0.5, A=1.0, beta_m_n=10.0, gamma_m_n=10.0, n=1.0)
 
@@ -41,9 +43,11 @@ def test_torsion_cycle_dissipates_as_the_scipy_bouc_wen():
     cycle equals the scipy reference's within 1 % (measured 0.1 %), and a
     reference with rho 0.05 off misses it by more than 1 %."""
     period, cycles = 20.0, 4
-    t, theta, M = run(segment(LAW), period, cycles, 100)
+    loop = rh.torsion_loop(dataclasses.asdict(LAW), period, cycles, 100, elements=2,
+                           comm=MPI.COMM_SELF)  # the API: studies/torsion_loop.py
+    t, theta, M = loop["t_s"], loop["theta_rad"], loop["moment_Nm"]
     E = bouc_wen.cycle_energies(t, theta, M, period, cycles)
-    E_ref = bouc_wen.cycle_energies(t, theta, reference(LAW, t, period), period, cycles)
+    E_ref = bouc_wen.cycle_energies(t, theta, loop["reference_moment_Nm"], period, cycles)
     error = np.abs(E / E_ref - 1)
     print("dissipated per cycle [J]: FE", E, "scipy", E_ref, "relative", error)
     assert np.all(E_ref > 0.1)  # a loop, clockwise: energy is dissipated

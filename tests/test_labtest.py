@@ -10,7 +10,8 @@ import pytest
 import rawehelix as rh
 from rawehelix.solvers import analytic
 from rawehelix.solvers.cantilever import CantileverSolver
-from rawehelix.studies import cli, labtest
+from rawehelix.cli import main as cli
+from rawehelix.studies import labtest
 
 L0 = labtest.LAB_LENGTH_M
 

@@ -62,7 +62,8 @@ def test_stationary_on_a_cold_cache_prints_nothing_on_stderr(tmp_path):
     the summary on stdout, nothing on stderr."""
     code = f"""
     import sys
-    from rawehelix.studies import cli, logs
+    from rawehelix.cli import main as cli
+from rawehelix.studies import logs
     logs.configure(0)
     sys.exit(cli.main(["stationary", "stationary_table2", "--elements", "4",
                        "-o", {str(tmp_path / "out")!r}]))

@@ -15,7 +15,8 @@ from rawehelix.solvers import analytic, shooting
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.stationary import StationarySolver
-from rawehelix.studies import cli, scene
+from rawehelix.cli import main as cli
+from rawehelix.studies import scene
 
 ELEMENTS = (2, 4, 8, 16)
 

@@ -269,7 +269,7 @@ def test_continuation_points_are_orbits_and_the_command_writes_the_branch(alpha_
     import json
 
     from rawehelix.solvers.continuation import Branch
-    from rawehelix.studies import cli
+    from rawehelix.cli import main as cli
 
     m = alpha_map
     first = m.orbit(m.X_stationary, 9.0, lead_in=5)

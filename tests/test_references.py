@@ -47,7 +47,7 @@ def test_spline_n8_matches_fe(spectra, family):
 #: the FE path: what the references must not import
 FE_MODULES = ("dolfinx", "ufl", "basix", "ffcx", "petsc4py", "slepc4py", "rawehelix.forms",
               "rawehelix.compat", "rawehelix.meshes")
-REFERENCES = ("rawehelix.solvers.shooting", "rawehelix.solvers.spline_galerkin")
+REFERENCES = ("rawehelix.references.shooting", "rawehelix.references.spline_galerkin")
 # scheme-independent numpy code the references may use: the shooting Newton and
 # the Floquet multipliers of a period map (no FE module)
 SHARED = ("rawehelix.solvers.floquet",)
@@ -56,15 +56,15 @@ _PROBE = """
 import importlib, pkgutil, sys
 for name in {blocked!r}:
     sys.modules[name] = None  # importing it raises ImportError
-import rawehelix.solvers.spline_galerkin as sg
+import rawehelix.references.spline_galerkin as sg
 for info in pkgutil.iter_modules(sg.__path__):
     importlib.import_module(sg.__name__ + "." + info.name)
-import rawehelix.solvers.shooting
-from rawehelix.solvers.spline_galerkin import spectrum, stationary
-from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
+import rawehelix.references.shooting
+from rawehelix.references.spline_galerkin import spectrum, stationary
+from rawehelix.references.spline_galerkin.system import SplineGalerkin
 from rawehelix.studies import scene
 nd = scene.load("stationary_table2").normalised()
-rawehelix.solvers.shooting.solve(nd)
+rawehelix.references.shooting.solve(nd)
 system = SplineGalerkin(nd, 2)
 assert spectrum.modes(system, stationary.solve(system).x)
 print(" ".join(sorted(m for m, v in sys.modules.items() if v is not None)))

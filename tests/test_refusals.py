@@ -18,7 +18,7 @@ import pytest
 from rawehelix.errors import SceneError
 from rawehelix.studies import outdir, resources
 
-CLI = [sys.executable, "-m", "rawehelix.studies.cli"]
+CLI = [sys.executable, "-m", "rawehelix.cli.main"]
 HUGE = ["--elements", "100000000", "--set", 'discretisation.bending="mixed"']
 FAST_S = 10.0  # a refusal: the imports (~2 s) and no work, on a loaded 2-core machine
 SMALL_RSS_KB = 400_000  # a refusal's peak RSS: the interpreter and its imports
@@ -221,7 +221,7 @@ def test_stationary_runs_a_scene_off_the_plane(tmp_path):
 
 
 def test_the_shooting_reference_applies_to_the_planar_scenes():
-    from rawehelix.solvers import shooting
+    from rawehelix.references import shooting
     from rawehelix.studies import scene
     for name in ("stationary_table2", "nominal_operation"):
         assert shooting.not_applicable(scene.load(name).normalised()) is None

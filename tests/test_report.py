@@ -1,4 +1,4 @@
-"""studies/report.py and the report half of studies/demo.py, on synthetic data."""
+"""studies/report.py and the report half of cli/demo.py, on synthetic data."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from rawehelix.studies import demo, paper
+from rawehelix.cli import demo
+from rawehelix.studies import paper
 from rawehelix.studies.report import (TABLE3_HEADER, MissingImage, Section, Table, table3_rows,
                                       write_report)
 

@@ -242,7 +242,7 @@ def test_refusals():
 
 
 def test_cli_writes_summary_and_figure(tmp_path, capsys):
-    from rawehelix.studies import cli
+    from rawehelix.cli import main as cli
     out = tmp_path / "response"
     assert cli.main(["response", "mobile_end", "--elements", "4", "--f1", "9:10.5:0.5",
                      "-o", str(out)]) == 0

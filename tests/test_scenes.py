@@ -11,7 +11,8 @@ import tomllib
 import pytest
 
 from rawehelix import parameters
-from rawehelix.studies import cli, scene
+from rawehelix.cli import main as cli
+from rawehelix.studies import scene
 from tests_util import write_scene
 
 SHIPPED = ("stationary_table2", "nominal_operation", "mobile_end", "example")

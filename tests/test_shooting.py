@@ -5,7 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rawehelix.solvers import shooting
+from rawehelix.references import shooting
 from rawehelix.studies import scene
 
 S = np.linspace(0.0, 1.0, 101)
@@ -156,7 +156,7 @@ def test_shares_no_code_with_the_fe_path():
     """The reference must stay independent: importing it loads no FE stack."""
     import subprocess
     import sys
-    code = ("import sys; import rawehelix.solvers.shooting; "
+    code = ("import sys; import rawehelix.references.shooting; "
             "print(sorted({m.split('.')[0] for m in sys.modules} & "
             "{'dolfinx', 'ufl', 'basix', 'petsc4py', 'ffcx'}))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

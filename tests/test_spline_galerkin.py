@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from rawehelix.solvers import analytic
-from rawehelix.solvers.spline_galerkin import dynamics, spectrum, stationary
-from rawehelix.solvers.spline_galerkin.basis import SplineBasis
-from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
+from rawehelix.references.spline_galerkin import dynamics, spectrum, stationary
+from rawehelix.references.spline_galerkin.basis import SplineBasis
+from rawehelix.references.spline_galerkin.system import SplineGalerkin
 from rawehelix.studies import modes as modes_study
 from rawehelix.studies import paper
 from rawehelix.studies import scene
@@ -67,7 +67,7 @@ def test_complex_step_jacobian_matches_finite_differences(nd):
 def test_residual_at_shooting_solution_falls_with_N(nd):
     """|g(x_s)| at the shooting solution decreases as N grows (Sec. 5.1), and
     Newton's nodes approach the shooting solution."""
-    from rawehelix.solvers import shooting
+    from rawehelix.references import shooting
     centre_line = shooting.solve(nd).centre_line
     res, gap = [], []
     for N in (2, 4, 8, 16):

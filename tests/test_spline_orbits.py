@@ -7,8 +7,8 @@ import pytest
 
 import rawehelix as rh
 from rawehelix.solvers.periodic import periodic_response
-from rawehelix.solvers.spline_galerkin.forced import SplineBackend
-from rawehelix.solvers.spline_galerkin.orbits import SplineMap
+from rawehelix.references.spline_galerkin.forced import SplineBackend
+from rawehelix.references.spline_galerkin.orbits import SplineMap
 
 # the torque ramp (69) short, so that the brute-force run sees the orbits' steady torque
 SCENE = {"torque.rise_time_s": 0.05, "sweep.periodic_tolerance": 1e-6, "sweep.lead_in_s": 1.0}

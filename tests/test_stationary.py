@@ -11,7 +11,7 @@ import dolfinx.fem.petsc
 from mpi4py import MPI
 
 from rawehelix import compat
-from rawehelix.solvers import shooting
+from rawehelix.references import shooting
 from rawehelix.solvers.snes import NewtonSolver
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene

@@ -277,7 +277,7 @@ def test_one_and_two_ranks_give_the_same_csv(tmp_path_factory):
 def test_sigkill_resumes_without_recomputing(tmp_path):
     """A study killed with SIGKILL after some points and started again
     computes each finished point not again, and ends with every point."""
-    cmd = [sys.executable, "-m", "rawehelix.studies.cli", "study", "mobile_end", "--elements",
+    cmd = [sys.executable, "-m", "rawehelix.cli.main", "study", "mobile_end", "--elements",
            str(N), "--vary", "helix.EI_Nm2=3000:6000:8", "--quantity", "lateral_frequency_Hz",
            "--fd-step", "0", "-o", str(tmp_path)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from rawehelix.studies import cli, scene, sweep
+from rawehelix.cli import main as cli
+from rawehelix.studies import scene, sweep
 from tests_util import write_scene
 
 # periodic to 0.1 of the oscillation: about 2e-3 of T max at 8-10 Hz
@@ -34,7 +35,7 @@ def entries(path):
 
 
 def run_cli(scene_path, outdir, f1="8:10:0.5", extra=()):
-    return subprocess.Popen([sys.executable, "-m", "rawehelix.studies.cli", "sweep",
+    return subprocess.Popen([sys.executable, "-m", "rawehelix.cli.main", "sweep",
                              str(scene_path), "--f1", f1, "-o", str(outdir), *extra],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 

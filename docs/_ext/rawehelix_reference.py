@@ -4,7 +4,7 @@ A page carries a marker line ``<!-- rawehelix-reference: NAME -->``; when Sphinx
 reads it, the marker is replaced by the Markdown of :data:`GENERATORS` [NAME]:
 
 - ``commands``: every ``rawehelix`` command with its ``--help``, rendered from
-  the argparse parser of ``rawehelix.studies.cli`` (nothing else is imported);
+  the argparse parser of ``rawehelix.cli.main`` (nothing else is imported);
 - ``scene-keys``: every scene section and key with its type, unit, default and
   allowed values, walked from the parameter dataclasses
   (``rawehelix.studies.scene.SECTIONS``): the description and unit from the
@@ -45,7 +45,7 @@ def _subparsers(parser):
 
 def commands() -> str:
     """One section a command: its one-line purpose and its ``--help`` verbatim."""
-    from rawehelix.studies import cli
+    from rawehelix.cli import main as cli
     old = os.environ.get("COLUMNS")
     os.environ["COLUMNS"] = "100"  # argparse wraps to the terminal: fix the width
     try:

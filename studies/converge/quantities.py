@@ -18,7 +18,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.families import VIBRATIONS
-from rawehelix.solvers.spline_galerkin import spectrum
+from rawehelix.references.spline_galerkin import spectrum
 from rawehelix.studies import metrics
 
 
@@ -76,8 +76,8 @@ def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
     p = with_method(params, method, value)
     q = p.normalised()
     if method.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin import stationary
-        from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
+        from rawehelix.references.spline_galerkin import stationary
+        from rawehelix.references.spline_galerkin.system import SplineGalerkin
         system = SplineGalerkin(q, p.discretisation.elements)
         x = stationary.solve(system).x
         return np.array([q.tension_N(system.tension(x, 0.0, s=np.array([0.0]))[0])])
@@ -87,7 +87,7 @@ def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
 
 
 def _shooting_tension_s0(params: Parameters):
-    from rawehelix.solvers import shooting
+    from rawehelix.references import shooting
     q = params.normalised()
     return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
 
@@ -105,8 +105,8 @@ def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
     p = with_method(params, method, value)
     q = p.normalised()
     if method.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin import stationary
-        from rawehelix.solvers.spline_galerkin.system import SplineGalerkin
+        from rawehelix.references.spline_galerkin import stationary
+        from rawehelix.references.spline_galerkin.system import SplineGalerkin
         system = SplineGalerkin(q, p.discretisation.elements)
         modes = spectrum.modes(system, stationary.solve(system).x)
     else:
@@ -132,7 +132,7 @@ def _spin_series(params: Parameters, method: Method, value):
     p = with_method(params, method, value)
     q = p.normalised()
     if method.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin.dynamics import time_series
+        from rawehelix.references.spline_galerkin.dynamics import time_series
         ts = time_series(p, until_s=SPIN_RUN_S, output_every_s=SPIN_SAMPLE_S, rtol=1e-9)
         return ts.time_s, ts.spin_rpm
     from rawehelix.solvers.dynamics import DynamicsSolver
@@ -195,7 +195,7 @@ def tension_max(params: Parameters, method: Method, value) -> np.ndarray:
         p = p.replace(time={"dt_s": TENSION_MAX_SPACE_DT_S})
     q = p.normalised()
     if method.scheme == "spline":
-        from rawehelix.solvers.spline_galerkin.forced import SplineBackend
+        from rawehelix.references.spline_galerkin.forced import SplineBackend
         backend = SplineBackend(q, p.discretisation.elements, rtol=1e-9, atol=1e-11)
     else:
         from rawehelix.solvers.forced import FEBackend

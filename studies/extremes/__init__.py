@@ -55,7 +55,7 @@ def _modal(params, torque=None, nev=None):
 
 
 def _shooting_check(params):
-    from rawehelix.solvers import shooting
+    from rawehelix.references import shooting
     from rawehelix.solvers.stationary import StationarySolver
     q = params.normalised()
     fe = StationarySolver(params, MPI.COMM_SELF).solve()
@@ -186,7 +186,7 @@ def f1_40hz():
     884 N; the paper's N = 2 gives 89 N, a periodic and silently wrong answer."""
     from rawehelix.solvers.forced import FEBackend
     from rawehelix.solvers.periodic import periodic_response
-    from rawehelix.solvers.spline_galerkin.forced import SplineBackend
+    from rawehelix.references.spline_galerkin.forced import SplineBackend
     results = {}
     for label, N in (("fe_N8", 8), ("fe_N16", 16), ("spline_N2", 2)):
         params = _load("f1_40Hz", elements=N, scheme="spline" if label.startswith("spline") else "fe")

@@ -27,9 +27,9 @@ class Stationary:
 @functools.lru_cache(maxsize=8)
 def _shooting(nd):
     """The shooting solution of Sys. (67) for ``nd`` (cached), or None when
-    ``rawehelix.solvers.shooting`` is not available."""
+    ``rawehelix.references.shooting`` is not available."""
     try:
-        from rawehelix.solvers import shooting
+        from rawehelix.references import shooting
     except ImportError:
         return None
     return shooting.solve(nd)

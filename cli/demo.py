@@ -1,4 +1,4 @@
-"""A helix designer's first three minutes: ``python -m rawehelix.studies.demo [OUTDIR]``.
+"""A helix designer's first three minutes: ``python -m rawehelix.cli.demo [OUTDIR]``.
 
 Runs the paper's Sec. 5 with the public API, at small N, and writes
 OUTDIR/report.html with every figure and the key tables:
@@ -194,7 +194,7 @@ def build_report(outdir, summaries: dict, images: dict, wall_s: dict | None = No
 
 
 def cli(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m rawehelix.studies.demo",
+    parser = argparse.ArgumentParser(prog="python -m rawehelix.cli.demo",
                                      description=__doc__.split("\n")[0])
     parser.add_argument("outdir", nargs="?", default="results")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more messages")

@@ -234,7 +234,8 @@ def _overrides(args) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from rawehelix.studies import argv as argv_split, logs, outdir as outdir_check, outdir_lock
+    from rawehelix.cli import argv as argv_split
+    from rawehelix.studies import logs, outdir as outdir_check, outdir_lock
 
     argv = sys.argv[1:] if argv is None else argv
     parser = _parser()

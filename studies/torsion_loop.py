@@ -1,4 +1,5 @@
-"""The torsion test of Sec. 4 (Fig. 2c, Fig. 5) on the FE rod, with a prescribed end twist.
+"""The hysteretic torsion loop of Sec. 4 (Fig. 2c, Fig. 5) on the FE rod, with a
+prescribed end twist: ``rh.torsion_loop`` (the static lab tests hold z = 0).
 
 The lab segment of ``rawehelix labtest`` (studies/labtest.py: 6.76 m with the
 mass per length and stiffnesses of the Table 2 helix, no wind or drag), its
@@ -19,7 +20,7 @@ import math
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix.parameters import TorsionHysteresis
+from rawehelix.parameters import Parameters, TorsionHysteresis
 from rawehelix.solvers import bouc_wen
 from rawehelix.studies import labtest, scene
 
