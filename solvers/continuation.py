@@ -411,7 +411,7 @@ class Branch:
                 st.ds = max(self.ds_min, st.ds * max(0.2, 0.8 * self.tension_step / change))
                 continue
             if not natural:
-                orbit = self.m.finish(X, f1, self.m.rotation(f1), its, res, start, steps)
+                orbit = self.m.orbit_through(X, f1, self.m.rotation(f1), its, res, start, steps)
             # the new point's tangent with the steps it was found with (a natural step:
             # its own at its f1); the events between the two with the last point's
             tau_new, A, gf = self._tangent(orbit, st.tau, orbit.steps)
@@ -532,7 +532,7 @@ class Branch:
                 raise SolverError(f"continuation: the corrector failed while bisecting a "
                                   f"{kind} between {a.f1_Hz:.5f} and {b.f1_Hz:.5f} Hz")
             X, f1, its, res, _, _ = got
-            o = self.m.finish(X, f1, self.m.rotation(f1), its, res, time.perf_counter(), steps)
+            o = self.m.orbit_through(X, f1, self.m.rotation(f1), its, res, time.perf_counter(), steps)
             return o.f1_Hz, o.multipliers, o
 
         lo, hi, f_lo, f_hi, o, probes = bisect_crossing(probe, st.ds, count_a, kind)

@@ -605,7 +605,7 @@ class _LinearMap(PeriodMap):
         G = (M - np.eye(self.size)) @ (X - self.fixed(f1))
         return G, np.array([100.0 + 10.0 * f1]), (M if tangent else None)
 
-    def finish(self, X, f1, delta, its, res, start, steps=None):
+    def orbit_through(self, X, f1, delta, its, res, start, steps=None):
         from rawehelix.solvers.orbits import Orbit
         M = self.monodromy(f1)
         mu = np.linalg.eigvals(M)
@@ -623,7 +623,7 @@ def test_the_branch_locates_period_doubling_and_neimark_sacker(kind):
     from rawehelix.solvers.continuation import Branch
 
     m = _LinearMap(kind)
-    first = m.finish(m.fixed(10.0), 10.0, 0.0, 1, 0.0, 0.0)
+    first = m.finish(m.fixed(10.0), 10.0, 1, 0.0, 0.0)
     branch = Branch(m, ds=0.1, ds_max=0.2)
     points = branch.trace(first, 11.0)
     assert points[-1].f1_Hz > 11.0 and not branch.folds
@@ -652,7 +652,7 @@ def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     from rawehelix.solvers.continuation import Branch, Site, sites_for
 
     m = _LinearMap("superharmonic")
-    first = m.finish(m.fixed(4.6), 4.6, 0.0, 1, 0.0, 0.0)
+    first = m.finish(m.fixed(4.6), 4.6, 1, 0.0, 0.0)
     T0 = 50.0 if with_sites == "far from the linearised state" else 75.0
     sites = sites_for([10.0], 4.6, 5.4, tension_N=T0) if with_sites else ()
     assert list(sites) == ([Site(10.0, 2, T0)] if with_sites else [])

@@ -68,3 +68,29 @@ def test_the_orbits_command_takes_the_scenes_scheme(scheme, kind):
     from rawehelix.studies.orbits import period_map
     params = rh.load_scene("mobile_end", scheme=scheme, elements=2, overrides=SCENE)
     assert type(period_map(params)).__name__ == kind
+
+
+def test_the_spline_scheme_is_a_periodic_orbit_problem(spline_map, orbit):
+    """The spline shooting through the periodic-orbit interface
+    (solvers/orbit_problem.py): at the 10 Hz orbit G is within the shooting's
+    tolerance; the orbit at 10.05 Hz, solved by its own Newton, moves X as the
+    interface's two Jacobians predict (dX/df1 = -G_X^-1 G_f1, to the step's
+    second order: 2e-2 of the change); the multipliers and the samples of one
+    period from X are the orbit's."""
+    from rawehelix.solvers.orbit_problem import PeriodicOrbitProblem
+
+    m = spline_map
+    assert isinstance(m, PeriodicOrbitProblem)
+    steps = m.resolution(10.0)
+    G, samples, J = m.residual(orbit.X, 10.0, jacobian=True, resolution=steps)
+    assert m.norm(G, orbit.X) <= 1e-6
+    gf = m.residual_f1(orbit.X, 10.0, steps, G)
+    df = 0.05
+    moved = m.orbit(orbit.X, 10.0 + df)
+    predicted = -np.linalg.solve(J, gf) * df
+    change = moved.X - orbit.X
+    assert np.linalg.norm(predicted - change) <= 2e-2 * np.linalg.norm(change)
+    assert np.allclose(m.multipliers(orbit.X, 10.0), orbit.multipliers, rtol=1e-10, atol=1e-12)
+    T = m.q_base.tension_N(m.samples(orbit.X, 10.0))
+    assert T.max() == pytest.approx(orbit.tension_max_N, rel=1e-12)
+    assert T.min() == pytest.approx(orbit.tension_min_N, rel=1e-12)
