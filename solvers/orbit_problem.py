@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
+from typing import Callable
 
 import numpy as np
 
@@ -95,6 +96,23 @@ class Orbit:
                 "max_modulus": float(np.abs(mu).max()) if mu.size else None,
                 "max_distance_to_1": float(np.abs(mu - 1.0).max()) if mu.size else None}
         return out
+
+
+@dataclasses.dataclass(frozen=True)
+class Observable:
+    """A scalar the caller reads off the orbits (BifurcationKit's
+    ``record_from_solution``): ``of_samples`` from one period's samples
+    (:meth:`PeriodicOrbitProblem.samples`, a corrected point before its
+    Floquet period), ``of_orbit`` from a finished :class:`Orbit`; ``name``: its
+    key in the events reported."""
+
+    name: str
+    of_samples: Callable[[np.ndarray], float]
+    of_orbit: Callable[[Orbit], float]
+
+    def __post_init__(self):
+        if not self.name:
+            raise ValueError("Observable: a name is needed (the events' key)")
 
 
 class PeriodicOrbitProblem(abc.ABC):

@@ -29,7 +29,8 @@ linearisation (the families the end's circle drives; the FE's SLEPc modes or
 the spline scheme's eigenvalues, :func:`driven_frequencies`) give the k:1
 sites f_n / k (k in ``superharmonics``, default 2 and 3) inside the window,
 where the continuation's step closes in on the multiplier's crossing of +1
-(:mod:`rawehelix.solvers.continuation`).
+(the step guards of :mod:`rawehelix.solvers.resonances`, given to the
+continuation by :func:`branch` with T max, the branch's observable).
 
 Not yet: the free twist rotation without a controller
 (refused).
@@ -325,10 +326,31 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[flo
              if x["family"] in LATERAL], float(T0))
 
 
+def tension_max(m):
+    """T max [N] over a period, the branch's observable: of the samples of the
+    period map ``m`` (the tension at s = 0, normalised) or of a finished orbit."""
+    from rawehelix.solvers.orbit_problem import Observable
+    return Observable("tension_max_N", lambda samples: m.q.tension_N(samples).max(),
+                      lambda orbit: orbit.tension_max_N)
+
+
+def branch(m, tension_step: float | None = None, sites=(), **options):
+    """The continuation of the periodic-orbit problem ``m`` with this study's
+    observable (T max) and step guards: T max's relative step (``tension_step``,
+    default TENSION_STEP) and its peaks, then the superharmonic ``sites``
+    (solvers/resonances.py); ``options``: Branch's (ds, ds_min, ds_max, tol, max_it)."""
+    from rawehelix.solvers.continuation import Branch
+    from rawehelix.solvers.resonances import TENSION_STEP, Peaks, Sites
+    observable = tension_max(m)
+    step = TENSION_STEP if tension_step is None else tension_step
+    return Branch(m, observable=observable, guards=(Peaks(observable, step), Sites(sites)),
+                  **options)
+
+
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
                   superharmonics=()):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
-    from rawehelix.solvers.continuation import Branch, sites_for
+    from rawehelix.solvers.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
 
     start_f1, stop_f1 = window
@@ -345,15 +367,15 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
         else:
             sites = sites_for(f_n, lo, hi, superharmonics, tension_N=T0)
             about["sites"] = [{"f1_Hz": x.f1_Hz, "f_n_Hz": x.f_n_Hz, "order": x.k} for x in sites]
-    branch = Branch(m, tension_step=tension_step, sites=sites)
+    traced = branch(m, tension_step, sites)
     stored = store.load() if store else None
     if stored:
-        branch.resume(*stored)
+        traced.resume(*stored)
     else:
         first = m.orbit(m.X_stationary, start_f1, lead_in=LEAD_IN_PERIODS)
-        branch.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
+        traced.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
         if store:
-            store.save(first, [], branch.state)
+            store.save(first, [], traced.state)
         if progress:
             progress(first)
 
@@ -362,10 +384,10 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
         if progress:
             progress(orbit)
 
-    branch.trace(None, stop_f1, max_points=max_points, progress=each,
+    traced.trace(None, stop_f1, max_points=max_points, progress=each,
                  on_point=store.save if store else None)
-    entries = [o.entry() for o in branch.points]
-    return entries, branch.folds, branch.bifurcations, branch.peaks, about
+    entries = [o.entry() for o in traced.points]
+    return entries, traced.folds, traced.bifurcations, traced.peaks, about
 
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
@@ -375,7 +397,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     of ``comm``; with ``outdir``, stored point by point and resumed from it.
     ``superharmonics``: the orders k of the k:1 sites the step closes in on
     (default SUPERHARMONIC_ORDERS; () for none)."""
-    from rawehelix.solvers.continuation import SUPERHARMONIC_ORDERS, TENSION_STEP
+    from rawehelix.solvers.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
     if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
