@@ -34,8 +34,10 @@ with its Floquet multipliers, and nothing else.  The implementations:
 - its linear case, one harmonic about the stationary state with the forcing
   at small amplitude, is the harmonic response of
   :mod:`rawehelix.solvers.response` ((K - w^2 M + i w C) X = f): the shooting
-  orbit at small amplitude is that response (tests/test_orbits.py,
-  ``test_small_amplitude_orbit_is_the_linear_response``).
+  orbit at small amplitude is that response, its midpoint's lateral ellipse
+  and the first harmonic of its samples (T(0)) the response's
+  (tests/test_orbits.py, ``test_small_amplitude_orbit_is_the_linear_response``,
+  ``test_the_problems_linear_case_is_the_harmonic_response``).
 
 No FE code (numpy only): the spline reference implements it.
 """
