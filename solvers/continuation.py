@@ -5,13 +5,13 @@ The orbits are those of a periodic-orbit problem
 the FE or the spline scheme), which gives the residual G(X, f1), its Jacobians
 G_X and G_f1, its own Newton at fixed f1 and the finished orbit with its Floquet
 multipliers; nothing here knows the rod.  The caller's step guards
-(:class:`StepGuard`; studies/orbits.py gives the T max step and the
-superharmonic sites of solvers/resonances.py) refuse points, cap steps and
+(:class:`StepGuard`; studies/orbits.py gives its observable's relative step
+and the resonance sites of solvers/resonances.py) refuse points, cap steps and
 report their events in ``peaks``; folds and bifurcations are located by
 solvers/bifurcations.py and report the caller's observable.
 
-Unknowns Y = (X, f1) (and Delta without a controller: not continued here,
-refused by the problem).  From an orbit Y_k with unit tangent tau_k (||tau||
+Unknowns Y = (X, f1) (a problem with a family of orbits at each f1 is
+refused by the problem itself, :meth:`PeriodicOrbitProblem.continuable`).  From an orbit Y_k with unit tangent tau_k (||tau||
 in the problem's unknowns and f1 [Hz]), the predictor Y_k + ds tau_k is
 corrected by Newton on
 
