@@ -54,6 +54,12 @@ STALL = 100.0  # |dz| within STALL round-offs that stops contracting: at R's flo
 NEWTON = ("chord", "full")  # the steps' Newton: chord (held LU), or full (the reference)
 
 
+def check_newton(newton: str):
+    """Refuse a Newton other than NEWTON's (before anything is built)."""
+    if newton not in NEWTON:
+        raise SolverError(f"orbits: newton {newton!r} is not one of {NEWTON}")
+
+
 class AlphaStepper:
     """Steps of the generalised-alpha scheme on a :class:`RodOperator`.
 
@@ -64,8 +70,7 @@ class AlphaStepper:
 
     def __init__(self, op: RodOperator, rho_inf: float = 0.9, tol: float = TOL,
                  rate: float = 0.03, max_it: int = 12, order: int = 2, newton: str = "chord"):
-        if newton not in NEWTON:
-            raise SolverError(f"orbits: newton {newton!r} is not one of {NEWTON}")
+        check_newton(newton)
         self.op = op
         self.n = n = op.n
         if 3 * n > MAX_STATE:

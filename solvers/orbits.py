@@ -52,7 +52,7 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.dynamics import DynamicsSolver, law_hint
 from rawehelix.solvers.floquet import Orbit, PeriodMap  # noqa: F401  (Orbit re-exported)
-from rawehelix.solvers.generalised_alpha import MAX_STATE, TOL, AlphaStepper  # noqa: F401
+from rawehelix.solvers.generalised_alpha import MAX_STATE, TOL, AlphaStepper, check_newton  # noqa: F401
 from rawehelix.solvers.rod_operator import RodOperator
 from rawehelix.solvers.snes import SolverError
 
@@ -73,6 +73,7 @@ class AlphaMap(PeriodMap):
     def __init__(self, params: Parameters, rho_inf: float = 0.9, comm=MPI.COMM_SELF,
                  solver: DynamicsSolver | None = None, tol: float = TOL, rate: float = 0.03,
                  max_it: int = 12, order: int = 2, newton: str = "chord"):
+        check_newton(newton)
         if comm.size > 1:
             raise SolverError("orbits: the shooting solver runs on one rank (dense monodromy); "
                               "run separate frequency windows on separate ranks")
