@@ -782,33 +782,6 @@ def test_the_diagram_draws_each_run_of_stability_as_one_line(tmp_path):
     assert (tmp_path / "o.png").stat().st_size > 5_000
 
 
-def test_the_fe_shooting_is_a_periodic_orbit_problem(alpha_map):
-    """The FE shooting through the periodic-orbit interface (solvers/orbit_problem.py),
-    N = 4: at the 10 Hz orbit G is within the shooting's tolerance; the orbit at
-    10.05 Hz, solved by the shooting's own Newton, moves X as the interface's two
-    Jacobians predict (dX/df1 = -G_X^-1 G_f1, to the step's second order: 2e-2 of
-    the change); the multipliers and the samples of one period from X are the
-    orbit's (the same periods: to round-off)."""
-    from rawehelix.solvers.orbit_problem import PeriodicOrbitProblem
-
-    m = alpha_map
-    assert isinstance(m, PeriodicOrbitProblem) and m.carried.size == 0
-    orbit = m.orbit(m.X_stationary, 10.0, lead_in=5)
-    steps = m.resolution(10.0)
-    G, samples, J = m.residual(orbit.X, 10.0, jacobian=True, resolution=steps)
-    assert m.norm(G, orbit.X) <= 1e-6
-    gf = m.residual_f1(orbit.X, 10.0, steps, G)
-    df = 0.05
-    moved = m.orbit(orbit.X, 10.0 + df, steps=steps)
-    predicted = -np.linalg.solve(J, gf) * df
-    change = moved.X - orbit.X
-    assert np.linalg.norm(predicted - change) <= 2e-2 * np.linalg.norm(change)
-    assert np.allclose(m.multipliers(orbit.X, 10.0), orbit.multipliers, rtol=1e-8, atol=1e-10)
-    T = m.q.tension_N(m.samples(orbit.X, 10.0))
-    assert T.max() == pytest.approx(orbit.tension_max_N, rel=1e-10)
-    assert T.min() == pytest.approx(orbit.tension_min_N, rel=1e-10)
-
-
 def test_the_problems_linear_case_is_the_harmonic_response():
     """The periodic-orbit problem's linear case is solvers/response.py's one-harmonic
     response (N = 4, f1 = 3 Hz, the scene torque- and controller-free, as
