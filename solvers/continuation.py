@@ -1,71 +1,40 @@
 """Pseudo-arclength continuation of periodic orbits in f1, through folds.
 
-Unknowns Y = (X, f1) (and Delta without a controller: not continued here,
-refused).  From an orbit Y_k with unit tangent tau_k (||tau|| in the
-normalised state and f1 [Hz]), the predictor Y_k + ds tau_k is corrected
-by Newton on
+The orbits are those of a periodic-orbit problem
+(:class:`~rawehelix.solvers.orbit_problem.PeriodicOrbitProblem`: shooting with
+the FE or the spline scheme), which gives the residual G(X, f1), its Jacobians
+G_X and G_f1, its own Newton at fixed f1 and the finished orbit with its Floquet
+multipliers; nothing here knows the rod.  The caller's step guards
+(:class:`StepGuard`; studies/orbits.py gives its observable's relative step
+and the resonance sites of solvers/resonances.py) refuse points, cap steps and
+report their events in ``peaks``; folds and bifurcations are located by
+solvers/bifurcations.py and report the caller's observable.
 
-    G(X, f1) = P(X; f1) - X - Delta(f1) e_alpha = 0,     tau_k . (Y - Y_pred) = 0,
+Unknowns Y = (X, f1) (a problem with a family of orbits at each f1 is
+refused by the problem itself, :meth:`PeriodicOrbitProblem.continuable`).  From an orbit Y_k with unit tangent tau_k (||tau||
+in the problem's unknowns and f1 [Hz]), the predictor Y_k + ds tau_k is
+corrected by Newton on
 
-with the chord [[M_k - I, G_f1], [tau_k^T]]: M_k is the monodromy at Y_k,
-G_f1 central differences of G over f1 with the steps per period held
-(one M for the whole corrector, so that the map is smooth in f1).  The
-next tangent solves [[M - I, G_f1], [tau_k^T]] tau = (0, 1).
+    G(X, f1) = 0,     tau_k . (Y - Y_pred) = 0,
 
-A corrector that had to refresh the monodromy starts the next one with the
-monodromy at its predictor (``State.fresh``): below the resonance the
-multipliers rotate by 2 pi f_n d(1/f1) between points, so the last point's
-monodromy is a stale chord.  After two slow correctors in a row (>= SLOW
-iterations) or a failed one, and while every multiplier of the last point is
-FOLD_MARGIN away from +1 (no fold near, so f1 parametrises the branch), the
-next point is found by *natural* steps (``State.natural``): shooting at the
-predictor's f1 (:meth:`PeriodMap.orbit`, with the scheme's own steps per period
+with the chord [[G_X, G_f1], [tau_k^T]] at Y_k (shooting: G_X = M_k - I with M_k
+the monodromy, G_f1 central differences of G over f1 with the steps per period
+held: one resolution for the whole corrector, so that G is smooth in f1).  The
+next tangent solves [[G_X, G_f1], [tau_k^T]] tau = (0, 1).
+
+A corrector that had to refresh the Jacobian starts the next one with the
+Jacobian at its predictor (``State.fresh``): below a resonance the
+multipliers rotate between points, so the last point's monodromy is a stale
+chord.  After two slow correctors in a row (>= SLOW iterations) or a failed
+one, and while every multiplier of the last point is FOLD_MARGIN away from +1
+(no fold near, so f1 parametrises the branch), the next point is found by
+*natural* steps (``State.natural``): the problem's own Newton at the
+predictor's f1 (:meth:`PeriodicOrbitProblem.orbit`, with its own resolution
 there), f1 moving by at most NATURAL_STEP of itself.  Near a fold the
 arclength corrector takes over again.
 
 The step adapts: x1.5 after a corrector of <= 5 iterations, /1.5 after >= 7,
-/2 after a failure; and so that T max changes by at most ``tension_step``
-(relative) between two points: a corrected point past it is refused (before
-its Floquet period) and retried with a step scaled to the change, and the
-next step is capped by the same linear prediction.  So a peak of T max is
-approached in steps of at most that fraction and is not stepped over.
-
-Folds (limit points of cycles) are where df1/ds changes sign; their arclength
-by the secant on tau_f1, their f1 there by the cubic Hermite interpolant of
-f1(s) (values and slopes tau_f1 at both points); ``f1_error_Hz`` is its
-distance from the linear interpolant, an estimate of the error.  Period
-doubling (a real multiplier through -1) and Neimark-Sacker (a complex pair
-through the unit circle) are flagged where the count of multipliers of that
-kind outside the unit circle changes, and located by bisection in arclength
-between the two points (:func:`bisect_crossing`): each probe is a corrector
-from the earlier point with a shorter step and a Floquet period.
-
-Superharmonic resonances k:1 (k f1 = f_n of a driven natural frequency) are
-where a Floquet multiplier mu = exp(lambda T1) of that mode passes the
-positive real axis: its angle is 2 pi f_n / f1 (mod 2 pi), its distance
-|mu - 1| (about the modal damping over a period there, 1 - |mu|) sets the
-resonance's width, and the resolvent (M - I)^-1 its height.  A narrow one
-lies between two points of the T max step unseen, so the caller names the
-``sites`` (:class:`Site`: f_n / k with f_n from the linearisation) and, within
-``SITE_WINDOW`` of a site, the step moves the site's multiplier's angle
-(d theta / d f1 = 2 pi f_n / f1^2) by at most ``angle_step`` |mu - 1| (the
-multiplier's distance to +1 at the last point), so the points close in
-geometrically on the crossing; a step that would jump a window is cut to
-land at its edge.  The site's multiplier is tracked from point to point
-(:func:`track`): the lightly damped one (|mu| >= ``LIGHT``) nearest the
-predicted angle 2 pi (f_n / f1 - k) where a run in the window begins, then
-the one nearest the last one's angle moved by the predicted rotation, so
-that the many other lightly damped multipliers (70 of 156 at N = 4), which
-rotate at other rates, are not taken for it.  Only near the linearisation's
-state (the orbit's mean T(0) within LINEAR_SHIFT of its tension,
-:meth:`Site.holds_at`): on the primary resonance's S-curve a site's prediction
-means nothing (at N = 4 the 3:1 site of a 38.1 Hz lateral mode, 12.70 Hz, lies
-on it, and 10 "superharmonic" minima of |mu - 1| were reported there).
-Where the tracked multiplier's angle changes sign between two points of a
-window, the resonance is located by the angle's zero, interpolated linearly
-in 1/f1 (:func:`superharmonic_between`), and reported in ``peaks`` with kind
-``superharmonic``, its f1, |mu - 1| there and T max and T max - T min
-interpolated to it.
+/2 after a failure; then each guard caps it (:meth:`StepGuard.cap`).
 """
 
 from __future__ import annotations
@@ -76,137 +45,38 @@ import time
 
 import numpy as np
 
-from rawehelix.solvers.floquet import SLOW_RATE, Broyden, Orbit, PeriodMap
-from rawehelix.solvers.snes import SolverError
+from rawehelix.errors import SolverError
+from rawehelix.solvers import bifurcations
+from rawehelix.solvers.bifurcations import far_from_folds
+from rawehelix.solvers.floquet import SLOW_RATE, Broyden
+from rawehelix.solvers.orbit_problem import Observable, Orbit, PeriodicOrbitProblem
 
 log = logging.getLogger(__name__)
 
-TENSION_STEP = 0.05  # the largest relative change of T max between two branch points
-BISECTION_HZ = 1e-4  # PD / NS located to this width in f1 [Hz]
-BISECTION_MAX = 12  # probes per bisection
-PEAK_PROBES = 8  # correctors per peak refinement
-PEAK_TOL = 1e-6  # a peak's T max located to this relative change between two vertices
-SITE_WINDOW = 0.05  # the step control acts within this relative distance of a site's f1
-ANGLE_STEP = 1.0  # within a window: the angle's change per step over |mu - 1|
-LIGHT = 0.5  # multipliers of modulus below this are not a site's (damped over a period)
-SITE_ANGLE = 0.5  # a site's multiplier: within this of its predicted angle [rad]
-RUN = 200  # the points a site's multiplier is tracked over (the last of the branch)
-SUPERHARMONIC_ORDERS = (2, 3)  # k of the k:1 resonances the sites are made for
-LINEAR_SHIFT = 0.1  # sites act on orbits whose mean T(0) is within this of the linearised one
-FOLD_MARGIN = 0.02  # natural steps only while every multiplier is this far from +1
 NATURAL_STEP = 0.5  # a natural step moves f1 by at most this fraction of itself
 STOP_TOL = 1e-9  # relative: a point this near the window's end ends the trace
 SLOW = 6  # two correctors in a row of this many iterations turn to natural steps
 
 
-@dataclasses.dataclass(frozen=True)
-class Site:
-    """Where a k:1 superharmonic resonance of the natural frequency f_n is expected."""
+class StepGuard:
+    """A caller's rule on the branch's steps and the events it watches for; this
+    base guards nothing (a null guard)."""
 
-    f_n_Hz: float
-    k: int
-    tension_N: float | None = None  # T(0) of the linearised state (None: not checked)
+    def admit(self, prev: Orbit, orbit: Orbit | None, samples) -> float | None:
+        """None to take the corrected point after ``prev`` (``orbit``: the finished
+        orbit of a natural step, else None and the problem's ``samples`` over the
+        corrected point's period), or the factor (< 1) to retry with a shorter step."""
+        return None
 
-    @property
-    def f1_Hz(self) -> float:
-        return self.f_n_Hz / self.k
+    def cap(self, points, f1_s: float, ds: float, last_ds: float | None) -> float:
+        """The next step from the last of ``points`` (``f1_s``: df1/ds there;
+        ``last_ds``: the step that reached it, None at the branch's start)."""
+        return ds
 
-    def angle(self, f1: float) -> float:
-        """The mode's multiplier's predicted angle at f1, in (-pi, pi]."""
-        return float(np.angle(np.exp(2j * np.pi * (self.f_n_Hz / f1 - self.k))))
-
-    def near(self, f1: float) -> bool:
-        return abs(f1 / self.f1_Hz - 1.0) <= SITE_WINDOW
-
-    def holds_at(self, orbit: Orbit) -> bool:
-        """The orbit's mean tension at s = 0 is within LINEAR_SHIFT of the
-        linearised state's, so f_n (~ sqrt(T) for the lateral modes) has moved
-        by less than the window: on a resonance's S-curve (T several times the
-        stationary) the prediction means nothing."""
-        if self.tension_N is None:
-            return True
-        mean = 0.5 * (orbit.tension_max_N + orbit.tension_min_N)
-        return abs(mean / self.tension_N - 1.0) <= LINEAR_SHIFT
-
-
-def sites_for(frequencies_Hz, f1_lo: float, f1_hi: float,
-              orders=SUPERHARMONIC_ORDERS, tension_N: float | None = None) -> list[Site]:
-    """The k:1 sites f_n / k of the natural frequencies f_n inside [f1_lo, f1_hi]
-    (of the linearisation about a state whose tension at s = 0 is ``tension_N``);
-    sites closer than a tenth of the window (a lateral pair) are one."""
-    out = []
-    for site in sorted((Site(float(f), int(k), tension_N) for f in frequencies_Hz for k in orders
-                        if f1_lo <= f / k <= f1_hi), key=lambda x: x.f1_Hz):
-        if not out or site.f1_Hz / out[-1].f1_Hz - 1.0 > 0.1 * SITE_WINDOW:
-            out.append(site)
-    return out
-
-
-def track(site: Site, points) -> list:
-    """The site's multiplier at each of ``points`` (None outside its window): at the
-    first point of a run inside the window, the lightly damped one (|mu| >= LIGHT)
-    nearest the predicted angle 2 pi (f_n / f1 - k); at each next point, the one
-    nearest the last one's angle moved by the predicted 2 pi f_n (1/f1 - 1/f1_last),
-    so that other modes passing by are not taken for it.  A run restarts where
-    none is within SITE_ANGLE of the prediction."""
-    out, last = [], None
-    for o in points:
-        mu = np.asarray(o.multipliers)
-        mu = mu[np.abs(mu) >= LIGHT]
-        if not site.near(o.f1_Hz) or mu.size == 0 or not site.holds_at(o):
-            out.append(None)
-            last = None
-            continue
-        if last is None:
-            want = site.angle(o.f1_Hz)
-        else:
-            want = np.angle(last[0]) + 2 * np.pi * site.f_n_Hz * (1 / o.f1_Hz - 1 / last[1])
-        miss = np.abs(np.angle(mu * np.exp(-1j * want)))
-        k = int(np.argmin(miss))
-        if miss[k] > SITE_ANGLE:
-            out.append(None)
-            last = None
-            continue
-        out.append(complex(mu[k]))
-        last = (out[-1], o.f1_Hz)
-    return out
-
-
-def far_from_folds(mu) -> bool:
-    """No multiplier within FOLD_MARGIN of +1: no fold (a real multiplier through
-    +1) is near, so f1 parametrises the branch and shooting at fixed f1 is sound."""
-    mu = np.asarray(mu)
-    return bool(mu.size == 0 or np.min(np.abs(mu - 1.0)) > FOLD_MARGIN)
-
-
-def _unstable(mu) -> dict:
-    """Multipliers outside the unit circle, by kind (real > 1, real < -1, complex)."""
-    out = np.abs(mu) > 1.0 + 1e-9
-    real = np.abs(mu.imag) <= 1e-9 * np.maximum(1.0, np.abs(mu))
-    return {"fold": int(np.sum(out & real & (mu.real > 0))),
-            "period_doubling": int(np.sum(out & real & (mu.real < 0))),
-            "neimark_sacker": int(np.sum(out & ~real))}
-
-
-def bisect_crossing(probe, s_b: float, count_a: int, kind: str, f1_width: float = BISECTION_HZ,
-                    max_probes: int = BISECTION_MAX):
-    """Bisection in arclength s in (0, s_b) for the change of the count of
-    ``kind`` multipliers outside the unit circle, from ``count_a`` at s = 0.
-    ``probe(s)`` -> (f1, multipliers, info).  Returns (s_lo, s_hi, f1_lo,
-    f1_hi, info_hi, probes): the bracket that holds the change, the probe
-    just past it, and the number of probes used.  Stops when the bracket is
-    under ``f1_width`` in f1 or after ``max_probes``."""
-    lo, hi, f_lo, f_hi, info_hi = 0.0, s_b, None, None, None
-    probes = 0
-    while probes < max_probes and (f_lo is None or f_hi is None or abs(f_hi - f_lo) > f1_width):
-        mid = 0.5 * (lo + hi)
-        f1, mu, info = probe(mid)
-        probes += 1
-        if _unstable(np.asarray(mu))[kind] == count_a:
-            lo, f_lo = mid, f1
-        else:
-            hi, f_hi, info_hi = mid, f1, info
-    return lo, hi, f_lo, f_hi, info_hi, probes
+    def events(self, branch: "Branch", a: Orbit, b: Orbit, st: "State", steps) -> list[dict]:
+        """Events between a (the branch's last point) and b (the new one), called
+        once the branch has two points."""
+        return []
 
 
 @dataclasses.dataclass
@@ -234,59 +104,46 @@ class State:
 
 
 class Branch:
-    """A branch of orbits traced by pseudo-arclength continuation."""
+    """A branch of orbits of ``problem`` traced by pseudo-arclength continuation:
+    ``observable`` the caller's scalar reported at folds and bifurcations,
+    ``guards`` the caller's step guards (:class:`StepGuard`), in order."""
 
-    def __init__(self, alpha_map: PeriodMap, ds: float = 0.1, ds_min: float = 1e-4,
+    def __init__(self, problem: PeriodicOrbitProblem, ds: float = 0.1, ds_min: float = 1e-4,
                  ds_max: float = 2.0, tol: float = 1e-7, max_it: int = 8,
-                 tension_step: float = TENSION_STEP, sites=(), angle_step: float = ANGLE_STEP):
-        if not alpha_map.controller:
-            raise SolverError("continuation: a scene without the controller's integral action "
-                              "(k1 = 0) has a free twist rotation; continue it at fixed f1 steps "
-                              "(AlphaMap.orbit) instead")
-        if not 0 < tension_step < 1:
-            raise SolverError(f"continuation: tension_step {tension_step} must be in (0, 1)")
-        self.m = alpha_map
+                 observable: Observable | None = None, guards=()):
+        problem.continuable()
+        self.problem = problem
         self.ds, self.ds_min, self.ds_max, self.tol, self.max_it = ds, ds_min, ds_max, tol, max_it
-        self.tension_step = tension_step
-        self.sites, self.angle_step = tuple(sites), angle_step  # superharmonic sites
+        self.observable, self.guards = observable, tuple(guards)
         self.points: list[Orbit] = []
         self.folds: list[dict] = []
         self.bifurcations: list[dict] = []
         self.peaks: list[dict] = []
         self.state: State | None = None
 
-    def _G(self, X, f1, steps, tangent=False):
-        """(G, tension over the period, monodromy or None) at (X, f1), Delta fixed
-        by the controller."""
-        return self.m.shooting_residual(X, f1, self.m.rotation(f1), tangent=tangent, steps=steps)
-
-    def _G_f1(self, X, f1, steps, G=None, eps=1e-5):
-        """dG/df1 at fixed steps per period: forward differences from ``G`` (G at
-        (X, f1), one more period), or central ones without it."""
-        if G is None:
-            gf = (self._G(X, f1 + eps, steps)[0] - self._G(X, f1 - eps, steps)[0]) / (2 * eps)
-        else:
-            gf = (self._G(X, f1 + eps, steps)[0] - G) / eps
-        gf[self.m.carried] = 0.0  # carried entries (floquet.py): not on the tangent
-        return gf
-
     def _bordered(self, A, gf, tau):
-        """[[M - I, G_f1], [(w^2 tau)^T]]: the corrector's and the tangent's matrix."""
+        """[[G_X, G_f1], [(w^2 tau)^T]]: the corrector's and the tangent's matrix."""
         return np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
 
     def _tangent(self, orbit: Orbit, tau_prev, steps):
-        A = self.m.newton_matrix(orbit.monodromy)
+        A = self.problem.jacobian(orbit)
         G = orbit.G if orbit.steps == steps else None
-        gf = self._G_f1(orbit.X, orbit.f1_Hz, steps, G)
+        gf = self.problem.residual_f1(orbit.X, orbit.f1_Hz, steps, G)
         K = self._bordered(A, gf, tau_prev)
         rhs = np.zeros(K.shape[0])
         rhs[-1] = 1.0
         tau = np.linalg.solve(K, rhs)
         return tau / np.linalg.norm(self.w * tau), A, gf
 
-    def _correct(self, prev: Orbit, tau, A, gf, ds, steps, fresh: bool = False):
+    def _cap(self, points, f1_s, ds, last_ds) -> float:
+        """The step ``ds`` capped by each guard in turn, not below ds_min."""
+        for guard in self.guards:
+            ds = max(self.ds_min, guard.cap(points, f1_s, ds, last_ds))
+        return ds
+
+    def correct(self, prev: Orbit, tau, A, gf, ds, steps, fresh: bool = False):
         """The corrector from ``prev`` along ``tau`` by ``ds``: (X, f1, iterations,
-        |G|/|X|, the tension over the period (normalised), whether it refreshed the
+        |G|/|X|, the problem's samples over the period, whether it refreshed the
         monodromy) or None if it fails.  The bordered chord (``A``: the last point's
         M - I) improved by Broyden's updates (:class:`Broyden`) and refreshed where
         an iteration leaves more than SLOW_RATE of |G|.  ``fresh``: the first
@@ -303,19 +160,18 @@ class Branch:
             # the chord is too far off (or stale from the start)
             slow = (H is not None and res > SLOW_RATE * last) or (fresh and its == 1)
             try:
-                G, tension, Phi = self._G(X, f1, steps, tangent=slow)
+                G, samples, J = self.problem.residual(X, f1, jacobian=slow, resolution=steps)
             except SolverError as err:  # the period's steps failed from this iterate
                 log.debug("corrector %d: the period map failed at f1 = %.6f Hz: %s", its, f1, err)
                 return None
-            if slow:  # Newton: the monodromy and G_f1 here
-                A = self.m.newton_matrix(Phi)
-                gf = self._G_f1(X, f1, steps, G)
+            if slow:  # Newton: the Jacobians in X and f1 here
+                A, gf = J, self.problem.residual_f1(X, f1, steps, G)
                 K, H, refreshed = self._bordered(A, gf, tau), None, True
-            last, res = res, self.m.shooting_norm(G, X)
+            last, res = res, self.problem.norm(G, X)
             log.debug("corrector %d: f1 = %.6f Hz, |G|/|X| = %.3g, ds %.3g%s", its, f1, res,
                       ds, " (fresh monodromy)" if slow else "")
             if res <= self.tol:
-                return self.m.settle(X, G), f1, its, res, tension, refreshed
+                return self.problem.settle(X, G), f1, its, res, samples, refreshed
             r = np.concatenate([G, [(self.w**2 * tau) @ (Y - Y0) - ds]])
             if H is None:
                 H = Broyden(K)
@@ -327,9 +183,8 @@ class Branch:
 
     def _natural(self, prev: Orbit, st: State, f1_stop: float) -> Orbit | None:
         """The next point by shooting at the predictor's f1 (natural parameter), from
-        the predictor's state, with the monodromy at each start of the shooting's
-        Newton (:meth:`PeriodMap.orbit`) and the scheme's own steps per period at that
-        f1; None if it fails.  The step moves f1 by at most NATURAL_STEP of itself,
+        the predictor's state, by the problem's own Newton (:meth:`PeriodicOrbitProblem.orbit`,
+        shooting: the monodromy at each start) and its own resolution at that f1; None if it fails.  The step moves f1 by at most NATURAL_STEP of itself,
         and not past ``f1_stop`` (``st.ds`` is cut to match): at 0.5 Hz a period is
         the dearest of the curve, and one past the window cost 46 s of 505 at N = 8."""
         room = abs(f1_stop - prev.f1_Hz)
@@ -340,8 +195,8 @@ class Branch:
         if not f1 > 0:
             return None
         try:
-            return self.m.orbit(Y[:-1], f1, tol=self.tol, max_it=2 * self.max_it,
-                                steps=self.m.steps_per_period(f1), linear=True)
+            return self.problem.orbit(Y[:-1], f1, tol=self.tol, max_it=2 * self.max_it,
+                                      steps=self.problem.resolution(f1), linear=True)
         except SolverError as err:
             log.debug("natural step to %.6f Hz failed: %s", f1, err)
             return None
@@ -359,7 +214,7 @@ class Branch:
         self.w[:n] = abs(tau[-1]) / max(np.linalg.norm(tau[:n]), 1e-300)
         tau, A, gf = self._tangent(first, tau, steps)
         self.points = [first]
-        ds = max(self.ds_min, self._site_step(self.points, tau[-1], self.ds))
+        ds = self._cap(self.points, tau[-1], self.ds, None)
         self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=ds)
 
     def resume(self, points: list[Orbit], state: State, folds=(), bifurcations=(), peaks=()):
@@ -388,14 +243,14 @@ class Branch:
         while len(self.points) < max_points:
             prev, st = self.points[-1], self.state
             start = time.perf_counter()
-            steps = self.m.steps_per_period(prev.f1_Hz)
+            steps = self.problem.resolution(prev.f1_Hz)
             natural = st.natural and far_from_folds(prev.multipliers)
             if natural:  # the corrector was slow and no fold is near: shooting at the next f1
                 orbit = self._natural(prev, st, f1_stop)
                 got = None if orbit is None else (orbit.X, orbit.f1_Hz, orbit.newton_iterations,
                                                   orbit.residual, None, True)
             else:
-                got = self._correct(prev, st.tau, st.A, st.gf, st.ds, steps, fresh=st.fresh)
+                got = self.correct(prev, st.tau, st.A, st.gf, st.ds, steps, fresh=st.fresh)
             if got is None:
                 st.ds /= 2
                 st.natural = True  # a failed corrector: try the next step at fixed f1
@@ -403,15 +258,16 @@ class Branch:
                     raise SolverError(f"continuation: the corrector failed at f1 = "
                                       f"{prev.f1_Hz:.4f} Hz with the smallest step {self.ds_min}")
                 continue
-            X, f1, its, res, tension, refreshed = got
-            T_max = orbit.tension_max_N if natural else self.m.q.tension_N(tension).max()
-            change = abs(T_max / prev.tension_max_N - 1.0)
-            if change > self.tension_step and st.ds > self.ds_min:
-                # T max moved too far: a shorter step (before the Floquet period of a corrector)
-                st.ds = max(self.ds_min, st.ds * max(0.2, 0.8 * self.tension_step / change))
+            X, f1, its, res, samples, refreshed = got
+            # the guards' verdicts (all of them: each keeps what it measured)
+            scale = [x for x in (g.admit(prev, orbit if natural else None, samples)
+                                 for g in self.guards) if x is not None]
+            if scale and st.ds > self.ds_min:
+                # a guard refuses the point: a shorter step (before the Floquet period of a corrector)
+                st.ds = max(self.ds_min, st.ds * min(scale))
                 continue
             if not natural:
-                orbit = self.m.finish(X, f1, self.m.rotation(f1), its, res, start, steps)
+                orbit = self.problem.finish(X, f1, its, res, start, steps)
             # the new point's tangent with the steps it was found with (a natural step:
             # its own at its f1); the events between the two with the last point's
             tau_new, A, gf = self._tangent(orbit, st.tau, orbit.steps)
@@ -423,9 +279,7 @@ class Branch:
                 ds = min(self.ds_max, ds * 1.5)
             elif its >= 7:
                 ds = max(self.ds_min, ds / 1.5)
-            if change > 0:  # the next change of T max, predicted linearly, within the bound
-                ds = max(self.ds_min, min(ds, st.ds * 0.8 * self.tension_step / change))
-            ds = max(self.ds_min, self._site_step(self.points + [orbit], tau_new[-1], ds))
+            ds = self._cap(self.points + [orbit], tau_new[-1], ds, st.ds)
             self.state = State(tau=tau_new, A=A, gf=gf, w=self.w.copy(), ds=ds, fresh=refreshed,
                                natural=natural or min(its, prev.newton_iterations) >= SLOW)
             self.points.append(orbit)
@@ -437,166 +291,23 @@ class Branch:
                 break
         return self.points
 
-    def _site_step(self, points, f1_s: float, ds: float) -> float:
-        """The next step from the last of ``points`` cut by the superharmonic sites
-        (module docstring): within a window, the site's multiplier's angle moves by
-        at most angle_step |mu - 1|; a window ahead is not jumped (the step lands
-        just inside its edge)."""
-        if not self.sites or abs(f1_s) < 1e-12:
-            return ds
-        f1, ahead = points[-1].f1_Hz, float(np.sign(f1_s))
-        for site in self.sites:
-            if site.near(f1):
-                mu = track(site, points[-RUN:])[-1]
-                if mu is not None:
-                    rate = 2 * np.pi * site.f_n_Hz / f1**2  # |d theta / d f1| [rad/Hz]
-                    ds = min(ds, self.angle_step * abs(mu - 1.0) / rate / abs(f1_s))
-                continue
-            edge = site.f1_Hz * (1.0 - ahead * 0.9 * SITE_WINDOW)  # just inside the window
-            if ahead * (edge - f1) > 0 and ahead * (f1 + ds * f1_s - edge) > 0:
-                ds = min(ds, abs(edge - f1) / abs(f1_s))
-        return ds
-
     # -- events -------------------------------------------------------------------------
     def _detect(self, a: Orbit, b: Orbit, st: State, tau_b, steps) -> list[dict]:
         """Folds and bifurcations between two consecutive points (appended to
-        ``folds`` / ``bifurcations`` and returned)."""
+        ``folds`` / ``bifurcations`` and returned), then the guards' events
+        (appended to ``peaks``)."""
         events = []
         ta, tb = st.tau[-1], tau_b[-1]
         if np.sign(ta) != np.sign(tb):  # df1/ds through zero: a fold
-            events.append(fold_between(a, b, ta, tb, st.ds))
+            events.append(bifurcations.fold_between(a, b, ta, tb, st.ds, self.observable))
             self.folds.append(events[-1])
-        ua, ub = _unstable(a.multipliers), _unstable(b.multipliers)
-        for kind in ("period_doubling", "neimark_sacker"):
-            if ua[kind] != ub[kind]:
-                events.append(self._locate(a, b, st, kind, ua[kind], steps))
-                self.bifurcations.append(events[-1])
+        for kind, count_a in bifurcations.unstable_changes(a, b):
+            events.append(bifurcations.locate(self, a, b, st, kind, count_a, steps,
+                                              self.observable))
+            self.bifurcations.append(events[-1])
         if len(self.points) >= 2:
-            z = self.points[-2]
-            if a.tension_max_N > z.tension_max_N and a.tension_max_N >= b.tension_max_N:
-                events.append(self._peak(z, a, b, st, steps))
-                self.peaks.append(events[-1])
-            for site in self.sites:
-                found = superharmonic_between(site, (self.points + [b])[-RUN:])
-                if found:
-                    events.append(found)
-                    self.peaks.append(found)
+            for guard in self.guards:
+                found = guard.events(self, a, b, st, steps)
+                events += found
+                self.peaks += found
         return events
-
-    def _peak(self, z: Orbit, a: Orbit, b: Orbit, st: State, steps) -> dict:
-        """A local maximum of T max at or near a (T max of z < a >= b): the vertex
-        of the parabola through (s, T max) of the three, in arclength s from a
-        along its tangent, then correctors at the vertex, each keeping the highest
-        point and its neighbours in s (a bracket), until T max changes by less
-        than PEAK_TOL."""
-        Y = lambda o: np.concatenate([o.X, [o.f1_Hz]])  # noqa: E731
-        s_z = float((self.w**2 * st.tau) @ (Y(z) - Y(a)))
-        pts = [(s_z, z.tension_max_N, z.f1_Hz), (0.0, a.tension_max_N, a.f1_Hz),
-               (st.ds, b.tension_max_N, b.f1_Hz)]
-        best, probes, located = pts[1], 0, "point"
-        while probes < PEAK_PROBES:
-            x, y = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
-            c2, c1, _ = np.polyfit(x, y, 2)
-            if not c2 < 0:
-                break
-            sv = -c1 / (2 * c2)
-            if not min(x) < sv < max(x):
-                break
-            got = self._correct(a, st.tau, st.A, st.gf, sv, steps)
-            probes += 1
-            if got is None:
-                break
-            _, f1, _, _, tension, _ = got
-            T = float(self.m.q.tension_N(tension).max())
-            previous = best
-            if T > best[1]:
-                best, located = (sv, T, f1), "refined"
-            # the highest of the four and its neighbours on either side in s: a bracket
-            # (dropping the lowest could drop the only point beyond the vertex)
-            pts = sorted(pts + [(sv, T, f1)])
-            top = int(np.argmax([p[1] for p in pts]))
-            top = min(max(top, 1), len(pts) - 2)
-            pts = pts[top - 1:top + 2]
-            if abs(T / previous[1] - 1) <= PEAK_TOL:
-                break
-        return {"f1_Hz": best[2], "tension_max_N": best[1], "kind": "peak", "located": located,
-                "probes": probes, "bracket_Hz": [z.f1_Hz, b.f1_Hz]}
-
-    def _locate(self, a: Orbit, b: Orbit, st: State, kind: str, count_a: int, steps) -> dict:
-        """PD / NS between a and b by bisection in arclength (each probe: a
-        corrector from a with a shorter step and the Floquet period there)."""
-
-        def probe(s):
-            got = self._correct(a, st.tau, st.A, st.gf, s, steps)
-            if got is None:
-                raise SolverError(f"continuation: the corrector failed while bisecting a "
-                                  f"{kind} between {a.f1_Hz:.5f} and {b.f1_Hz:.5f} Hz")
-            X, f1, its, res, _, _ = got
-            o = self.m.finish(X, f1, self.m.rotation(f1), its, res, time.perf_counter(), steps)
-            return o.f1_Hz, o.multipliers, o
-
-        lo, hi, f_lo, f_hi, o, probes = bisect_crossing(probe, st.ds, count_a, kind)
-        f_lo = a.f1_Hz if f_lo is None else f_lo
-        if o is None:
-            o = b
-        f_hi = o.f1_Hz
-        return {"f1_Hz": 0.5 * (f_lo + f_hi), "tension_max_N": o.tension_max_N, "kind": kind,
-                "f1_error_Hz": 0.5 * abs(f_hi - f_lo), "probes": probes,
-                "multiplier": _crossing(o.multipliers, kind)}
-
-
-def superharmonic_between(site: Site, points) -> dict | None:
-    """The site's resonance between the last two ``points`` (a, b), where the
-    angle of the site's tracked multiplier changes sign: k f1 passes the orbit's
-    own f_n there.  Located by linear interpolation of the angle in 1/f1 (theta =
-    2 pi (f_n / f1 - k) is linear in 1/f1 while f_n holds), with |mu|, T max and
-    T max - T min interpolated linearly in the same weight; ``distance`` is
-    |mu - 1| there, | |mu| - 1 |.  (The former vertex of the parabola through
-    |mu - 1|^2 of three points moved by 1.7e-3 Hz at the N = 8 2:1 site when the
-    points were twice as far apart; this zero moved by 2e-5 Hz.)"""
-    if len(points) < 2:
-        return None
-    a, b = points[-2:]
-    mus = track(site, points)[-2:]
-    if any(m is None for m in mus):
-        return None
-    ta, tb = np.angle(mus)
-    if not ((ta > 0 >= tb or ta < 0 <= tb) and abs(ta - tb) < np.pi):
-        return None
-    w = ta / (ta - tb)
-    at = lambda va, vb: float(va + w * (vb - va))  # noqa: E731
-    fv = 1.0 / at(1.0 / a.f1_Hz, 1.0 / b.f1_Hz)
-    mu = complex(at(abs(mus[0]), abs(mus[1])), 0.0)  # on the positive real axis there
-    return {"f1_Hz": fv, "kind": "superharmonic", "order": site.k, "f_n_Hz": site.f_n_Hz,
-            "distance": abs(mu.real - 1.0),
-            "tension_max_N": at(a.tension_max_N, b.tension_max_N),
-            "oscillation_N": at(a.tension_max_N - a.tension_min_N,
-                                b.tension_max_N - b.tension_min_N),
-            "multiplier": [mu.real, mu.imag], "bracket_Hz": [a.f1_Hz, b.f1_Hz]}
-
-
-def _crossing(mu, kind) -> list[float]:
-    """The multiplier of ``kind`` nearest the unit circle (re, im)."""
-    mu = np.asarray(mu)
-    real = np.abs(mu.imag) <= 1e-9 * np.maximum(1.0, np.abs(mu))
-    sel = (real & (mu.real < 0)) if kind == "period_doubling" else ~real
-    if not np.any(sel):
-        return []
-    m = mu[sel][np.argmin(np.abs(np.abs(mu[sel]) - 1.0))]
-    return [float(m.real), float(m.imag)]
-
-
-def fold_between(a: Orbit, b: Orbit, ta: float, tb: float, ds: float) -> dict:
-    """A fold between a and b, where df1/ds goes from ta to tb (opposite signs):
-    s* by the secant on df1/ds, f1(s*) by the cubic Hermite interpolant of f1(s)
-    over [0, ds]; the error estimate is its distance from the linear one."""
-    w = ta / (ta - tb)
-    fa, fb = a.f1_Hz, b.f1_Hz
-    h00, h10, h01, h11 = (2 * w**3 - 3 * w**2 + 1, w**3 - 2 * w**2 + w, -2 * w**3 + 3 * w**2,
-                          w**3 - w**2)
-    hermite = h00 * fa + h10 * ds * ta + h01 * fb + h11 * ds * tb
-    linear = fa + w * (fb - fa)
-    return {"f1_Hz": float(hermite),
-            "tension_max_N": a.tension_max_N + w * (b.tension_max_N - a.tension_max_N),
-            "kind": "fold", "f1_error_Hz": float(abs(hermite - linear)),
-            "bracket_Hz": [fa, fb]}

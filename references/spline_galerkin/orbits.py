@@ -30,8 +30,11 @@ multipliers are the physical ones.
 
 The shooting Newton, the rotation Delta and the orbit's summary are the
 scheme-independent ones of :class:`rawehelix.solvers.floquet.PeriodMap`
-(numpy only: no FE code); only the period map is this scheme's own, so the continuation (:mod:`rawehelix.solvers.continuation`)
-traces the paper's N = 2 curve with its unstable branch as it does the FE's.
+(numpy only: no FE code), so :class:`SplineMap` is a periodic-orbit problem
+(:class:`rawehelix.solvers.orbit_problem.PeriodicOrbitProblem`) as the FE
+shooting is; only the period map is this scheme's own, so the continuation
+(:mod:`rawehelix.solvers.continuation`) traces the paper's N = 2 curve with its
+unstable branch as it does the FE's.
 """
 
 from __future__ import annotations
