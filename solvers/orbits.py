@@ -51,7 +51,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.dynamics import DynamicsSolver, law_hint
-from rawehelix.solvers.floquet import Orbit, PeriodMap  # noqa: F401  (Orbit re-exported)
+from rawehelix.periodic_orbits.floquet import Orbit, PeriodMap  # noqa: F401  (Orbit re-exported)
 from rawehelix.solvers.generalised_alpha import MAX_STATE, TOL, AlphaStepper, check_newton  # noqa: F401
 from rawehelix.solvers.rod_operator import RodOperator
 from rawehelix.solvers.snes import SolverError

@@ -2,7 +2,7 @@
 
 The first orbit (at the start of the f1 window) is found by shooting from
 the stationary state after a few lead-in periods; the branch is then traced
-by pseudo-arclength continuation (:mod:`rawehelix.solvers.continuation`),
+by pseudo-arclength continuation (:mod:`rawehelix.periodic_orbits.continuation`),
 through folds, until f1 leaves the window.  Every point carries its Floquet
 multipliers' largest modulus and its stability.  The torque ramp (69) is
 at its final value (the summary says so).
@@ -29,7 +29,7 @@ linearisation (the families the end's circle drives; the FE's SLEPc modes or
 the spline scheme's eigenvalues, :func:`driven_frequencies`) give the k:1
 sites f_n / k (k in ``superharmonics``, default 2 and 3) inside the window,
 where the continuation's step closes in on the multiplier's crossing of +1
-(the step guards of :mod:`rawehelix.solvers.resonances`, given to the
+(the step guards of :mod:`rawehelix.periodic_orbits.resonances`, given to the
 continuation by :func:`branch` with T max, the branch's observable).
 
 Not yet: the free twist rotation without a controller
@@ -198,7 +198,7 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[flo
 def tension_max(m):
     """T max [N] over a period, the branch's observable: of the samples of the
     period map ``m`` (the tension at s = 0, normalised) or of a finished orbit."""
-    from rawehelix.solvers.orbit_problem import Observable
+    from rawehelix.periodic_orbits.problem import Observable
     return Observable("tension_max_N", lambda samples: m.q.tension_N(samples).max(),
                       lambda orbit: orbit.tension_max_N)
 
@@ -207,9 +207,9 @@ def branch(m, tension_step: float | None = None, sites=(), **options):
     """The continuation of the periodic-orbit problem ``m`` with this study's
     observable (T max) and step guards: T max's relative step (``tension_step``,
     default TENSION_STEP) and its peaks, then the superharmonic ``sites``
-    (solvers/resonances.py); ``options``: Branch's (ds, ds_min, ds_max, tol, max_it)."""
-    from rawehelix.solvers.continuation import Branch
-    from rawehelix.solvers.resonances import TENSION_STEP, Peaks, Sites
+    (periodic_orbits/resonances.py); ``options``: Branch's (ds, ds_min, ds_max, tol, max_it)."""
+    from rawehelix.periodic_orbits.continuation import Branch
+    from rawehelix.periodic_orbits.resonances import TENSION_STEP, Peaks, Sites
     observable = tension_max(m)
     step = TENSION_STEP if tension_step is None else tension_step
     return Branch(m, observable=observable, guards=(Peaks(observable, step), Sites(sites)),
@@ -219,7 +219,7 @@ def branch(m, tension_step: float | None = None, sites=(), **options):
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
                   superharmonics=()):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
-    from rawehelix.solvers.resonances import sites_for
+    from rawehelix.periodic_orbits.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
 
     start_f1, stop_f1 = window
@@ -266,7 +266,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     of ``comm``; with ``outdir``, stored point by point and resumed from it.
     ``superharmonics``: the orders k of the k:1 sites the step closes in on
     (default SUPERHARMONIC_ORDERS; () for none)."""
-    from rawehelix.solvers.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
+    from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
     if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
@@ -365,7 +365,7 @@ def report(result: OrbitsResult) -> str:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
     defects = [p["defects"] for p in s["branch"] if "defects" in p]
-    if defects:  # carried entries (hysteretic torsion: z, solvers/floquet.py)
+    if defects:  # carried entries (hysteretic torsion: z, periodic_orbits/floquet.py)
         internal = [p["internal_multipliers"] for p in s["branch"]
                     if p.get("internal_multipliers", {}).get("count")]
         lines.append("  carried along by the shooting (hysteretic torsion's z): largest drift of "

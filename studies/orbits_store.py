@@ -91,8 +91,8 @@ class WindowStore:
         The points are read in order up to the first that fails its checks: it and
         the points after it (continued from it) are set aside and computed again;
         a .npz without its record (written before an interruption) is removed."""
-        from rawehelix.solvers.continuation import State
-        from rawehelix.solvers.floquet import Orbit
+        from rawehelix.periodic_orbits.continuation import State
+        from rawehelix.periodic_orbits.floquet import Orbit
         root = self.dir.parent
         legacy = self.dir / "state.npz"  # an older rawehelix's: its points have no seal either
         if legacy.exists():

@@ -8,7 +8,7 @@ from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.solvers.forced import FEBackend
-from rawehelix.solvers.floquet import PeriodMap
+from rawehelix.periodic_orbits.floquet import PeriodMap
 from rawehelix.solvers.orbits import AlphaMap
 from rawehelix.solvers.periodic import periodic_response
 
@@ -44,7 +44,7 @@ def test_broyden_updates_meet_the_secant_condition():
     """floquet.Broyden against the dense update it stands for: after each update
     H y = s (the secant condition), H is the inverse of B_k + (y - B_k s) s^T /
     (s^T s) ("good" Broyden) to 1e-10, and H^T solves with its transpose."""
-    from rawehelix.solvers.floquet import Broyden
+    from rawehelix.periodic_orbits.floquet import Broyden
 
     rng = np.random.default_rng(3)
     B = np.eye(6) + 0.3 * rng.standard_normal((6, 6))
@@ -484,7 +484,7 @@ def test_the_bisection_locates_a_synthetic_crossing(kind):
     (0.8 + 0.34 s) e^{+-1.2 i} (Neimark-Sacker) crosses the unit circle at
     s* = 1/1.7; a fold's multiplier 1.2 and a stable one 0.3 ride along
     (they do not count).  The bisection brackets s* to the f1 width 1e-4 Hz."""
-    from rawehelix.solvers.bifurcations import _unstable, bisect_crossing
+    from rawehelix.periodic_orbits.bifurcations import _unstable, bisect_crossing
 
     def path(s):
         if kind == "period_doubling":
@@ -512,7 +512,7 @@ def test_fold_location_is_the_hermite_extremum():
     error estimate is the distance to the linear interpolant, 0.06 Hz."""
     from types import SimpleNamespace
 
-    from rawehelix.solvers.bifurcations import fold_between
+    from rawehelix.periodic_orbits.bifurcations import fold_between
     from rawehelix.studies.orbits import tension_max
 
     f = lambda s: 12.7 - (s - 0.3) ** 2  # noqa: E731
@@ -649,8 +649,8 @@ def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     and reports nothing, and so does a site whose linearised state's tension is
     not the orbits' (their mean T(0) ~ 75 N here; the site's 50 N: a prediction
     that holds nowhere on the branch, as on a resonance's S-curve)."""
-    from rawehelix.solvers import resonances
-    from rawehelix.solvers.resonances import Site, sites_for
+    from rawehelix.periodic_orbits import resonances
+    from rawehelix.periodic_orbits.resonances import Site, sites_for
     from rawehelix.studies.orbits import branch as orbits_branch
 
     m = _LinearMap("superharmonic")
@@ -708,7 +708,7 @@ def test_the_branch_crosses_the_quasi_static_band_in_natural_steps(alpha_map):
     (its own steps per period), and the orbit at the end equals the shooting's
     from the stationary state there.  The last natural step lands on the
     window's end, 1 Hz, instead of past it."""
-    from rawehelix.solvers import bifurcations, continuation
+    from rawehelix.periodic_orbits import bifurcations, continuation
     from rawehelix.studies.orbits import branch as orbits_branch
 
     m = alpha_map

@@ -74,13 +74,13 @@ def test_the_orbits_command_takes_the_scenes_scheme(scheme, kind):
 @pytest.mark.parametrize("scheme", ["spline", "fe"])
 def test_each_scheme_is_a_periodic_orbit_problem(scheme, spline_map, orbit):
     """The shooting of each scheme through the periodic-orbit interface
-    (solvers/orbit_problem.py; the spline at N = 2, the FE at N = 4, p = 3): at
+    (periodic_orbits/problem.py; the spline at N = 2, the FE at N = 4, p = 3): at
     the 10 Hz orbit G is within the shooting's tolerance; the orbit at 10.05 Hz,
     solved by the problem's own Newton, moves X as the interface's two Jacobians
     predict (dX/df1 = -G_X^-1 G_f1, to the step's second order: 2e-2 of the
     change); the multipliers and the samples of one period from X are the
     orbit's (the same periods: to round-off)."""
-    from rawehelix.solvers.orbit_problem import PeriodicOrbitProblem
+    from rawehelix.periodic_orbits.problem import PeriodicOrbitProblem
     from rawehelix.solvers.orbits import AlphaMap
 
     m = spline_map

@@ -1,14 +1,14 @@
 """Pseudo-arclength continuation of periodic orbits in f1, through folds.
 
 The orbits are those of a periodic-orbit problem
-(:class:`~rawehelix.solvers.orbit_problem.PeriodicOrbitProblem`: shooting with
+(:class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`: shooting with
 the FE or the spline scheme), which gives the residual G(X, f1), its Jacobians
 G_X and G_f1, its own Newton at fixed f1 and the finished orbit with its Floquet
 multipliers; nothing here knows the rod.  The caller's step guards
 (:class:`StepGuard`; studies/orbits.py gives its observable's relative step
-and the resonance sites of solvers/resonances.py) refuse points, cap steps and
+and the resonance sites of periodic_orbits/resonances.py) refuse points, cap steps and
 report their events in ``peaks``; folds and bifurcations are located by
-solvers/bifurcations.py and report the caller's observable.
+periodic_orbits/bifurcations.py and report the caller's observable.
 
 Unknowns Y = (X, f1) (a problem with a family of orbits at each f1 is
 refused by the problem itself, :meth:`PeriodicOrbitProblem.continuable`).  From an orbit Y_k with unit tangent tau_k (||tau||
@@ -46,10 +46,10 @@ import time
 import numpy as np
 
 from rawehelix.errors import SolverError
-from rawehelix.solvers import bifurcations
-from rawehelix.solvers.bifurcations import far_from_folds
-from rawehelix.solvers.floquet import SLOW_RATE, Broyden
-from rawehelix.solvers.orbit_problem import Observable, Orbit, PeriodicOrbitProblem
+from rawehelix.periodic_orbits import bifurcations
+from rawehelix.periodic_orbits.bifurcations import far_from_folds
+from rawehelix.periodic_orbits.floquet import SLOW_RATE, Broyden
+from rawehelix.periodic_orbits.problem import Observable, Orbit, PeriodicOrbitProblem
 
 log = logging.getLogger(__name__)
 

@@ -1,5 +1,5 @@
 """Folds and bifurcations of periodic orbits between two points of a branch
-(:class:`~rawehelix.solvers.continuation.Branch`).
+(:class:`~rawehelix.periodic_orbits.continuation.Branch`).
 
 Folds (limit points of cycles) are where df1/ds changes sign; their arclength
 by the secant on tau_f1, their f1 there by the cubic Hermite interpolant of
@@ -11,7 +11,7 @@ kind outside the unit circle changes, and located by bisection in arclength
 between the two points (:func:`bisect_crossing`): each probe is a corrector
 from the earlier point with a shorter step and a Floquet period.
 
-An event reports the caller's observable (:class:`~rawehelix.solvers.orbit_problem.Observable`)
+An event reports the caller's observable (:class:`~rawehelix.periodic_orbits.problem.Observable`)
 under its name, interpolated to the event (a fold) or at the probe past it.
 """
 
@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from rawehelix.errors import SolverError
-from rawehelix.solvers.orbit_problem import Observable, Orbit
+from rawehelix.periodic_orbits.problem import Observable, Orbit
 
 BISECTION_HZ = 1e-4  # PD / NS located to this width in f1 [Hz]
 BISECTION_MAX = 12  # probes per bisection

@@ -1,5 +1,5 @@
 """Resonance tracking along a branch of periodic orbits: the step guards that the
-caller (studies/orbits.py) gives :class:`~rawehelix.solvers.continuation.Branch`,
+caller (studies/orbits.py) gives :class:`~rawehelix.periodic_orbits.continuation.Branch`,
 and the peaks and superharmonic resonances they report.
 
 :class:`Peaks`: the step adapts so that the observable (T max) changes by at
@@ -45,8 +45,8 @@ import dataclasses
 import numpy as np
 
 from rawehelix.errors import SolverError
-from rawehelix.solvers.continuation import StepGuard
-from rawehelix.solvers.orbit_problem import Observable, Orbit
+from rawehelix.periodic_orbits.continuation import StepGuard
+from rawehelix.periodic_orbits.problem import Observable, Orbit
 
 TENSION_STEP = 0.05  # the largest relative change of T max between two branch points
 PEAK_PROBES = 8  # correctors per peak refinement

@@ -1,6 +1,6 @@
 """Periodic orbits by shooting, scheme-independent: the shooting Newton, the
 twist's rotation per period and the Floquet multipliers of an orbit.  Shooting
-is one :class:`~rawehelix.solvers.orbit_problem.PeriodicOrbitProblem`
+is one :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`
 (:class:`PeriodMap`), which the continuation traces.
 
 A scheme supplies the period map (:meth:`PeriodMap.period`: the state after
@@ -48,7 +48,7 @@ import numpy as np
 import scipy.linalg
 
 from rawehelix.errors import SolverError
-from rawehelix.solvers.orbit_problem import Orbit, PeriodicOrbitProblem  # noqa: F401  (Orbit re-exported)
+from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem  # noqa: F401  (Orbit re-exported)
 
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
 #: a Newton iteration on a held monodromy (a chord) that leaves more than this fraction of
@@ -93,12 +93,12 @@ class Broyden:
 
 class PeriodMap(PeriodicOrbitProblem):
     """Shooting on a scheme's period map (see the module's docstring): the
-    :class:`~rawehelix.solvers.orbit_problem.PeriodicOrbitProblem` whose unknowns
+    :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem` whose unknowns
     are the state at the start of the period and whose resolution is the steps
     per period.  ``carried``: entries of X the Newton does not solve for (module
     docstring, "Carried entries")."""
 
-    # -- the periodic-orbit problem (orbit_problem.py) ---------------------------
+    # -- the periodic-orbit problem (periodic_orbits/problem.py) ---------------------------
     def continuable(self):
         if not self.controller:
             raise SolverError("continuation: a scene without the controller's integral action "

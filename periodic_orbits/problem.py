@@ -6,11 +6,11 @@ the same ``continuation``).
 
 An orbit at the forcing frequency f1 is a zero of a residual G(X, f1) in the
 problem's unknowns X; the pseudo-arclength continuation
-(:mod:`rawehelix.solvers.continuation`) asks a :class:`PeriodicOrbitProblem` for
+(:mod:`rawehelix.periodic_orbits.continuation`) asks a :class:`PeriodicOrbitProblem` for
 G, its Jacobians in X and in f1, the problem's Newton at fixed f1 and the orbit
 with its Floquet multipliers, and nothing else.  The implementations:
 
-- shooting, :class:`rawehelix.solvers.floquet.PeriodMap`: X the state at the
+- shooting, :class:`rawehelix.periodic_orbits.floquet.PeriodMap`: X the state at the
   start of the period, G = P(X) - X - Delta e_alpha with P a scheme's period
   map; the FE generalised-alpha map (:class:`rawehelix.solvers.orbits.AlphaMap`)
   and the paper's spline-Galerkin flow
