@@ -39,8 +39,7 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms.extensible import unit_tangent
-from rawehelix.forms.kinematics import d
+from rawehelix.forms.kinematics import d, unit_tangent
 
 
 def normal_part(f, axis):

@@ -57,32 +57,15 @@ from __future__ import annotations
 import ufl
 
 from rawehelix.forms import extensible
-from rawehelix.forms.kinematics import d, stretch, twist
-from rawehelix.forms.rod import Coefficients, ip_penalty, jump_d
-
-
-def tangent_rate(r, r_t):
-    """t_t = (I - t t) r_t' / |r'|, the rate of t = r'/|r'|."""
-    t = extensible.unit_tangent(r)
-    return (d(r_t) - ufl.dot(t, d(r_t)) * t) / stretch(r)
-
-
-def frenet_torsion_rate(r, r_t, eps):
-    """d gamma/dt along r_t of the regularised Frenet torsion of Eq. (34),
-    gamma = r'.(r'' x r''')/(|r''|^2 + eps^2) (forms/kinematics.py::frenet_torsion)."""
-    r1, r2, r3 = d(r), d(r, 2), d(r, 3)
-    u1, u2, u3 = d(r_t), d(r_t, 2), d(r_t, 3)
-    num = ufl.dot(r1, ufl.cross(r2, r3))
-    num_t = (ufl.dot(u1, ufl.cross(r2, r3)) + ufl.dot(r1, ufl.cross(u2, r3))
-             + ufl.dot(r1, ufl.cross(r2, u3)))
-    den = ufl.dot(r2, r2) + eps**2
-    return num_t / den - num * 2 * ufl.dot(r2, u2) / den**2
+from rawehelix.forms.coefficients import Coefficients
+from rawehelix.forms.interior_penalty import ip_penalty, jump_d
+from rawehelix.forms.kinematics import d, frenet_torsion_rate, tangent_rate, unit_tangent
 
 
 def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
     """(eps_t, tau_t, b, [[j]]_t) of the module docstring at the state r, each linear
     in (r_t, alpha_t); ``alpha_t`` None (the planar model): tau_t None."""
-    t, t_t = extensible.unit_tangent(r), tangent_rate(r, r_t)
+    t, t_t = unit_tangent(r), tangent_rate(r, r_t)
     w = ufl.cross(t, t_t)  # the tangent's spin
 
     def jump(f):  # [[f]] at a node

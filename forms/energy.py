@@ -37,7 +37,9 @@ import ufl
 
 from rawehelix.forms.kinematics import d, internal_force, stretch, tension, twist
 from rawehelix.forms import extensible, mixed
-from rawehelix.forms.rod import K_E, Coefficients, bending, ip_penalty
+from rawehelix.forms.coefficients import Coefficients
+from rawehelix.forms.interior_penalty import bending, ip_penalty
+from rawehelix.forms.rod import K_E
 
 
 def kinetic(r_t, alpha_t, c: Coefficients, dx):

@@ -90,12 +90,7 @@ from ufl.algorithms.apply_derivatives import apply_derivatives
 from ufl.algorithms.map_integrands import map_integrands
 from ufl.algorithms.transformer import strip_variables
 
-from rawehelix.forms.kinematics import d, stretch
-
-
-def unit_tangent(r):
-    """t = r'/|r'|."""
-    return d(r) / stretch(r)
+from rawehelix.forms.kinematics import d, stretch, unit_tangent  # noqa: F401 (extensible.unit_tangent)
 
 
 def strain(r):

@@ -33,79 +33,15 @@ and return UFL.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
-
 import ufl
 
-from rawehelix.forms import extensible, mixed
-from rawehelix.forms.kinematics import d, internal_force, tension, twist
+from rawehelix.forms import damping, extensible, hysteresis, mixed
+from rawehelix.forms.coefficients import Coefficients
+from rawehelix.forms.interior_penalty import avg_d2, bending, ip_penalty, jump_d  # noqa: F401
+from rawehelix.forms.kinematics import d, frenet_torsion_rate, internal_force, tension, twist
 
 K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
 I_E = ufl.as_vector((1.0, 0.0, 0.0))  # i_E: the wind blows along -i_E
-
-
-@dataclass
-class Coefficients:
-    """The normalised groups of Eqs. (26)-(27) as UFL-ready values.
-
-    Each field is a number or a constant (for instance ``dolfinx.fem.Constant``)
-    so that a solver can change it (torques in time) without recompiling.
-    """
-
-    sigma: Any
-    mu: Any
-    beta: Any
-    nu: Any
-    delta: Any
-    v_w0: Any
-    m0: Any = 0.0  # torque at s = 0, Eq. (38)
-    mN: Any = 0.0  # torque at s = 1, Eq. (39)
-    gravity: Any = 1.0  # 1 switches gravity on, 0 off
-    drag: Any = 1.0
-    bending: Any = 1.0
-    gamma_eps: Any = 1.0e-3
-    gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
-    kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
-    # structural damping (forms/damping.py): retardation times / t_scale; ``damped``
-    # False leaves the viscous terms out of the forms altogether
-    tau_a: Any = 0.0
-    tau_b: Any = 0.0
-    tau_t: Any = 0.0
-    damped: bool = False
-    # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
-    # mu_a sigma eps + mu_b; ``bending_law`` False: mu
-    mu_a: Any = 0.0
-    mu_b: Any = 0.0
-    bending_law: bool = False
-    # hysteretic torsion (forms/hysteresis.py): Bouc-Wen rho, A, beta, gamma
-    # (normalised) and the exponent n (a number: it chooses the form's shape);
-    # ``hysteretic`` False: no z field, the elastic moment
-    bw_rho: Any = 1.0
-    bw_A: Any = 1.0
-    bw_beta: Any = 0.0
-    bw_gamma: Any = 0.0
-    bw_n: float = 1.0
-    hysteretic: bool = False
-
-    @classmethod
-    def from_normalised(cls, q, model, make=float):
-        """From :class:`rawehelix.parameters.Normalised` and a scene's
-        ``model``; ``make`` wraps each number (e.g. into a dolfinx Constant)."""
-        return cls(
-            sigma=make(q.sigma), mu=make(q.mu), beta=make(q.beta), nu=make(q.nu),
-            delta=make(q.delta), v_w0=make(q.v_w0), m0=make(0.0), mN=make(0.0),
-            gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
-            gamma_eps=make(model.gamma_eps),
-            gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
-            kinematics=model.kinematics,
-            tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
-            damped=q.damped,
-            mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
-            bending_law=q.bending_law,
-            bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),
-            bw_gamma=make(q.bw_gamma), bw_n=q.bw_n, hysteretic=q.hysteretic,
-        )
 
 
 def quadrature_degree(degree: int, chosen: int = 0) -> int | None:
@@ -135,37 +71,6 @@ def measures(mesh, degree: int, chosen: int = 0):
     return (ufl.dx(domain=mesh, metadata=metadata), ufl.dS(domain=mesh), ufl.ds(domain=mesh))
 
 
-def jump_d(f, n):
-    """[[f']] = f'(+) n(+) + f'(-) n(-): the jump of the normal derivative at a node."""
-    return d(f)("+") * n("+")[0] + d(f)("-") * n("-")[0]
-
-
-def avg_d2(f):
-    """{{f''}}: the average of the second derivative at a node."""
-    return 0.5 * (d(f, 2)("+") + d(f, 2)("-"))
-
-
-def ip_penalty(degree: int, penalty, dS):
-    """The interior-penalty factor eta p^2 / h_avg at a node; eta is
-    ``discretisation.penalty``."""
-    h = ufl.CellDiameter(dS.ufl_domain())
-    return penalty * degree**2 / (0.5 * (h("+") + h("-")))
-
-
-def bending(r, v, degree: int, penalty, dx, dS):
-    """C0 interior-penalty form of int r''.v'' (the dolfinx biharmonic demo, in 1D).
-
-    The penalty eta p^2 / h_avg (:func:`ip_penalty`) scales with the degree
-    and the element size.
-    """
-    n = ufl.FacetNormal(dS.ufl_domain())
-    alpha_ip = ip_penalty(degree, penalty, dS)
-    return (ufl.inner(d(r, 2), d(v, 2)) * dx
-            - ufl.inner(avg_d2(r), jump_d(v, n)) * dS
-            - ufl.inner(jump_d(r, n), avg_d2(v)) * dS
-            + alpha_ip * ufl.inner(jump_d(r, n), jump_d(v, n)) * dS)
-
-
 def aerodynamic_force(r_t, c: Coefficients):
     """F~_A = -nu |v_A| v_A with v_A = r_t + v_w0 i_E, Eqs. (14) and (28).
 
@@ -193,7 +98,6 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
     if z is not None:  # the moment / GJ, hysteretic (Fig. 5)
-        from rawehelix.forms import hysteresis
         tau = hysteresis.moment(tau, z, c)
     if c.kinematics == "extensible":  # stretch and bending from the stored energy
         F = extensible.centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
@@ -256,15 +160,13 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
                           z=z)
          - ufl.inner(body_force(r_t, c), v) * dx)
     if z is not None:  # the Bouc-Wen equation of z (forms/hysteresis.py)
-        from rawehelix.forms import damping, hysteresis  # (both build on this module)
         if z_t is None or not moving:
             F += hysteresis.virgin_residual(z, third[0], dx)
         else:  # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate
-            tau_t = (c.gamma_coupling * damping.frenet_torsion_rate(r, r_t, c.gamma_eps)
+            tau_t = (c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps)
                      + d(alpha_t))
             F += hysteresis.evolution_residual(z, z_t, tau_t, third[0], dx, c)
     if c.damped and moving:  # Kelvin-Voigt, from the dissipation potential
-        from rawehelix.forms import damping  # (damping builds on this module)
         F += damping.viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx

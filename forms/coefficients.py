@@ -1,0 +1,69 @@
+"""The normalised groups of Eqs. (26)-(27) as the forms read them (:class:`Coefficients`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass
+class Coefficients:
+    """The normalised groups of Eqs. (26)-(27) as UFL-ready values.
+
+    Each field is a number or a constant (for instance ``dolfinx.fem.Constant``)
+    so that a solver can change it (torques in time) without recompiling.
+    """
+
+    sigma: Any
+    mu: Any
+    beta: Any
+    nu: Any
+    delta: Any
+    v_w0: Any
+    m0: Any = 0.0  # torque at s = 0, Eq. (38)
+    mN: Any = 0.0  # torque at s = 1, Eq. (39)
+    gravity: Any = 1.0  # 1 switches gravity on, 0 off
+    drag: Any = 1.0
+    bending: Any = 1.0
+    gamma_eps: Any = 1.0e-3
+    gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
+    kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
+    # structural damping (forms/damping.py): retardation times / t_scale; ``damped``
+    # False leaves the viscous terms out of the forms altogether
+    tau_a: Any = 0.0
+    tau_b: Any = 0.0
+    tau_t: Any = 0.0
+    damped: bool = False
+    # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
+    # mu_a sigma eps + mu_b; ``bending_law`` False: mu
+    mu_a: Any = 0.0
+    mu_b: Any = 0.0
+    bending_law: bool = False
+    # hysteretic torsion (forms/hysteresis.py): Bouc-Wen rho, A, beta, gamma
+    # (normalised) and the exponent n (a number: it chooses the form's shape);
+    # ``hysteretic`` False: no z field, the elastic moment
+    bw_rho: Any = 1.0
+    bw_A: Any = 1.0
+    bw_beta: Any = 0.0
+    bw_gamma: Any = 0.0
+    bw_n: float = 1.0
+    hysteretic: bool = False
+
+    @classmethod
+    def from_normalised(cls, q, model, make=float):
+        """From :class:`rawehelix.parameters.Normalised` and a scene's
+        ``model``; ``make`` wraps each number (e.g. into a dolfinx Constant)."""
+        return cls(
+            sigma=make(q.sigma), mu=make(q.mu), beta=make(q.beta), nu=make(q.nu),
+            delta=make(q.delta), v_w0=make(q.v_w0), m0=make(0.0), mN=make(0.0),
+            gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
+            gamma_eps=make(model.gamma_eps),
+            gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
+            kinematics=model.kinematics,
+            tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
+            damped=q.damped,
+            mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
+            bending_law=q.bending_law,
+            bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),
+            bw_gamma=make(q.bw_gamma), bw_n=q.bw_n, hysteretic=q.hysteretic,
+        )
