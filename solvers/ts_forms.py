@@ -48,9 +48,8 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.errors import SceneError
 from rawehelix.solvers.fields import set_constant
-from rawehelix.forms import damping, energy, rod
+from rawehelix.forms import rod
 from rawehelix.solvers.discrete import RodDiscretisation
 
 
@@ -62,6 +61,20 @@ class Fields:
     def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
         self.kappa, self.z = kappa, z
+
+    @classmethod
+    def of(cls, model, u, v):
+        """The views of the state ``u`` and its rate ``v`` on ``model``'s space
+        (models/base.py): the roles' fields under the paper's names."""
+        f, f_t = model.split(u), model.split(v)
+        return cls(f["centre_line"], f["twist"], f_t["centre_line"], f_t["twist"],
+                   f["curvature"], f["internal_twist"])
+
+    def roles(self) -> tuple[dict, dict]:
+        """(fields, rates) by role, as the model's forms take them."""
+        return ({"centre_line": self.r, "twist": self.alpha, "curvature": self.kappa,
+                 "internal_twist": self.z},
+                {"centre_line": self.r_t, "twist": self.alpha_t})
 
 
 def controller_torque(c: rod.Coefficients, q, fields: Fields, time, offset):
@@ -99,18 +112,16 @@ class _Formulation:
         self.F = dolfinx.fem.form(F)
         self.J = dolfinx.fem.form(J)
         self.fields = fields
-        dx = self.rod.measures[0]
-        self.kinetic = dolfinx.fem.form(energy.kinetic(fields.r_t, fields.alpha_t, self.rod.c, dx))
-        self.potential = dolfinx.fem.form(energy.potential(
-            fields.r, fields.alpha, self.rod.c, self.rod.degree, self.rod.penalty,
-            self.rod.measures, kappa=fields.kappa))
-        self.power_nv = dolfinx.fem.form(energy.non_variational_power(
-            fields.r, fields.alpha, fields.r_t, self.rod.c, dx, kappa=fields.kappa))
+        rod_, model = self.rod, self.rod.model
+        dx = rod_.measures[0]
+        f, f_t = fields.roles()
+        self.kinetic = dolfinx.fem.form(model.kinetic_energy(f_t, rod_.c, dx))
+        self.potential = dolfinx.fem.form(model.stored_energy(
+            f, rod_.c, rod_.degree, rod_.penalty, rod_.measures))
+        self.power_nv = dolfinx.fem.form(model.non_variational_power(f, f_t, rod_.c, dx))
         # 2 D, the power of the structural damping (forms/damping.py); None: undamped
-        self.dissipation = None if not self.rod.c.damped else dolfinx.fem.form(
-            2 * damping.dissipation(fields.r, fields.r_t, fields.alpha_t,
-                                    self.rod.c, self.rod.degree, self.rod.penalty,
-                                    self.rod.measures))
+        D = model.dissipation(f, f_t, rod_.c, rod_.degree, rod_.penalty, rod_.measures)
+        self.dissipation = None if D is None else dolfinx.fem.form(2 * D)
         self.b = compat.create_vector(self.F)
         self._scratch = self.b.duplicate()
         owned = self.b.getLocalSize()
@@ -195,13 +206,10 @@ class SecondOrder(_Formulation):
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.shift_v = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
         self.shift_a = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
-        r, alpha, *third = ufl.split(self.u)  # kappa (mixed bending) or z (hysteresis)
-        r_t, alpha_t = ufl.split(self.v)[:2]
-        fields = Fields(r, alpha, r_t, alpha_t, third[0] if rod_.mixed else None,
-                        third[0] if rod_.hysteretic else None)
+        fields = Fields.of(rod_.model, self.u, self.v)
         c_dyn = self._coefficients(fields)
-        F = rod.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree, rod_.penalty,
-                         rod_.measures)
+        F = rod_.model.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree,
+                                rod_.penalty, rod_.measures)
         J = (ufl.derivative(F, self.u, rod_.trial)
              + self.shift_v * ufl.derivative(F, self.v, rod_.trial)
              + self.shift_a * ufl.derivative(F, self.a, rod_.trial))
@@ -253,18 +261,7 @@ class FirstOrder(_Formulation):
     second_order = False
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
-        if rod_.hysteretic:
-            raise SceneError(
-                rod_.params.name, "torsion_hysteresis",
-                "runs with the second-order integrator only (-rawehelix_ts_type alpha2, the "
-                "default): the first-order TS types are not set up for its internal twist z "
-                "(forms/hysteresis.py)")
-        if rod_.mixed:
-            raise SceneError(
-                rod_.params.name, "discretisation.bending",
-                "'mixed' runs with the second-order integrator "
-                "only (-rawehelix_ts_type alpha2, the default): the first-order TS types "
-                "are not set up for its algebraic curvature field")
+        rod_.model.refuse("first_order", rod_.params.name)  # models/unshearable.py
         mesh = rod_.mesh
         self.W2 = compat.function_space(mesh, compat.rod_pair_element(mesh.ufl_cell(), rod_.degree))
         self.x = dolfinx.fem.Function(self.W2, name="state")

@@ -1,0 +1,113 @@
+"""The paper's unshearable rod (r, alpha), Eqs. (30)-(39), as a :class:`~rawehelix.models.base.RodModel`.
+
+Fields, in the order of the mixed space (compat.rod_element):
+
+* ``centre_line`` r (vector P_p) and ``twist`` alpha (scalar P_p), always;
+* ``curvature`` kappa (vector P_p), with ``discretisation.bending = "mixed"``
+  (forms/mixed.py, kappa = 0 at both ends, Eq. 37);
+* ``internal_twist`` z (scalar DG_(p-1)), with ``[torsion_hysteresis]``
+  (forms/hysteresis.py; no end condition).
+
+Its forms are those of forms/rod.py and forms/energy.py: the elastic part is
+the variation of the stored energy where the code takes it so (the extensible
+kinematics, forms/extensible.py: ufl derivative of U; Kelvin-Voigt damping,
+forms/damping.py: the derivative of D); the paper's kinematics keep their
+hand-written F_NL (Eq. 32), whose -mu kappa^2 r' and twist coupling
+beta tau (r' x r'') are the model's non-variational terms, with drag (Eq. 28)
+and the end torques (Eqs. 38-39).
+"""
+
+from __future__ import annotations
+
+from rawehelix import compat
+from rawehelix.forms import damping, energy, kinematics, rod
+from rawehelix.models.base import EndCondition, Refusal, RodModel
+from rawehelix.parameters import Parameters
+
+#: the first-order TS types are set up for (r, alpha) and its rates only
+MIXED_FIRST_ORDER = Refusal(
+    "discretisation.bending",
+    "'mixed' runs with the second-order integrator "
+    "only (-rawehelix_ts_type alpha2, the default): the first-order TS types "
+    "are not set up for its algebraic curvature field")
+HYSTERESIS_FIRST_ORDER = Refusal(
+    "torsion_hysteresis",
+    "runs with the second-order integrator only (-rawehelix_ts_type alpha2, the "
+    "default): the first-order TS types are not set up for its internal twist z "
+    "(forms/hysteresis.py)")
+HYSTERESIS_MODAL = Refusal(
+    "torsion_hysteresis",
+    "the modal solver does not linearise the hysteretic torsion "
+    "(forms/hysteresis.py); it runs in time only ('simulate')")
+
+
+class UnshearableRod(RodModel):
+    """The (r, alpha) rod of a scene, with the fields its switches add."""
+
+    def __init__(self, params: Parameters):
+        self.params = params
+        self.mixed = params.discretisation.bending == "mixed"  # kappa, forms/mixed.py
+        self.hysteretic = params.model.torsion_hysteresis.active  # z, forms/hysteresis.py
+        self.twist_field = params.model.twist  # false: alpha held at 0
+        self.fields = (("centre_line", "twist") + ("curvature",) * self.mixed
+                       + ("internal_twist",) * self.hysteretic)
+
+    def element(self, cell, degree: int):
+        return compat.rod_element(cell, degree, curvature=self.mixed, internal=self.hysteretic)
+
+    # -- forms ---------------------------------------------------------------------
+    def residual(self, w, w_t, w_tt, test, c, degree: int, penalty, measures):
+        """Eqs. (30)-(31) and the components' equations (forms/rod.py::residual)."""
+        return rod.residual(w, w_t, w_tt, test, c, degree, penalty, measures)
+
+    def stored_energy(self, fields: dict, c, degree: int, penalty, measures):
+        """U = elastic + gravity (forms/energy.py::potential)."""
+        return energy.potential(fields["centre_line"], fields["twist"], c, degree, penalty,
+                                measures, kappa=fields["curvature"])
+
+    def kinetic_energy(self, rates: dict, c, dx):
+        return energy.kinetic(rates["centre_line"], rates["twist"], c, dx)
+
+    def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):
+        if not c.damped:
+            return None
+        return damping.dissipation(fields["centre_line"], rates["centre_line"], rates["twist"],
+                                   c, degree, penalty, measures)
+
+    def non_variational_power(self, fields: dict, rates: dict, c, dx):
+        return energy.non_variational_power(fields["centre_line"], fields["twist"],
+                                            rates["centre_line"], c, dx,
+                                            kappa=fields["curvature"])
+
+    # -- observables ---------------------------------------------------------------
+    def tension(self, fields: dict, c):
+        """T = sigma (|r'| - 1), Eq. (29)."""
+        return kinematics.tension(fields["centre_line"], c.sigma)
+
+    def twist(self, fields: dict, c):
+        """tau = gamma + alpha', Eq. (34)."""
+        return kinematics.twist(fields["centre_line"], fields["twist"], c.gamma_eps,
+                                c.gamma_coupling, k=fields["curvature"])
+
+    # -- end conditions, Eqs. (35)-(37) ---------------------------------------------
+    def end_conditions(self, pin_twist: bool) -> list[EndCondition]:
+        """r(0) = 0 (35), r(1) = r_N (36); alpha(0) = 0 if ``pin_twist`` (the rigid
+        rotation of torque-free ends); alpha = 0 everywhere with model.twist = false;
+        kappa = 0 at both ends (37) with the mixed form."""
+        bcs = [EndCondition("centre_line", "bottom"), EndCondition("centre_line", "top", "top_position")]
+        if pin_twist:
+            bcs.append(EndCondition("twist", "bottom"))
+        if not self.twist_field:
+            bcs.append(EndCondition("twist", "all"))
+        if self.mixed:
+            bcs.append(EndCondition("curvature", "ends"))
+        return bcs
+
+    # -- capabilities -----------------------------------------------------------------
+    def refusals(self, solver: str) -> list[Refusal]:
+        out = []
+        if solver == "first_order":
+            out += [HYSTERESIS_FIRST_ORDER] * self.hysteretic + [MIXED_FIRST_ORDER] * self.mixed
+        if solver == "modal":
+            out += [HYSTERESIS_MODAL] * self.hysteretic
+        return out
