@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
+
+from rawehelix.forms.damping import KelvinVoigt, NoneDamping
 
 
 @dataclass
@@ -28,12 +30,9 @@ class Coefficients:
     gamma_eps: Any = 1.0e-3
     gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
     kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
-    # structural damping (forms/damping.py): retardation times / t_scale; ``damped``
-    # False leaves the viscous terms out of the forms altogether
-    tau_a: Any = 0.0
-    tau_b: Any = 0.0
-    tau_t: Any = 0.0
-    damped: bool = False
+    # structural damping, a component (forms/damping.py): KelvinVoigt, or the null
+    # object NoneDamping that leaves the viscous terms out of the forms altogether
+    damping: Any = field(default_factory=NoneDamping)
     # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
     # mu_a sigma eps + mu_b; ``bending_law`` False: mu
     mu_a: Any = 0.0
@@ -60,8 +59,7 @@ class Coefficients:
             gamma_eps=make(model.gamma_eps),
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
             kinematics=model.kinematics,
-            tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
-            damped=q.damped,
+            damping=KelvinVoigt.from_normalised(q, make),
             mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
             bending_law=q.bending_law,
             bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),

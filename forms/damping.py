@@ -57,12 +57,11 @@ from __future__ import annotations
 import ufl
 
 from rawehelix.forms import extensible
-from rawehelix.forms.coefficients import Coefficients
 from rawehelix.forms.interior_penalty import ip_penalty, jump_d
 from rawehelix.forms.kinematics import d, frenet_torsion_rate, tangent_rate, unit_tangent
 
 
-def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
+def strain_rates(r, r_t, alpha_t, c, n):
     """(eps_t, tau_t, b, [[j]]_t) of the module docstring at the state r, each linear
     in (r_t, alpha_t); ``alpha_t`` None (the planar model): tau_t None."""
     t, t_t = unit_tangent(r), tangent_rate(r, r_t)
@@ -83,10 +82,11 @@ def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
     return eps_t, tau_t, b, jb
 
 
-def _bilinear(x, y, r, c: Coefficients, degree: int, penalty, measures):
+def _bilinear(x, y, r, c, degree: int, penalty, measures):
     """The symmetric form B(x, y) of D = 1/2 B(x, x), x = :func:`strain_rates` at the
     state r (which sets the bending modulus under the EI law)."""
     dx, dS, _ = measures
+    kv = c.damping  # the retardation times of the KelvinVoigt component
     (ea, ta, ba, ja), (eb, tb, bb, jb) = x, y
     alpha_ip = ip_penalty(degree, penalty, dS)
     if c.bending_law:  # m_v = EI(T) tau_b b: the modulus at the nodes as in forms/extensible.py
@@ -97,25 +97,25 @@ def _bilinear(x, y, r, c: Coefficients, degree: int, penalty, measures):
         B_b = (mu * ufl.dot(ba, bb) * dx
                + (-ufl.dot(avg(mu * ba), jb) - ufl.dot(avg(mu * bb), ja)
                   + alpha_ip * avg(mu) * ufl.dot(ja, jb)) * dS)
-        B = c.sigma * c.tau_a * ea * eb * dx + c.tau_b * B_b
+        B = c.sigma * kv.tau_a * ea * eb * dx + kv.tau_b * B_b
     else:
         B_b = (ufl.dot(ba, bb) * dx
                + (-ufl.dot(0.5 * (ba("+") + ba("-")), jb) - ufl.dot(0.5 * (bb("+") + bb("-")), ja)
                   + alpha_ip * ufl.dot(ja, jb)) * dS)
-        B = c.sigma * c.tau_a * ea * eb * dx + c.bending * c.mu * c.tau_b * B_b
+        B = c.sigma * kv.tau_a * ea * eb * dx + c.bending * c.mu * kv.tau_b * B_b
     if ta is not None:
-        B += c.beta * c.tau_t * ta * tb * dx
+        B += c.beta * kv.tau_t * ta * tb * dx
     return B
 
 
-def dissipation(r, r_t, alpha_t, c: Coefficients, degree: int, penalty, measures):
+def dissipation(r, r_t, alpha_t, c, degree: int, penalty, measures):
     """D of the module docstring at the state r and the rates (r_t, alpha_t);
     ``alpha_t`` None (the planar model) drops the torsion term."""
     x = strain_rates(r, r_t, alpha_t, c, ufl.FacetNormal(measures[0].ufl_domain()))
     return 0.5 * _bilinear(x, x, r, c, degree, penalty, measures)
 
 
-def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, penalty, measures):
+def viscous_residual(r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures):
     """dD/d(r_t, alpha_t) in the direction (v, delta/beta psi): the viscous forces.
 
     The rates are linear in (r_t, alpha_t), so this derivative is B(x(r_t, alpha_t),
@@ -127,3 +127,35 @@ def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, pena
     x = strain_rates(r, r_t, None if planar else alpha_t, c, n)
     y = strain_rates(r, v, None if planar else c.delta / c.beta * psi, c, n)
     return _bilinear(x, y, r, c, degree, penalty, measures)
+
+
+class KelvinVoigt:
+    """The damping component (the scene's ``[damping]``, parameters/damping.py): its
+    retardation times / t_scale (numbers or constants) and its contributions, the
+    dissipation potential D and the viscous residual dD/dw_t."""
+
+    def __init__(self, tau_a, tau_b, tau_t):
+        self.tau_a, self.tau_b, self.tau_t = tau_a, tau_b, tau_t
+
+    @classmethod
+    def from_normalised(cls, q, make=float):
+        """From :class:`rawehelix.parameters.Normalised`; the null object when all are 0."""
+        if not q.damped:
+            return NoneDamping()
+        return cls(make(q.tau_axial), make(q.tau_bending), make(q.tau_torsion))
+
+    def dissipation(self, r, r_t, alpha_t, c, degree: int, penalty, measures):
+        return dissipation(r, r_t, alpha_t, c, degree, penalty, measures)
+
+    def residual(self, r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures):
+        return viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
+
+
+class NoneDamping:
+    """No structural damping (the paper's model): no dissipation, no viscous force."""
+
+    def dissipation(self, r, r_t, alpha_t, c, degree: int, penalty, measures):
+        return None
+
+    def residual(self, r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures):
+        return 0

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms import damping, extensible, hysteresis, mixed
+from rawehelix.forms import extensible, hysteresis, mixed
 from rawehelix.forms.coefficients import Coefficients
 from rawehelix.forms.interior_penalty import avg_d2, bending, ip_penalty, jump_d  # noqa: F401
 from rawehelix.forms.kinematics import d, frenet_torsion_rate, internal_force, tension, twist
@@ -147,7 +147,7 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
     dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
     the curvature field of the mixed bending form, with the test
     ``tests[2]``.  ``alpha_t``: the twist rate, read by the structural damping
-    (``c.damped``, forms/damping.py) and the hysteresis only.  ``z``, ``z_t``:
+    (``c.damping``, forms/damping.py) and the hysteresis only.  ``z``, ``z_t``:
     the Bouc-Wen twist and its rate, with the test ``tests[2]``
     (forms/hysteresis.py); ``z_t`` None (a stationary residual) holds z = 0."""
     dx, dS, ds = measures
@@ -166,8 +166,8 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
             tau_t = (c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps)
                      + d(alpha_t))
             F += hysteresis.evolution_residual(z, z_t, tau_t, third[0], dx, c)
-    if c.damped and moving:  # Kelvin-Voigt, from the dissipation potential
-        F += damping.viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
+    if moving:  # the damping component: Kelvin-Voigt from its dissipation potential, or none
+        F += c.damping.residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
     return F

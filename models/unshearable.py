@@ -19,8 +19,11 @@ and the end torques (Eqs. 38-39).
 
 from __future__ import annotations
 
+import dataclasses
+
 from rawehelix import compat
-from rawehelix.forms import damping, energy, kinematics, rod
+from rawehelix.forms import energy, kinematics, rod
+from rawehelix.forms.damping import NoneDamping
 from rawehelix.models.base import EndCondition, Refusal, RodModel
 from rawehelix.parameters import Parameters
 
@@ -60,6 +63,10 @@ class UnshearableRod(RodModel):
         """Eqs. (30)-(31) and the components' equations (forms/rod.py::residual)."""
         return rod.residual(w, w_t, w_tt, test, c, degree, penalty, measures)
 
+    def conservative(self, c):
+        """``c`` without the dissipative components: the residual of the stiffness."""
+        return dataclasses.replace(c, damping=NoneDamping())
+
     def stored_energy(self, fields: dict, c, degree: int, penalty, measures):
         """U = elastic + gravity (forms/energy.py::potential)."""
         return energy.potential(fields["centre_line"], fields["twist"], c, degree, penalty,
@@ -69,10 +76,8 @@ class UnshearableRod(RodModel):
         return energy.kinetic(rates["centre_line"], rates["twist"], c, dx)
 
     def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):
-        if not c.damped:
-            return None
-        return damping.dissipation(fields["centre_line"], rates["centre_line"], rates["twist"],
-                                   c, degree, penalty, measures)
+        return c.damping.dissipation(fields["centre_line"], rates["centre_line"], rates["twist"],
+                                     c, degree, penalty, measures)
 
     def non_variational_power(self, fields: dict, rates: dict, c, dx):
         return energy.non_variational_power(fields["centre_line"], fields["twist"],

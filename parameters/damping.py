@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rawehelix.parameters.checks import _non_negative
+from rawehelix.parameters.checks import ParameterError, _non_negative
 
 
 @dataclass(frozen=True)
@@ -27,3 +27,28 @@ class Damping:
     def describe(self) -> str:
         return (f"damping: Kelvin-Voigt tau_a = {self.axial_s:g} s, tau_b = {self.bending_s:g} s, "
                 f"tau_t = {self.torsion_s:g} s")
+
+
+#: its normalised groups (parameters/scene.py::GROUP_KEYS): retardation time / t_scale, Eq. 25
+_T = ("helix.length_m", "environment.g_m_s2")  # t_scale = sqrt(L0/g)
+GROUP_KEYS = {
+    "tau_axial": ("tau_a/sqrt(L0/g)", "Eq. 25", ("damping.axial_s",), _T),
+    "tau_bending": ("tau_b/sqrt(L0/g)", "Eq. 25", ("damping.bending_s",), _T),
+    "tau_torsion": ("tau_t/sqrt(L0/g)", "Eq. 25", ("damping.torsion_s",), _T),
+}
+
+
+def normalise(section: Damping, t_scale) -> dict:
+    """The retardation times / t_scale (Eq. 25): Normalised's tau_axial, tau_bending, tau_torsion."""
+    return {"tau_axial": section.axial_s / t_scale, "tau_bending": section.bending_s / t_scale,
+            "tau_torsion": section.torsion_s / t_scale}
+
+
+def check(params) -> None:
+    """What the damping cannot run with (``params`` a whole scene): the spline scheme and
+    the mixed bending form (forms/damping.py is written on the FE scheme's IP form)."""
+    disc = params.discretisation
+    if params.model.damping.active and (disc.scheme != "fe" or disc.bending != "ip"):
+        raise ParameterError("damping", params.model.damping,
+                             "structural damping is implemented by the FE scheme with "
+                             "discretisation.bending = 'ip' only (forms/damping.py)")

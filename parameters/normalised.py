@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rawehelix.parameters import damping
 from rawehelix.parameters.forcing import EndForcing
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -105,9 +106,7 @@ class Normalised(EndForcing):
             spin_target=p.controller.target_rpm * RPM * t_scale,
             gravity=float(p.model.gravity), drag=float(p.model.drag),
             bending=float(p.model.bending),
-            tau_axial=p.model.damping.axial_s / t_scale,
-            tau_bending=p.model.damping.bending_s / t_scale,
-            tau_torsion=p.model.damping.torsion_s / t_scale,
+            **damping.normalise(p.model.damping, t_scale),
             bending_law=law is not None,
             mu_per_tension=0.0 if law is None else law.a_Nm2_per_N / L0**2,
             mu_at_zero_tension=0.0 if law is None else law.b_Nm2 / (M * g * L0**2),

@@ -6,6 +6,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
+from rawehelix.parameters import damping
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.fingerprint import drop_later_switches
 from rawehelix.parameters.normalised import Normalised
@@ -50,11 +51,7 @@ class Parameters:
                 "energy 1/2 EI(eps) kappa^2, whose variation gives the axial force its "
                 "1/2 EI'(eps) kappa^2; the paper's forces (Eqs. 32-33) are not the "
                 "variation of an energy and act with EI on axial motion (forms/extensible.py)")
-        if self.model.damping.active and (
-                self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"):
-            raise ParameterError("damping", self.model.damping,
-                                 "structural damping is implemented by the FE scheme with "
-                                 "discretisation.bending = 'ip' only (forms/damping.py)")
+        damping.check(self)
         if self.model.torsion_hysteresis.active and (
                 self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"
                 or not self.model.twist):
@@ -146,9 +143,7 @@ GROUP_KEYS = {
     "mN0": ("M_N0 L0/GJ", "Eq. 69", ("torque.top_Nm",), (_L0, _GJ)),
     "t0": ("t0/sqrt(L0/g)", "Eq. 69", ("torque.rise_time_s",), _T),
     "spin_target": ("alpha_dot* sqrt(L0/g)", "Eq. 40", ("controller.target_rpm",), _T),
-    "tau_axial": ("tau_a/sqrt(L0/g)", "Eq. 25", ("damping.axial_s",), _T),
-    "tau_bending": ("tau_b/sqrt(L0/g)", "Eq. 25", ("damping.bending_s",), _T),
-    "tau_torsion": ("tau_t/sqrt(L0/g)", "Eq. 25", ("damping.torsion_s",), _T),
+    **damping.GROUP_KEYS,
     "mu_per_tension": ("a/L0^2", "Eq. 64", ("helix.EI_law.a_Nm2_per_N",), (_L0,)),
     "mu_at_zero_tension": ("b/(M g L0^2)", "Eq. 64", ("helix.EI_law.b_Nm2",), (_M, _g, _L0)),
     "bw_beta": ("beta/L0^n", "Eq. 25", ("torsion_hysteresis.beta_m_n",),

@@ -36,7 +36,6 @@ conditions kappa = 0 (37) are in the bcs like the displacement's.
 
 from __future__ import annotations
 
-import dataclasses
 
 import ufl
 from mpi4py import MPI
@@ -72,9 +71,9 @@ class Linearisation:
         # structural damping (forms/damping.py): its forces are linear in the rates, so
         # they add nothing to K at w_t = 0; K is taken of the residual without them
         # (the same K, for a fraction of the assembly)
-        F_K = F if not rod.c.damped else rod.model.residual(
-            rod.w, self.w_t, self.w_tt, rod.test, dataclasses.replace(rod.c, damped=False),
-            rod.degree, rod.penalty, rod.measures)
+        F_K = rod.model.residual(rod.w, self.w_t, self.w_tt, rod.test,
+                                 rod.model.conservative(rod.c), rod.degree, rod.penalty,
+                                 rod.measures)
         self.a_K = dolfinx.fem.form(ufl.derivative(F_K, rod.w, du))
         self.a_C = dolfinx.fem.form(ufl.derivative(F, self.w_t, du))
         self.a_M = dolfinx.fem.form(ufl.derivative(F, self.w_tt, du))
