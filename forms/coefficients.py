@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
+from rawehelix.forms.hysteresis import BoucWen, NoneHysteresis
 
 
 @dataclass
@@ -38,15 +39,9 @@ class Coefficients:
     mu_a: Any = 0.0
     mu_b: Any = 0.0
     bending_law: bool = False
-    # hysteretic torsion (forms/hysteresis.py): Bouc-Wen rho, A, beta, gamma
-    # (normalised) and the exponent n (a number: it chooses the form's shape);
-    # ``hysteretic`` False: no z field, the elastic moment
-    bw_rho: Any = 1.0
-    bw_A: Any = 1.0
-    bw_beta: Any = 0.0
-    bw_gamma: Any = 0.0
-    bw_n: float = 1.0
-    hysteretic: bool = False
+    # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
+    # object NoneHysteresis (no z field, the elastic moment)
+    hysteresis: Any = field(default_factory=NoneHysteresis)
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
@@ -62,6 +57,5 @@ class Coefficients:
             damping=KelvinVoigt.from_normalised(q, make),
             mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
             bending_law=q.bending_law,
-            bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),
-            bw_gamma=make(q.bw_gamma), bw_n=q.bw_n, hysteretic=q.hysteretic,
+            hysteresis=BoucWen.from_normalised(q, make),
         )

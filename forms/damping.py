@@ -132,7 +132,11 @@ def viscous_residual(r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures)
 class KelvinVoigt:
     """The damping component (the scene's ``[damping]``, parameters/damping.py): its
     retardation times / t_scale (numbers or constants) and its contributions, the
-    dissipation potential D and the viscous residual dD/dw_t."""
+    dissipation potential D and the viscous residual dD/dw_t.  It adds no field
+    and every solver runs it (its scene refusals: parameters/damping.py)."""
+
+    fields = ()
+    refuses = {}
 
     def __init__(self, tau_a, tau_b, tau_t):
         self.tau_a, self.tau_b, self.tau_t = tau_a, tau_b, tau_t
@@ -153,6 +157,9 @@ class KelvinVoigt:
 
 class NoneDamping:
     """No structural damping (the paper's model): no dissipation, no viscous force."""
+
+    fields = ()
+    refuses = {}
 
     def dissipation(self, r, r_t, alpha_t, c, degree: int, penalty, measures):
         return None

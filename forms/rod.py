@@ -22,7 +22,7 @@ B) are instead the variation of the extensible rod's stored energy,
 :mod:`rawehelix.forms.extensible`; :func:`elastic_residual` is the one place
 that chooses.
 
-With ``[torsion_hysteresis]`` (``c.hysteretic``) the state has a third
+With ``[torsion_hysteresis]`` (``c.hysteresis``) the state has a third
 field, the Bouc-Wen internal twist z (a DG field), every GJ tau is the moment
 of :mod:`rawehelix.forms.hysteresis` and the residual has z's equation; the
 functions below see it as ``z`` (and its test ``zeta``).
@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms import extensible, hysteresis, mixed
+from rawehelix.forms import extensible, mixed
 from rawehelix.forms.coefficients import Coefficients
 from rawehelix.forms.interior_penalty import avg_d2, bending, ip_penalty, jump_d  # noqa: F401
 from rawehelix.forms.kinematics import d, frenet_torsion_rate, internal_force, tension, twist
@@ -97,8 +97,8 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     (IP bending only; the twist terms are the same)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    if z is not None:  # the moment / GJ, hysteretic (Fig. 5)
-        tau = hysteresis.moment(tau, z, c)
+    if z is not None:  # the moment / GJ of the hysteresis component (Fig. 5)
+        tau = c.hysteresis.moment(tau, z)
     if c.kinematics == "extensible":  # stretch and bending from the stored energy
         F = extensible.centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
     elif kappa is None:
@@ -115,26 +115,6 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
             - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)
 
 
-def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures):
-    """The full residual of Eqs. (30)-(31): inertia + elastic - loads.
-
-    ``w``, ``w_t``, ``w_tt``: mixed (r, alpha) fields or their time
-    derivatives; ``w_tt = None`` gives the stationary residual (and ``w_t =
-    None`` zero velocity).  ``measures`` = (dx, dS, ds).  On the space
-    (r, alpha, kappa) of the mixed bending form the third field is kappa
-    (which has no rate: the rates' kappa parts are unused); on (r, alpha, z)
-    (``c.hysteretic``) it is the Bouc-Wen twist z, whose rate is read."""
-    r, alpha, *third = ufl.split(w)
-    r_t, alpha_t, *third_t = ufl.split(w_t) if w_t is not None else (None, None)
-    r_tt, alpha_tt = ufl.split(w_tt)[:2] if w_tt is not None else (None, None)
-    hysteretic = c.hysteretic and bool(third)
-    return residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, test_fields(test), c, degree,
-                              penalty, measures,
-                              kappa=third[0] if third and not hysteretic else None,
-                              alpha_t=alpha_t, z=third[0] if hysteretic else None,
-                              z_t=third_t[0] if hysteretic and third_t else None)
-
-
 def test_fields(test):
     """(v, psi) of a mixed (r, alpha) test function; (v, psi, eta) on (r, alpha, kappa)."""
     return ufl.split(test)
@@ -142,9 +122,10 @@ def test_fields(test):
 
 def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, degree: int,
                        penalty, measures, kappa=None, alpha_t=None, z=None, z_t=None):
-    """:func:`residual` on fields given one by one, so that (r, alpha) and
-    their rates may live in a larger mixed space (the first-order form of the
-    dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
+    """The full residual of Eqs. (30)-(31), inertia + elastic - loads + the
+    components' terms, on fields given one by one (the rod model,
+    models/unshearable.py, splits its state; the first-order form of the
+    dynamics has (r, alpha) and their rates in a larger space); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
     the curvature field of the mixed bending form, with the test
     ``tests[2]``.  ``alpha_t``: the twist rate, read by the structural damping
     (``c.damping``, forms/damping.py) and the hysteresis only.  ``z``, ``z_t``:
@@ -159,13 +140,11 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
                           kappa=kappa, eta=third[0] if third and kappa is not None else None,
                           z=z)
          - ufl.inner(body_force(r_t, c), v) * dx)
-    if z is not None:  # the Bouc-Wen equation of z (forms/hysteresis.py)
-        if z_t is None or not moving:
-            F += hysteresis.virgin_residual(z, third[0], dx)
-        else:  # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate
-            tau_t = (c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps)
-                     + d(alpha_t))
-            F += hysteresis.evolution_residual(z, z_t, tau_t, third[0], dx, c)
+    if z is not None:  # z's equation, of the hysteresis component (forms/hysteresis.py)
+        # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate (None at rest)
+        tau_t = (c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps) + d(alpha_t)
+                 if moving and z_t is not None else None)
+        F += c.hysteresis.residual(z, z_t, tau_t, third[0], dx, c)
     if moving:  # the damping component: Kelvin-Voigt from its dissipation potential, or none
         F += c.damping.residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
     if r_tt is not None:

@@ -23,7 +23,8 @@ import dataclasses
 
 from rawehelix import compat
 from rawehelix.forms import energy, kinematics, rod
-from rawehelix.forms.damping import NoneDamping
+from rawehelix.forms.damping import KelvinVoigt, NoneDamping
+from rawehelix.forms.hysteresis import BoucWen
 from rawehelix.models.base import EndCondition, Refusal, RodModel
 from rawehelix.parameters import Parameters
 
@@ -33,15 +34,6 @@ MIXED_FIRST_ORDER = Refusal(
     "'mixed' runs with the second-order integrator "
     "only (-rawehelix_ts_type alpha2, the default): the first-order TS types "
     "are not set up for its algebraic curvature field")
-HYSTERESIS_FIRST_ORDER = Refusal(
-    "torsion_hysteresis",
-    "runs with the second-order integrator only (-rawehelix_ts_type alpha2, the "
-    "default): the first-order TS types are not set up for its internal twist z "
-    "(forms/hysteresis.py)")
-HYSTERESIS_MODAL = Refusal(
-    "torsion_hysteresis",
-    "the modal solver does not linearise the hysteretic torsion "
-    "(forms/hysteresis.py); it runs in time only ('simulate')")
 
 
 class UnshearableRod(RodModel):
@@ -50,18 +42,28 @@ class UnshearableRod(RodModel):
     def __init__(self, params: Parameters):
         self.params = params
         self.mixed = params.discretisation.bending == "mixed"  # kappa, forms/mixed.py
-        self.hysteretic = params.model.torsion_hysteresis.active  # z, forms/hysteresis.py
         self.twist_field = params.model.twist  # false: alpha held at 0
+        q = params.normalised()
+        # the components (a switched-off one is its null object): the fields they
+        # add and what they refuse
+        self.components = (KelvinVoigt.from_normalised(q), BoucWen.from_normalised(q))
         self.fields = (("centre_line", "twist") + ("curvature",) * self.mixed
-                       + ("internal_twist",) * self.hysteretic)
+                       + sum((comp.fields for comp in self.components), ()))
+        self.hysteretic = self.has("internal_twist")  # z, forms/hysteresis.py
 
     def element(self, cell, degree: int):
         return compat.rod_element(cell, degree, curvature=self.mixed, internal=self.hysteretic)
 
     # -- forms ---------------------------------------------------------------------
     def residual(self, w, w_t, w_tt, test, c, degree: int, penalty, measures):
-        """Eqs. (30)-(31) and the components' equations (forms/rod.py::residual)."""
-        return rod.residual(w, w_t, w_tt, test, c, degree, penalty, measures)
+        """Eqs. (30)-(31) and the components' equations (forms/rod.py::residual_of_fields)
+        on this model's fields; the curvature has no rate (its parts of w_t are unused)."""
+        f, f_t = self.split(w), self.rates(w_t)
+        f_tt = self.rates(w_tt)
+        return rod.residual_of_fields(
+            f["centre_line"], f["twist"], f_t["centre_line"], f_tt["centre_line"], f_tt["twist"],
+            rod.test_fields(test), c, degree, penalty, measures, kappa=f["curvature"],
+            alpha_t=f_t["twist"], z=f["internal_twist"], z_t=f_t["internal_twist"])
 
     def conservative(self, c):
         """``c`` without the dissipative components: the residual of the stiffness."""
@@ -94,6 +96,13 @@ class UnshearableRod(RodModel):
         return kinematics.twist(fields["centre_line"], fields["twist"], c.gamma_eps,
                                 c.gamma_coupling, k=fields["curvature"])
 
+    def moment(self, fields: dict, c):
+        """The torsional moment / GJ: tau, or the hysteresis component's
+        rho tau + (1 - rho) z (forms/hysteresis.py)."""
+        tau = self.twist(fields, c)
+        z = fields["internal_twist"]
+        return tau if z is None else c.hysteresis.moment(tau, z)
+
     # -- end conditions, Eqs. (35)-(37) ---------------------------------------------
     def end_conditions(self, pin_twist: bool) -> list[EndCondition]:
         """r(0) = 0 (35), r(1) = r_N (36); alpha(0) = 0 if ``pin_twist`` (the rigid
@@ -110,9 +119,8 @@ class UnshearableRod(RodModel):
 
     # -- capabilities -----------------------------------------------------------------
     def refusals(self, solver: str) -> list[Refusal]:
-        out = []
-        if solver == "first_order":
-            out += [HYSTERESIS_FIRST_ORDER] * self.hysteretic + [MIXED_FIRST_ORDER] * self.mixed
-        if solver == "modal":
-            out += [HYSTERESIS_MODAL] * self.hysteretic
+        out = [Refusal(*comp.refuses[solver]) for comp in self.components
+               if solver in comp.refuses]
+        if solver == "first_order" and self.mixed:
+            out.append(MIXED_FIRST_ORDER)
         return out

@@ -51,3 +51,29 @@ class TorsionHysteresis:
     def describe(self) -> str:
         return (f"torsion hysteresis: Bouc-Wen rho = {self.rho:g}, A = {self.A:g}, "
                 f"beta = {self.beta_m_n:g}, gamma = {self.gamma_m_n:g} (m/rad)^n, n = {self.n:g}")
+
+
+#: its normalised groups (parameters/scene.py::GROUP_KEYS): tau~ = L0 tau, so beta~ = beta / L0^n
+GROUP_KEYS = {
+    "bw_beta": ("beta/L0^n", "Eq. 25", ("torsion_hysteresis.beta_m_n",),
+                ("helix.length_m", "torsion_hysteresis.n")),
+    "bw_gamma": ("gamma/L0^n", "Eq. 25", ("torsion_hysteresis.gamma_m_n",),
+                 ("helix.length_m", "torsion_hysteresis.n")),
+}
+
+
+def normalise(section: TorsionHysteresis, L0) -> dict:
+    """Normalised's bw_rho, bw_A, bw_beta, bw_gamma, bw_n (twist in units of 1/L0)."""
+    return {"bw_rho": section.rho, "bw_A": section.A, "bw_beta": section.beta_m_n / L0**section.n,
+            "bw_gamma": section.gamma_m_n / L0**section.n, "bw_n": section.n}
+
+
+def check(params) -> None:
+    """What the hysteresis cannot run with (``params`` a whole scene): the spline
+    scheme, the mixed bending form (its third field is z's place) and model.twist = false."""
+    disc, section = params.discretisation, params.model.torsion_hysteresis
+    if section.active and (disc.scheme != "fe" or disc.bending != "ip" or not params.model.twist):
+        raise ParameterError("torsion_hysteresis", section,
+                             "hysteretic torsion is implemented by the FE scheme with "
+                             "discretisation.bending = 'ip' and model.twist = true only "
+                             "(forms/hysteresis.py)")

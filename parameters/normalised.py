@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rawehelix.parameters import damping
+from rawehelix.parameters import damping, hysteresis
 from rawehelix.parameters.forcing import EndForcing
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -91,7 +91,6 @@ class Normalised(EndForcing):
         mu = h.EI_Nm2 / (M * g * L0**2)  # (26)
         beta = h.GJ_Nm2 / (M * g * L0**2)  # (26)
         sigma = h.EA_N / (M * g)  # (27)
-        bw = p.model.torsion_hysteresis
         return cls(
             L0=L0, t_scale=t_scale, force_scale=M * g, torque_scale=h.GJ_Nm2 / L0,
             sigma=sigma, mu=mu, beta=beta,
@@ -110,8 +109,7 @@ class Normalised(EndForcing):
             bending_law=law is not None,
             mu_per_tension=0.0 if law is None else law.a_Nm2_per_N / L0**2,
             mu_at_zero_tension=0.0 if law is None else law.b_Nm2 / (M * g * L0**2),
-            bw_rho=bw.rho, bw_A=bw.A, bw_beta=bw.beta_m_n / L0**bw.n,
-            bw_gamma=bw.gamma_m_n / L0**bw.n, bw_n=bw.n,
+            **hysteresis.normalise(p.model.torsion_hysteresis, L0),
         )
 
     # -- units back to SI ---------------------------------------------------

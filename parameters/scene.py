@@ -6,7 +6,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from rawehelix.parameters import damping
+from rawehelix.parameters import damping, hysteresis
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.fingerprint import drop_later_switches
 from rawehelix.parameters.normalised import Normalised
@@ -52,13 +52,7 @@ class Parameters:
                 "1/2 EI'(eps) kappa^2; the paper's forces (Eqs. 32-33) are not the "
                 "variation of an energy and act with EI on axial motion (forms/extensible.py)")
         damping.check(self)
-        if self.model.torsion_hysteresis.active and (
-                self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"
-                or not self.model.twist):
-            raise ParameterError("torsion_hysteresis", self.model.torsion_hysteresis,
-                                 "hysteretic torsion is implemented by the FE scheme with "
-                                 "discretisation.bending = 'ip' and model.twist = true only "
-                                 "(forms/hysteresis.py)")
+        hysteresis.check(self)
 
         self._check_groups()
 
@@ -146,8 +140,5 @@ GROUP_KEYS = {
     **damping.GROUP_KEYS,
     "mu_per_tension": ("a/L0^2", "Eq. 64", ("helix.EI_law.a_Nm2_per_N",), (_L0,)),
     "mu_at_zero_tension": ("b/(M g L0^2)", "Eq. 64", ("helix.EI_law.b_Nm2",), (_M, _g, _L0)),
-    "bw_beta": ("beta/L0^n", "Eq. 25", ("torsion_hysteresis.beta_m_n",),
-                (_L0, "torsion_hysteresis.n")),
-    "bw_gamma": ("gamma/L0^n", "Eq. 25", ("torsion_hysteresis.gamma_m_n",),
-                 (_L0, "torsion_hysteresis.n")),
+    **hysteresis.GROUP_KEYS,
 }
