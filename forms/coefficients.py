@@ -6,7 +6,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
+from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
+from rawehelix.forms.extensible import ExtensibleKinematics
 from rawehelix.forms.hysteresis import BoucWen, NoneHysteresis
+from rawehelix.forms.paper import PaperKinematics
+
+#: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py)
+KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics}
 
 
 @dataclass
@@ -30,15 +36,14 @@ class Coefficients:
     bending: Any = 1.0
     gamma_eps: Any = 1.0e-3
     gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
-    kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
+    # the kinematics, a component chosen by model.kinematics (:data:`KINEMATICS`)
+    kinematics: Any = field(default_factory=PaperKinematics)
     # structural damping, a component (forms/damping.py): KelvinVoigt, or the null
     # object NoneDamping that leaves the viscous terms out of the forms altogether
     damping: Any = field(default_factory=NoneDamping)
-    # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
-    # mu_a sigma eps + mu_b; ``bending_law`` False: mu
-    mu_a: Any = 0.0
-    mu_b: Any = 0.0
-    bending_law: bool = False
+    # the EI law, a component (forms/eilaw.py): TensionDependentBending, or the
+    # null object ConstantBending (mu)
+    bending_law: Any = field(default_factory=ConstantBending)
     # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
     # object NoneHysteresis (no z field, the elastic moment)
     hysteresis: Any = field(default_factory=NoneHysteresis)
@@ -53,9 +58,8 @@ class Coefficients:
             gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
             gamma_eps=make(model.gamma_eps),
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
-            kinematics=model.kinematics,
+            kinematics=KINEMATICS[model.kinematics](),
             damping=KelvinVoigt.from_normalised(q, make),
-            mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
-            bending_law=q.bending_law,
+            bending_law=TensionDependentBending.from_normalised(q, make),
             hysteresis=BoucWen.from_normalised(q, make),
         )

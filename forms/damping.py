@@ -56,8 +56,7 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms import extensible
-from rawehelix.forms.interior_penalty import ip_penalty, jump_d
+from rawehelix.forms.interior_penalty import ip_penalty
 from rawehelix.forms.kinematics import d, frenet_torsion_rate, tangent_rate, unit_tangent
 
 
@@ -67,13 +66,9 @@ def strain_rates(r, r_t, alpha_t, c, n):
     t, t_t = unit_tangent(r), tangent_rate(r, r_t)
     w = ufl.cross(t, t_t)  # the tangent's spin
 
-    def jump(f):  # [[f]] at a node
-        return f("+") * n("+")[0] + f("-") * n("-")[0]
-
-    if c.kinematics == "extensible":  # q = t', [[j]] = [[t]]
-        q, q_t, j, j_t = d(t), d(t_t), jump(t), jump(t_t)
-    else:  # q = r'', [[j]] = [[r']]
-        q, q_t, j, j_t = d(r, 2), d(r_t, 2), jump_d(r, n), jump_d(r_t, n)
+    # the kinematics component's curvature measure: q = r'', [[j]] = [[r']] (paper)
+    # or q = t', [[j]] = [[t]] (extensible)
+    q, q_t, j, j_t = c.kinematics.bending_measure(r, r_t, t, t_t, n)
     b = q_t - ufl.cross(w, q)
     jb = j_t - ufl.cross(0.5 * (w("+") + w("-")), j)
     eps_t = ufl.dot(t, d(r_t))  # d|r'|/dt
@@ -89,8 +84,8 @@ def _bilinear(x, y, r, c, degree: int, penalty, measures):
     kv = c.damping  # the retardation times of the KelvinVoigt component
     (ea, ta, ba, ja), (eb, tb, bb, jb) = x, y
     alpha_ip = ip_penalty(degree, penalty, dS)
-    if c.bending_law:  # m_v = EI(T) tau_b b: the modulus at the nodes as in forms/extensible.py
-        mu = extensible.bending_modulus(r, c)
+    if c.bending_law.field:  # m_v = EI(T) tau_b b: the modulus at the nodes as in forms/extensible.py
+        mu = c.bending_law.modulus(r, c)
 
         def avg(f):
             return 0.5 * (f("+") + f("-"))

@@ -64,8 +64,6 @@ compares with the scipy reference.
 
 from __future__ import annotations
 
-import ufl
-
 
 def moment(tau, z, c):
     """m = rho tau + (1 - rho) z: the torsional moment / GJ (normalised twist units)."""

@@ -8,6 +8,11 @@ import ufl
 from rawehelix.forms.kinematics import d
 
 
+def jump(f, n):
+    """[[f]] = f(+) n(+) + f(-) n(-): the jump of f at a node."""
+    return f("+") * n("+")[0] + f("-") * n("-")[0]
+
+
 def jump_d(f, n):
     """[[f']] = f'(+) n(+) + f'(-) n(-): the jump of the normal derivative at a node."""
     return d(f)("+") * n("+")[0] + d(f)("-") * n("-")[0]

@@ -102,3 +102,8 @@ def frenet_torsion_rate(r, r_t, eps):
              + ufl.dot(r1, ufl.cross(r2, u3)))
     den = ufl.dot(r2, r2) + eps**2
     return num_t / den - num * 2 * ufl.dot(r2, u2) / den**2
+
+
+def normal_part(f, axis):
+    """P f = f - (f.e) e: the part of f normal to the unit axis e."""
+    return f - ufl.dot(f, axis) * axis

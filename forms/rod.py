@@ -35,10 +35,8 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms import extensible, mixed
 from rawehelix.forms.coefficients import Coefficients
-from rawehelix.forms.interior_penalty import avg_d2, bending, ip_penalty, jump_d  # noqa: F401
-from rawehelix.forms.kinematics import d, frenet_torsion_rate, internal_force, tension, twist
+from rawehelix.forms.kinematics import d, frenet_torsion_rate, tension, twist
 
 K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
 I_E = ufl.as_vector((1.0, 0.0, 0.0))  # i_E: the wind blows along -i_E
@@ -99,15 +97,10 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
     if z is not None:  # the moment / GJ of the hysteresis component (Fig. 5)
         tau = c.hysteresis.moment(tau, z)
-    if c.kinematics == "extensible":  # stretch and bending from the stored energy
-        F = extensible.centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
-    elif kappa is None:
-        F = (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta), d(v)) * dx  # (32)
-             + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS))  # (33)
-    else:  # (33) and kappa = r'' with kappa = 0 at the ends (37), forms/mixed.py
-        F = (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa), d(v)) * dx
-             + c.bending * c.mu * mixed.bending_force(kappa, v, dx)
-             - c.mu * mixed.curvature_equation(r, kappa, eta, dx))
+    # the kinematics component: the paper's F_NL (32)-(33) (forms/paper.py) or the
+    # variation of the extensible rod's stored energy (forms/extensible.py)
+    F = c.kinematics.centre_line_residual(r, v, tau, c, degree, penalty, dx, dS,
+                                          kappa=kappa, eta=eta)
     if psi is None:  # the planar model: no twist equation
         return F
     return (F + c.delta * tau * d(psi) * dx  # (31)

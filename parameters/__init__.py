@@ -18,14 +18,20 @@ cross-checks), :mod:`.fingerprint` (compatibility of stored fingerprints),
 Every name stays importable from ``rawehelix.parameters``.
 """
 
-from rawehelix.parameters.checks import ParameterError, _non_negative, _positive  # noqa: F401
-from rawehelix.parameters.damping import Damping  # noqa: F401
-from rawehelix.parameters.eilaw import PAPER_EI_LAW, EILaw  # noqa: F401
-from rawehelix.parameters.fingerprint import LATER_HELIX_SWITCHES, LATER_MODEL_SWITCHES  # noqa: F401
-from rawehelix.parameters.hysteresis import TorsionHysteresis  # noqa: F401
-from rawehelix.parameters.normalised import RPM, Normalised  # noqa: F401
-from rawehelix.parameters.numerics import (BENDINGS, MESHES, PENALTY_MAX, SCHEMES,  # noqa: F401
+from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.damping import Damping
+from rawehelix.parameters.eilaw import PAPER_EI_LAW, EILaw
+from rawehelix.parameters.fingerprint import LATER_HELIX_SWITCHES, LATER_MODEL_SWITCHES
+from rawehelix.parameters.hysteresis import TorsionHysteresis
+from rawehelix.parameters.normalised import RPM, Normalised
+from rawehelix.parameters.numerics import (BENDINGS, MESHES, PENALTY_MAX, SCHEMES,
                                            Discretisation, Sweep, Time)
-from rawehelix.parameters.scene import GROUP_KEYS, Parameters  # noqa: F401
-from rawehelix.parameters.sections import (GAMMA_TREATMENTS, KINEMATICS, Controller,  # noqa: F401
+from rawehelix.parameters.scene import GROUP_KEYS, Parameters
+from rawehelix.parameters.sections import (GAMMA_TREATMENTS, KINEMATICS, Controller,
                                            Ends, Environment, Helix, Model, Torque)
+
+__all__ = ["ParameterError", "Damping", "PAPER_EI_LAW", "EILaw", "LATER_HELIX_SWITCHES",
+           "LATER_MODEL_SWITCHES", "TorsionHysteresis", "RPM", "Normalised", "BENDINGS", "MESHES",
+           "PENALTY_MAX", "SCHEMES", "Discretisation", "Sweep", "Time", "GROUP_KEYS", "Parameters",
+           "GAMMA_TREATMENTS", "KINEMATICS", "Controller", "Ends", "Environment", "Helix", "Model",
+           "Torque"]

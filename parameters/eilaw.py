@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rawehelix.parameters.checks import _non_negative, _positive
+from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 
 
 @dataclass(frozen=True)
@@ -44,3 +44,29 @@ class EILaw:
 
 #: the law the paper measured, Eq. (64) and Fig. 4: EI = 52.4 T + 2290
 PAPER_EI_LAW = EILaw(a_Nm2_per_N=52.4, b_Nm2=2290.0)
+
+
+#: its normalised groups (parameters/scene.py::GROUP_KEYS), Eq. (64) over Eq. (26)
+GROUP_KEYS = {
+    "mu_per_tension": ("a/L0^2", "Eq. 64", ("helix.EI_law.a_Nm2_per_N",), ("helix.length_m",)),
+    "mu_at_zero_tension": ("b/(M g L0^2)", "Eq. 64", ("helix.EI_law.b_Nm2",),
+                           ("helix.mass_kg", "environment.g_m_s2", "helix.length_m")),
+}
+
+
+def normalise(law: EILaw | None, L0, M, g) -> dict:
+    """Normalised's bending_law, mu_per_tension = a / L0^2, mu_at_zero_tension = b / (M g L0^2)."""
+    return {"bending_law": law is not None,
+            "mu_per_tension": 0.0 if law is None else law.a_Nm2_per_N / L0**2,
+            "mu_at_zero_tension": 0.0 if law is None else law.b_Nm2 / (M * g * L0**2)}
+
+
+def check(params) -> None:
+    """What the law cannot run with (``params`` a whole scene): the paper's kinematics."""
+    if params.helix.EI_law is not None and params.model.kinematics != "extensible":
+        raise ParameterError(
+            "helix.EI_law", params.helix.EI_law,
+            "needs model.kinematics = 'extensible': the law is built from the stored "
+            "energy 1/2 EI(eps) kappa^2, whose variation gives the axial force its "
+            "1/2 EI'(eps) kappa^2; the paper's forces (Eqs. 32-33) are not the "
+            "variation of an energy and act with EI on axial motion (forms/extensible.py)")

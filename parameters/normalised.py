@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rawehelix.parameters import damping, hysteresis
+from rawehelix.parameters import damping, eilaw, hysteresis
 from rawehelix.parameters.forcing import EndForcing
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -85,7 +85,6 @@ class Normalised(EndForcing):
     @classmethod
     def _groups(cls, p: "Parameters") -> "Normalised":
         h, e, env = p.helix, p.ends, p.environment
-        law = h.EI_law
         L0, M, g = np.float64(h.length_m), np.float64(h.mass_kg), np.float64(env.g_m_s2)
         t_scale = np.sqrt(L0 / g)  # (25)
         mu = h.EI_Nm2 / (M * g * L0**2)  # (26)
@@ -106,9 +105,7 @@ class Normalised(EndForcing):
             gravity=float(p.model.gravity), drag=float(p.model.drag),
             bending=float(p.model.bending),
             **damping.normalise(p.model.damping, t_scale),
-            bending_law=law is not None,
-            mu_per_tension=0.0 if law is None else law.a_Nm2_per_N / L0**2,
-            mu_at_zero_tension=0.0 if law is None else law.b_Nm2 / (M * g * L0**2),
+            **eilaw.normalise(h.EI_law, L0, M, g),
             **hysteresis.normalise(p.model.torsion_hysteresis, L0),
         )
 

@@ -6,7 +6,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from rawehelix.parameters import damping, hysteresis
+from rawehelix.parameters import damping, eilaw, hysteresis, sections
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.fingerprint import drop_later_switches
 from rawehelix.parameters.normalised import Normalised
@@ -39,18 +39,9 @@ class Parameters:
                                      "torque is carried by the twist, Eq. (31)")
             if self.discretisation.scheme != "fe":
                 raise ParameterError("model.twist", False, "is implemented by the FE scheme only")
-        if self.model.kinematics == "extensible" and (
-                self.discretisation.scheme != "fe" or self.discretisation.bending != "ip"):
-            raise ParameterError("model.kinematics", "extensible",
-                                 "is implemented by the FE scheme with discretisation.bending "
-                                 "= 'ip' only (forms/extensible.py)")
-        if self.helix.EI_law is not None and self.model.kinematics != "extensible":
-            raise ParameterError(
-                "helix.EI_law", self.helix.EI_law,
-                "needs model.kinematics = 'extensible': the law is built from the stored "
-                "energy 1/2 EI(eps) kappa^2, whose variation gives the axial force its "
-                "1/2 EI'(eps) kappa^2; the paper's forces (Eqs. 32-33) are not the "
-                "variation of an energy and act with EI on axial motion (forms/extensible.py)")
+        # each component's refusals of what it cannot run with
+        sections.check_kinematics(self)
+        eilaw.check(self)
         damping.check(self)
         hysteresis.check(self)
 
@@ -138,7 +129,6 @@ GROUP_KEYS = {
     "t0": ("t0/sqrt(L0/g)", "Eq. 69", ("torque.rise_time_s",), _T),
     "spin_target": ("alpha_dot* sqrt(L0/g)", "Eq. 40", ("controller.target_rpm",), _T),
     **damping.GROUP_KEYS,
-    "mu_per_tension": ("a/L0^2", "Eq. 64", ("helix.EI_law.a_Nm2_per_N",), (_L0,)),
-    "mu_at_zero_tension": ("b/(M g L0^2)", "Eq. 64", ("helix.EI_law.b_Nm2",), (_M, _g, _L0)),
+    **eilaw.GROUP_KEYS,
     **hysteresis.GROUP_KEYS,
 }

@@ -131,7 +131,16 @@ class Controller:
 
 
 GAMMA_TREATMENTS = ("regularised", "off")
-KINEMATICS = ("paper", "extensible")  # forms/rod.py (Eqs. 30-33), forms/extensible.py
+KINEMATICS = ("paper", "extensible")  # forms/paper.py (Eqs. 30-33), forms/extensible.py
+
+
+def check_kinematics(params) -> None:
+    """What the extensible kinematics cannot run with (``params`` a whole scene)."""
+    disc = params.discretisation
+    if params.model.kinematics == "extensible" and (disc.scheme != "fe" or disc.bending != "ip"):
+        raise ParameterError("model.kinematics", "extensible",
+                             "is implemented by the FE scheme with discretisation.bending "
+                             "= 'ip' only (forms/extensible.py)")
 
 
 @dataclass(frozen=True)

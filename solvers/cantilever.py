@@ -31,7 +31,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.forms import cantilever, extensible, kinematics
+from rawehelix.forms import cantilever, kinematics
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import petsc_options
 from rawehelix.solvers.discrete import RodDiscretisation
@@ -82,7 +82,7 @@ class CantileverSolver:
         self.force = dolfinx.fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
         axis = ufl.as_vector(AXIS)
         x = r.centre_line()
-        mu = extensible.bending_modulus(x, c) if c.kinematics == "extensible" else c.bending * c.mu
+        mu = c.kinematics.bending_modulus(x, c)  # with the EI law: mu(eps), forms/eilaw.py
         U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)
@@ -103,16 +103,16 @@ class CantileverSolver:
         mu = EI_Nm2 / (q.force_scale * q.L0**2)  # (26)
         c.mu.value = mu
         c.delta.value = q.beta * q.sigma / (2 * mu)
-        if c.bending_law:
+        if c.bending_law.field:
             self.set_bending_law(0.0, EI_Nm2)
 
     def set_bending_law(self, a_Nm2_per_N: float, b_Nm2: float):
         """The EI law EI = a T + b of a rod built with one (parameters.Normalised)."""
         q, c = self.q, self.rod.c
-        if not c.bending_law:
+        if not c.bending_law.field:
             raise ValueError("set_bending_law needs a rod built with helix.EI_law")
-        c.mu_a.value = a_Nm2_per_N / q.L0**2
-        c.mu_b.value = b_Nm2 / (q.force_scale * q.L0**2)
+        c.bending_law.mu_a.value = a_Nm2_per_N / q.L0**2
+        c.bending_law.mu_b.value = b_Nm2 / (q.force_scale * q.L0**2)
 
     def _set_loads(self, force_N, torque_Nm: float):
         self.force.value[:] = np.asarray(force_N, dtype=float) / self.q.force_scale
