@@ -14,6 +14,12 @@ from rawehelix.forms.paper import PaperKinematics
 #: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py)
 KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics}
 
+#: the components that add a stored energy per length W(r) and nothing else
+#: (forms/energy_component.py): the residual gets their variation (forms/rod.py), the
+#: energy W (forms/energy.py).  Each is a class with from_normalised(q, make) (its
+#: null object when off); a new one is appended here.
+ENERGY_COMPONENTS = ()
+
 
 @dataclass
 class Coefficients:
@@ -47,6 +53,8 @@ class Coefficients:
     # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
     # object NoneHysteresis (no z field, the elastic moment)
     hysteresis: Any = field(default_factory=NoneHysteresis)
+    # the ENERGY_COMPONENTS of the scene
+    extra: tuple = ()
 
     @classmethod
     def from_normalised(cls, q, model, make=float):
@@ -62,4 +70,5 @@ class Coefficients:
             damping=KelvinVoigt.from_normalised(q, make),
             bending_law=TensionDependentBending.from_normalised(q, make),
             hysteresis=BoucWen.from_normalised(q, make),
+            extra=tuple(cls.from_normalised(q, make) for cls in ENERGY_COMPONENTS),
         )

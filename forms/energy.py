@@ -52,7 +52,8 @@ def potential(r, alpha, c: Coefficients, degree: int, penalty, measures, kappa=N
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
     # stretch and bending: the kinematics component's (forms/paper.py, forms/extensible.py)
     return ((0.5 * c.beta * tau**2 - c.gravity * ufl.dot(K_E, r)) * dx
-            + c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa))
+            + c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa)
+            + sum(comp.energy(r, c, dx) for comp in c.extra))  # forms/coefficients.py
 
 
 def non_variational_power(r, alpha, r_t, c: Coefficients, dx, kappa=None):

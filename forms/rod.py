@@ -101,6 +101,8 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     # variation of the extensible rod's stored energy (forms/extensible.py)
     F = c.kinematics.centre_line_residual(r, v, tau, c, degree, penalty, dx, dS,
                                           kappa=kappa, eta=eta)
+    for comp in c.extra:  # the energy components (forms/energy_component.py): delta W(r; v)
+        F += comp.residual(r, v, c, dx)
     if psi is None:  # the planar model: no twist equation
         return F
     return (F + c.delta * tau * d(psi) * dx  # (31)

@@ -38,8 +38,14 @@ GROUP_KEYS = {
 }
 
 
-def normalise(section: Damping, t_scale) -> dict:
-    """The retardation times / t_scale (Eq. 25): Normalised's tau_axial, tau_bending, tau_torsion."""
+#: where the section lives in a scene: Parameters.model.damping (the file's [damping])
+HOLDER, KEY = "model", "damping"
+
+
+def normalise(p, scales: dict) -> dict:
+    """The retardation times / t_scale (Eq. 25): Normalised's tau_axial, tau_bending,
+    tau_torsion; ``scales`` the numpy L0, M, g, t_scale (parameters/normalised.py)."""
+    section, t_scale = p.model.damping, scales["t_scale"]
     return {"tau_axial": section.axial_s / t_scale, "tau_bending": section.bending_s / t_scale,
             "tau_torsion": section.torsion_s / t_scale}
 

@@ -54,8 +54,13 @@ GROUP_KEYS = {
 }
 
 
-def normalise(law: EILaw | None, L0, M, g) -> dict:
+#: where the law lives in a scene: Parameters.helix.EI_law
+HOLDER, KEY = "helix", "EI_law"
+
+
+def normalise(p, scales: dict) -> dict:
     """Normalised's bending_law, mu_per_tension = a / L0^2, mu_at_zero_tension = b / (M g L0^2)."""
+    law, L0, M, g = p.helix.EI_law, scales["L0"], scales["M"], scales["g"]
     return {"bending_law": law is not None,
             "mu_per_tension": 0.0 if law is None else law.a_Nm2_per_N / L0**2,
             "mu_at_zero_tension": 0.0 if law is None else law.b_Nm2 / (M * g * L0**2)}

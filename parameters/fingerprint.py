@@ -2,18 +2,16 @@
 
 from __future__ import annotations
 
-import dataclasses
-
-from rawehelix.parameters.damping import Damping
-from rawehelix.parameters.hysteresis import TorsionHysteresis
+from rawehelix.parameters import components
+from rawehelix.parameters.sections import Helix, Model
 
 #: model switches added after results were stored (sweep checkpoints, the
 #: convergence cache): left out of :meth:`Parameters.as_dict` at their
-#: defaults, so that those results keep their fingerprints
-LATER_MODEL_SWITCHES = {"kinematics": "paper", "damping": dataclasses.asdict(Damping()),
-                        "torsion_hysteresis": dataclasses.asdict(TorsionHysteresis())}
-#: the same for the helix section
-LATER_HELIX_SWITCHES = {"EI_law": None}
+#: defaults, so that those results keep their fingerprints: the kinematics and
+#: every component's section (parameters/components.py)
+LATER_MODEL_SWITCHES = {"kinematics": "paper", **components.later_switches("model", Model)}
+#: the same for the helix section (the EI law)
+LATER_HELIX_SWITCHES = components.later_switches("helix", Helix)
 
 
 def drop_later_switches(data: dict) -> dict:

@@ -62,8 +62,13 @@ GROUP_KEYS = {
 }
 
 
-def normalise(section: TorsionHysteresis, L0) -> dict:
+#: where the section lives in a scene: Parameters.model.torsion_hysteresis
+HOLDER, KEY = "model", "torsion_hysteresis"
+
+
+def normalise(p, scales: dict) -> dict:
     """Normalised's bw_rho, bw_A, bw_beta, bw_gamma, bw_n (twist in units of 1/L0)."""
+    section, L0 = p.model.torsion_hysteresis, scales["L0"]
     return {"bw_rho": section.rho, "bw_A": section.A, "bw_beta": section.beta_m_n / L0**section.n,
             "bw_gamma": section.gamma_m_n / L0**section.n, "bw_n": section.n}
 

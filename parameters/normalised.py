@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rawehelix.parameters import damping, eilaw, hysteresis
+from rawehelix.parameters import components
 from rawehelix.parameters.forcing import EndForcing
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -104,9 +104,8 @@ class Normalised(EndForcing):
             spin_target=p.controller.target_rpm * RPM * t_scale,
             gravity=float(p.model.gravity), drag=float(p.model.drag),
             bending=float(p.model.bending),
-            **damping.normalise(p.model.damping, t_scale),
-            **eilaw.normalise(h.EI_law, L0, M, g),
-            **hysteresis.normalise(p.model.torsion_hysteresis, L0),
+            # the components' groups (parameters/components.py)
+            **components.normalise(p, {"L0": L0, "M": M, "g": g, "t_scale": t_scale}),
         )
 
     # -- units back to SI ---------------------------------------------------

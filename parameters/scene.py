@@ -6,7 +6,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from rawehelix.parameters import damping, eilaw, hysteresis, sections
+from rawehelix.parameters import components, sections
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.fingerprint import drop_later_switches
 from rawehelix.parameters.normalised import Normalised
@@ -41,9 +41,7 @@ class Parameters:
                 raise ParameterError("model.twist", False, "is implemented by the FE scheme only")
         # each component's refusals of what it cannot run with
         sections.check_kinematics(self)
-        eilaw.check(self)
-        damping.check(self)
-        hysteresis.check(self)
+        components.check(self)
 
         self._check_groups()
 
@@ -79,7 +77,7 @@ class Parameters:
         the model's damping (the scene's ``[damping]`` section), ``torsion_hysteresis={...}``
         its hysteretic torsion."""
         sections = dict(sections)
-        for nested in ("damping", "torsion_hysteresis"):  # held by Model
+        for nested in components.nested("model"):  # held by Model
             if nested in sections:
                 value = dataclasses.replace(getattr(self.model, nested), **sections.pop(nested))
                 sections["model"] = {**sections.get("model", {}), nested: value}
@@ -128,7 +126,5 @@ GROUP_KEYS = {
     "mN0": ("M_N0 L0/GJ", "Eq. 69", ("torque.top_Nm",), (_L0, _GJ)),
     "t0": ("t0/sqrt(L0/g)", "Eq. 69", ("torque.rise_time_s",), _T),
     "spin_target": ("alpha_dot* sqrt(L0/g)", "Eq. 40", ("controller.target_rpm",), _T),
-    **damping.GROUP_KEYS,
-    **eilaw.GROUP_KEYS,
-    **hysteresis.GROUP_KEYS,
+    **components.group_keys(),
 }

@@ -8,6 +8,7 @@ import math
 import sys
 from dataclasses import dataclass, field
 
+from rawehelix.parameters import components
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 from rawehelix.parameters.damping import Damping
 from rawehelix.parameters.eilaw import EILaw
@@ -187,7 +188,8 @@ class Model:
             terms.append(f"gamma ({self.gamma})")
         text = (f"{head}; terms: {', '.join(terms) or 'tension only'}; "
                 f"kinematics: {self.kinematics}")
-        extras = [x.describe() for x in (self.damping, self.torsion_hysteresis) if x.active]
+        sections = (getattr(self, key) for key in components.nested("model"))  # [damping], ...
+        extras = [x.describe() for x in sections if x.active]
         return "; ".join([text, *extras])
 
     def __post_init__(self):

@@ -59,6 +59,13 @@ class RodDiscretisation:
         """The sub-space of the field ``role`` (models/base.py::ROLES) in W."""
         return self.W.sub(self.model.index(role))
 
+    def dofs(self, role: str) -> np.ndarray:
+        """The dofs of W (this rank's local indices) of the field ``role``; none if the
+        model has no such field (the internal twist without hysteresis)."""
+        if not self.model.has(role):
+            return np.zeros(0, dtype=int)
+        return np.asarray(compat.collapse(self.sub(role))[1], dtype=int)
+
     def _set_up_end_conditions(self, pin_twist: bool):
         """The model's end conditions (models/unshearable.py) as dolfinx bcs:
         ``bcs`` all of them, ``twist_bcs`` alpha = 0 everywhere (model.twist =
