@@ -21,12 +21,17 @@ from __future__ import annotations
 
 import dataclasses
 
+import ufl
+
 from rawehelix import compat
 from rawehelix.forms import energy, kinematics, rod
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
 from rawehelix.forms.hysteresis import BoucWen
-from rawehelix.models.base import EndCondition, Refusal, RodModel
+from rawehelix.models.base import ROLES, EndCondition, Refusal, RodModel
 from rawehelix.parameters import Parameters
+
+#: the fields of the first-order form (with their rates): no curvature, no z
+PAIR_ROLES = ("centre_line", "twist")
 
 #: the first-order TS types are set up for (r, alpha) and its rates only
 MIXED_FIRST_ORDER = Refusal(
@@ -58,12 +63,35 @@ class UnshearableRod(RodModel):
     def residual(self, w, w_t, w_tt, test, c, degree: int, penalty, measures):
         """Eqs. (30)-(31) and the components' equations (forms/rod.py::residual_of_fields)
         on this model's fields; the curvature has no rate (its parts of w_t are unused)."""
-        f, f_t = self.split(w), self.rates(w_t)
-        f_tt = self.rates(w_tt)
+        return self.residual_of_fields(self.split(w), self.rates(w_t), self.rates(w_tt),
+                                       rod.test_fields(test), c, degree, penalty, measures)
+
+    def residual_of_fields(self, f: dict, f_t: dict, f_tt: dict, tests, c, degree: int, penalty,
+                           measures):
+        """:meth:`residual` on fields, rates and accelerations by role (the
+        first-order form's live in its own space, :meth:`split_pair`); ``tests``
+        the tuple of test functions in the order of the fields."""
         return rod.residual_of_fields(
             f["centre_line"], f["twist"], f_t["centre_line"], f_tt["centre_line"], f_tt["twist"],
-            rod.test_fields(test), c, degree, penalty, measures, kappa=f["curvature"],
+            tests, c, degree, penalty, measures, kappa=f["curvature"],
             alpha_t=f_t["twist"], z=f["internal_twist"], z_t=f_t["internal_twist"])
+
+    # -- the first-order form: (r, alpha) and their rates as unknowns ------------------
+    def pair_element(self, cell, degree: int):
+        """The fields (r, alpha) and their rates as one mixed element (compat.rod_pair_element)."""
+        return compat.rod_pair_element(cell, degree)
+
+    def pair_index(self, role: str, rate: bool = False) -> int:
+        """The position of ``role``'s field (or of its rate) in :meth:`pair_element`."""
+        return PAIR_ROLES.index(role) + len(PAIR_ROLES) * rate
+
+    def split_pair(self, x) -> tuple[dict, dict]:
+        """(fields, rates) by role of a function (or test function) on :meth:`pair_element`."""
+        parts = ufl.split(x)
+        f, f_t = dict.fromkeys(ROLES), dict.fromkeys(ROLES)
+        for role in PAIR_ROLES:
+            f[role], f_t[role] = parts[self.pair_index(role)], parts[self.pair_index(role, True)]
+        return f, f_t
 
     def conservative(self, c):
         """``c`` without the dissipative components: the residual of the stiffness."""

@@ -50,6 +50,7 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
+from rawehelix.models.unshearable import PAIR_ROLES
 from rawehelix.solvers.discrete import RodDiscretisation
 
 
@@ -261,22 +262,23 @@ class FirstOrder(_Formulation):
     second_order = False
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
-        rod_.model.refuse("first_order", rod_.params.name)  # models/unshearable.py
+        model = rod_.model
+        model.refuse("first_order", rod_.params.name)  # models/unshearable.py
         mesh = rod_.mesh
-        self.W2 = compat.function_space(mesh, compat.rod_pair_element(mesh.ufl_cell(), rod_.degree))
+        self.W2 = compat.function_space(mesh, model.pair_element(mesh.ufl_cell(), rod_.degree))
         self.x = dolfinx.fem.Function(self.W2, name="state")
         self.x_t = dolfinx.fem.Function(self.W2, name="rate")
         super().__init__(rod_, self._end_conditions(rod_))
         self.shift = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
-        r, alpha, v_r, omega = ufl.split(self.x)
-        r_t, alpha_t, v_r_t, omega_t = ufl.split(self.x_t)
-        w_r, chi, v, psi = ufl.split(ufl.TestFunction(self.W2))
-        fields = Fields(r, alpha, v_r, omega)
+        f, vel = model.split_pair(self.x)  # X = (fields, velocities)
+        f_t, acc = model.split_pair(self.x_t)  # X_t = (rates, accelerations)
+        tests, tests_v = model.split_pair(ufl.TestFunction(self.W2))
+        fields = Fields(f["centre_line"], f["twist"], vel["centre_line"], vel["twist"])
         c_dyn = self._coefficients(fields)
         dx = rod_.measures[0]
-        F = (ufl.inner(r_t - v_r, w_r) + (alpha_t - omega) * chi) * dx \
-            + rod.residual_of_fields(r, alpha, v_r, v_r_t, omega_t, (v, psi), c_dyn,
-                                     rod_.degree, rod_.penalty, rod_.measures, alpha_t=omega)
+        F = sum(ufl.inner(f_t[role] - vel[role], tests[role]) for role in PAIR_ROLES) * dx \
+            + model.residual_of_fields(f, vel, acc, tuple(tests_v[role] for role in PAIR_ROLES),
+                                       c_dyn, rod_.degree, rod_.penalty, rod_.measures)
         trial = ufl.TrialFunction(self.W2)
         J = ufl.derivative(F, self.x, trial) + self.shift * ufl.derivative(F, self.x_t, trial)
         self._compile(F, J, fields, c_dyn)
@@ -292,14 +294,17 @@ class FirstOrder(_Formulation):
         zero = dolfinx.fem.Function(self.V_r)
         self._set_top_functions(0.0, rod_.q)
         bcs = []
-        for sub, values in ((0, {"bottom": zero, "top": self.r_top}),
-                            (2, {"bottom": zero, "top": self.r_top_t})):
+        model = rod_.model  # the fields and their rates in W2 (models/unshearable.py)
+        r_sub, r_t_sub = model.pair_index("centre_line"), model.pair_index("centre_line", True)
+        twist_subs = (model.pair_index("twist"), model.pair_index("twist", True))
+        for sub, values in ((r_sub, {"bottom": zero, "top": self.r_top}),
+                            (r_t_sub, {"bottom": zero, "top": self.r_top_t})):
             for end, g in values.items():
                 dofs = dolfinx.fem.locate_dofs_topological((W2.sub(sub), self.V_r), 0, ends[end])
                 bcs.append(dolfinx.fem.dirichletbc(g, dofs, W2.sub(sub)))
         if not rod_.params.model.twist:  # alpha = alpha_t = 0 everywhere
             bcs += [dolfinx.fem.dirichletbc(rod_.alpha_zero, rod_.all_dofs(W2.sub(sub), rod_.V_a),
-                                            W2.sub(sub)) for sub in (1, 3)]
+                                            W2.sub(sub)) for sub in twist_subs]
         return bcs
 
     def _set_top_functions(self, t, q):
@@ -333,8 +338,9 @@ class FirstOrder(_Formulation):
 
     def initial_vectors(self):
         """X0 = (r, alpha) of ``rod.w``, zero rates."""
-        self.x.sub(0).interpolate(self.rod.w.sub(0))
-        self.x.sub(1).interpolate(self.rod.w.sub(1))
+        model = self.rod.model
+        for role in PAIR_ROLES:
+            self.x.sub(model.pair_index(role)).interpolate(self.rod.w.sub(model.index(role)))
         self.x.x.scatter_forward()
         return compat.petsc_vec(self.x).copy(), None
 
