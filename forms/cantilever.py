@@ -4,7 +4,7 @@ The segment is clamped on a wall at s = 0 and loaded at its free end s = 1.
 r(0) = 0 and alpha(0) = 0 are Dirichlet conditions (solvers/cantilever.py);
 the clamp's slope condition, the tangent along the wall's axis e, is a
 Nitsche term of the interior-penalty bending energy: the wall is a node whose
-outer side has the tangent e, so the node terms of forms/rod.py::bending
+outer side has the tangent e, so the node terms of forms/interior_penalty.py::bending
 (-{{r''}}.[[r']] + alpha_ip/2 |[[r']]|^2) get the boundary value [[r']] =
 (P r'(0)) n, n = -1 the outward normal and P = I - e e the projection normal
 to e (the dolfinx biharmonic demo's clamped-edge terms, in 1D):

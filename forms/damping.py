@@ -40,7 +40,7 @@ is the local mu(eps) of the state (EI(T) tau_b: "the elastic modulus x the
 retardation time"), at the nodes as {{mu b}} and {{mu}}.
 
 Discretisation (C0 Lagrange, interior penalty): D_b is the IP energy of the
-rate, as the elastic bending form is that of r (forms/rod.py::bending) or of t
+rate, as the elastic bending form is that of r (forms/interior_penalty.py::bending) or of t
 (forms/extensible.py),
 
     D_b = 1/2 int |b|^2 dx - sum_nodes {{b}}.[[j]]_t + alpha_ip/2 sum_nodes |[[j]]_t|^2,
@@ -49,7 +49,7 @@ with [[j]] the node jump of r' (paper) or t (extensible) and [[j]]_t =
 [[j_t]] - {{w}} x [[j]] its co-rotational rate.  About a straight state it is
 1/2 B(r_t, r_t) (paper) or U_b(t_t) (extensible): symmetric and coercive on
 the jumps like the elastic form.  The mixed bending form and the spline
-scheme are refused (parameters.py).
+scheme are refused (parameters/damping.py::check).
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ The paper's -mu kappa^2 r' (the inextensibility's part of F_NL) has no place
 here: the variation of U takes its role.
 
 Discretisation: C0 Lagrange r, so t = r'/|r'| jumps at the nodes.  The
-interior-penalty energy of the dolfinx biharmonic demo (forms/rod.py::bending,
+interior-penalty energy of the dolfinx biharmonic demo (forms/interior_penalty.py::bending,
 whose symmetric form is the variation of 1/2 B(r, r) with [[r']] and {{r''}})
 is written on the unit tangent instead:
 
@@ -49,7 +49,7 @@ and lateral jumps).  The jump is taken of t, not of r': a stretch jump
 t' = 0 (zero moment, the extensible form of r'' = 0, Eq. 37) is natural, as
 in the paper's form.  The mixed form (forms/mixed.py) would need a Lagrange
 multiplier for kappa = r'' under a nonlinear energy; it is not offered
-(parameters.py refuses ``discretisation.bending = "mixed"``).
+(parameters/sections.py::check_kinematics refuses ``discretisation.bending = "mixed"``).
 
 Tension-dependent bending (``helix.EI_law``, EI = a T + b at the local
 tension T = EA eps, Eq. 64 and Fig. 4).  Normalised (parameters.Normalised:
@@ -72,7 +72,7 @@ moment mu t') and alpha_ip/2 {{mu}} |[[t]]|^2 (coercive while mu > 0, i.e.
 T > -b/a).  The energy is convex in (eps, kappa) while mu(eps) > mu_a^2
 sigma kappa^2 (the determinant of its Hessian); for Eq. (64) on Table 2 the
 right side is 2e-3 of the left.  The law is refused with the paper's
-kinematics (parameters.py): its forces are not the variation of an energy
+kinematics (parameters/eilaw.py::check): its forces are not the variation of an energy
 (the -mu kappa^2 r' of Eq. 32) and its bending acts on axial motion, so
 "the consistent axial term" has no meaning there.
 
@@ -108,7 +108,7 @@ def bending_modulus(r, c):
 def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
     """U = int sigma/2 eps^2 + mu U_b(t), U_b the interior-penalty energy of
     1/2 int |t'|^2 on the unit tangent (see above); ``alpha_ip`` the penalty
-    eta p^2 / h_avg (forms/rod.py::ip_penalty), ``mu`` includes the bending switch.
+    eta p^2 / h_avg (forms/interior_penalty.py::ip_penalty), ``mu`` includes the bending switch.
     ``field``: mu is a field (the EI law), taken at the nodes as {{mu t'}} and {{mu}}."""
     n = ufl.FacetNormal(dS.ufl_domain())
     t = unit_tangent(r)
@@ -124,7 +124,7 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
 
 
 def rod_energy(r, c, alpha_ip, dx, dS):
-    """:func:`stored_energy` with the coefficients ``c`` (forms/rod.py::Coefficients):
+    """:func:`stored_energy` with the coefficients ``c`` (forms/coefficients.py::Coefficients):
     the bending modulus of :func:`bending_modulus`, built from ``r`` itself, so
     that its variation carries 1/2 mu'(eps) kappa^2."""
     return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS, field=c.bending_law.field)

@@ -17,7 +17,7 @@ tau_t: a loop is a curve in the (tau, m) plane, whatever the speed).  A
 virgin material (z = 0) has the tangent GJ (rho + (1 - rho) A); loading
 saturates z at z_u = (A / (beta + gamma))^(1/n), and the loop is traversed
 clockwise in (tau, m) and dissipates (Wen's condition beta > 0, |gamma| <=
-beta, parameters.py).  rho = 1 is the paper's elastic rod.  Normalised like
+beta, parameters/hysteresis.py).  rho = 1 is the paper's elastic rod.  Normalised like
 the twist (tau~ = L0 tau, z~ = L0 z), so beta~ = beta / L0^n
 (parameters.Normalised).
 

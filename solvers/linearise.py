@@ -5,7 +5,7 @@ About a state w0, a small motion w = w0 + x e^{lambda t} obeys
     (lambda^2 M + lambda C + K) x = 0,                                 (*)
 
 with the three Jacobians of the full residual F(w, w_t, w_tt; v) of
-Eqs. (30)-(31) (:func:`rawehelix.forms.rod.residual`):
+Eqs. (30)-(31) (:meth:`rawehelix.models.unshearable.UnshearableRod.residual`):
 
     K = dF/dw     at (w0, 0, 0)   elastic + geometric stiffness (32)-(34),
     C = dF/dw_t   at (w0, 0, 0)   the linearised drag of Eq. (28) and the

@@ -2,13 +2,13 @@
 
 Second order (TSALPHA2), unknown U = (r, alpha) on the mixed space W:
 
-    F(t, U, V, A) = rod.residual(U, V, A)                 (30)-(31)
+    F(t, U, V, A) = model.residual(U, V, A)               (30)-(31), models/unshearable.py
     J = dF/dU + v_shift dF/dV + a_shift dF/dA             (I2Jacobian)
 
 First order (theta, bdf, arkimex, ... : IFunction), unknown X = (r, alpha,
 r_t, alpha_t) on a doubled mixed space:
 
-    G(t, X, X_t) = int (r_t - v_r).w + (alpha_t - omega) chi + rod.residual(r, alpha; v_r, v_r_t, omega_t)
+    G(t, X, X_t) = int (r_t - v_r).w + (alpha_t - omega) chi + model.residual(r, alpha; v_r, v_r_t, omega_t)
     J = dG/dX + shift dG/dX_t                            (IJacobian)
 
 Both put the ground torque of the controller into the form as a UFL
