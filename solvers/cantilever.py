@@ -56,14 +56,15 @@ class CantileverRod(RodDiscretisation):
 
     def _set_up_end_conditions(self, pin_twist: bool):
         wall = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 0.0))
-        self.V_r, _ = compat.collapse(self.W.sub(0))
-        self.V_a, _ = compat.collapse(self.W.sub(1))
+        W_r, W_a = self.sub("centre_line"), self.sub("twist")  # the model's fields
+        self.V_r, _ = compat.collapse(W_r)
+        self.V_a, _ = compat.collapse(W_a)
         self.r_bottom = dolfinx.fem.Function(self.V_r)
         self.alpha_zero = dolfinx.fem.Function(self.V_a)
-        dofs_r = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, wall)
-        dofs_a = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, wall)
-        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_r, self.W.sub(0)),
-                    dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, self.W.sub(1))]
+        dofs_r = dolfinx.fem.locate_dofs_topological((W_r, self.V_r), 0, wall)
+        dofs_a = dolfinx.fem.locate_dofs_topological((W_a, self.V_a), 0, wall)
+        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_r, W_r),
+                    dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, W_a)]
         self.twist_bcs = self.curvature_bcs = []
 
 
@@ -87,7 +88,7 @@ class CantileverSolver:
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)
         self.newton = NewtonSolver(F, w, r.bcs, prefix=petsc_options.LABTEST_PREFIX)
-        alpha = ufl.split(w)[1]
+        alpha = r.model.split(w)["twist"]
         tau = kinematics.twist(x, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
         T = kinematics.tension(x, c.sigma)  # (29)
         s = ufl.SpatialCoordinate(mesh)[0]
