@@ -53,13 +53,11 @@ class RodOperator:
         self._b = np.zeros(form.u.x.array.size)  # one rank: owned dofs only
         self.bc_dofs = form.bc_dofs  # one rank: every Dirichlet dof is owned
         # -- the layout: the rod's fields in X = (U, V, A) --------------------------------
-        _, alpha_dofs = compat.collapse(self.solver.rod.W.sub(1))
         self.e_alpha = np.zeros(3 * n)
-        self.e_alpha[np.asarray(alpha_dofs)] = 1.0  # a uniform twist of U
-        self.z_dofs = np.zeros(0, dtype=int)
-        if params.model.torsion_hysteresis.active:  # z and its V and A: carried (floquet.py)
-            _, z_dofs = compat.collapse(self.solver.rod.W.sub(2))
-            self.z_dofs = np.asarray(z_dofs, dtype=int)
+        self.e_alpha[self.solver.rod.dofs("twist")] = 1.0  # a uniform twist of U
+        # the model's internal variables (z of the hysteretic torsion) and their V and
+        # A: carried by the shooting (floquet.py); none without hysteresis
+        self.z_dofs = self.solver.rod.dofs("internal_twist")
         self.floor = self.solver.residual_floor()
         stationary = self.solver.state()
         self.offset = stationary.offset
