@@ -14,7 +14,7 @@ from rawehelix.references.spline_galerkin.basis import SplineBasis
 from rawehelix.references.spline_galerkin.system import SplineGalerkin
 from rawehelix.studies import modes as modes_study
 from rawehelix.studies import paper
-from rawehelix.studies import scene
+from rawehelix.studies import scene, schemes
 
 
 @pytest.fixture(scope="module")
@@ -235,7 +235,7 @@ def test_modes_run_fe_failure_leaves_no_output(tmp_path, monkeypatch):
 def test_modes_run_failure_leaves_no_output(tmp_path, monkeypatch):
     def boom(*a, **k):
         raise RuntimeError("Newton did not converge")
-    monkeypatch.setattr(modes_study, "spline_modes", boom)
+    monkeypatch.setattr(schemes.Spline, "spectrum", boom)
     params = scene.load("stationary_table2", scheme="spline", elements=2)
     with pytest.raises(RuntimeError):
         run_modes(params, tmp_path / "x")

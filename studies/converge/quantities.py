@@ -18,8 +18,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.families import VIBRATIONS
-from rawehelix.references.spline_galerkin import spectrum
-from rawehelix.studies import metrics
+from rawehelix.studies import metrics, schemes
 
 
 @dataclass(frozen=True)
@@ -74,16 +73,7 @@ def with_method(params: Parameters, method: Method, value) -> Parameters:
 def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
     """Stationary tension at s = 0 [N] (Sec. 5.1)."""
     p = with_method(params, method, value)
-    q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin import stationary
-        from rawehelix.references.spline_galerkin.system import SplineGalerkin
-        system = SplineGalerkin(q, p.discretisation.elements)
-        x = stationary.solve(system).x
-        return np.array([q.tension_N(system.tension(x, 0.0, s=np.array([0.0]))[0])])
-    from rawehelix.solvers.stationary import StationarySolver
-    result = StationarySolver(p, MPI.COMM_SELF).solve()
-    return np.array([q.tension_N(result.tension[0])])
+    return np.array([schemes.of(p).stationary_tension_N(p)])
 
 
 def _shooting_tension_s0(params: Parameters):
@@ -92,25 +82,11 @@ def _shooting_tension_s0(params: Parameters):
     return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
 
 
-def _fe_modes(p: Parameters) -> list:
-    """The FE modes (:class:`rawehelix.solvers.modal.Mode`) of the linearised
-    stationary state: the one modal call of the studies."""
-    from rawehelix.solvers.modal import ModalSolver
-    solver = ModalSolver.from_stationary(p, MPI.COMM_SELF)
-    return solver.solve(keep_vectors=False, require_families=False)
-
-
 def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
     """|lambda| [1/s] of the lowest mode of each family (Sec. 5.1, Table 3)."""
     p = with_method(params, method, value)
     q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin import stationary
-        from rawehelix.references.spline_galerkin.system import SplineGalerkin
-        system = SplineGalerkin(q, p.discretisation.elements)
-        modes = spectrum.modes(system, stationary.solve(system).x)
-    else:
-        modes = _fe_modes(p)
+    modes = schemes.of(p).spectrum(p, MPI.COMM_SELF, shapes=False).modes
     lowest = {}
     for m in modes:
         lam = abs(complex(m.eigenvalue)) / q.t_scale  # Eq. (25)
@@ -130,32 +106,8 @@ def _spin_series(params: Parameters, method: Method, value):
     5 ms, or at every step of a fixed-step (dt ladder) run: cutting its steps to
     land on the sample times would make every dt above 5 ms a 5 ms run."""
     p = with_method(params, method, value)
-    q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin.dynamics import time_series
-        ts = time_series(p, until_s=SPIN_RUN_S, output_every_s=SPIN_SAMPLE_S, rtol=1e-9)
-        return ts.time_s, ts.spin_rpm
-    from rawehelix.solvers.dynamics import DynamicsSolver
-    options = {"ts_type": method.ts_type} if method.ts_type else {}
-    if method.variable == "dt_s":
-        options["ts_adapt_type"] = "none"
-    else:  # adaptive steps, tight enough that space dominates the error
-        options.update({"ts_rtol": 1e-6, "ts_atol": 1e-6})
-    solver = DynamicsSolver.from_stationary(p, MPI.COMM_SELF, options=options)
-    rows = []
-
-    def sample(s):
-        v = s.probes.values()
-        rows.append((s.t, v["spin0"], v["spin_mid"], v["spin1"]))
-
-    if method.variable == "dt_s":
-        sample(solver)
-        solver.advance(SPIN_RUN_S / q.t_scale, on_step=sample)
-    else:
-        solver.advance(SPIN_RUN_S / q.t_scale, on_output=sample,
-                       output_every=SPIN_SAMPLE_S / q.t_scale)
-    rows = np.array(rows)
-    return q.time_s(rows[:, 0]), q.spin_rpm(rows[:, 1:])
+    return schemes.of(p).spin_series(p, SPIN_RUN_S, SPIN_SAMPLE_S, method.ts_type,
+                                     fixed_steps=method.variable == "dt_s")
 
 
 def spin_overshoot(params: Parameters, method: Method, value) -> np.ndarray:
@@ -191,17 +143,11 @@ def tension_max(params: Parameters, method: Method, value) -> np.ndarray:
     from rawehelix.solvers.periodic import periodic_response
     p = with_method(params, method, value).replace(
         sweep={"lead_in_s": 3.0, "periodic_tolerance": 5e-4})
-    if method.variable == "elements" and method.scheme == "fe":
+    scheme = schemes.of(p)
+    if method.variable == "elements" and scheme.fixed_time_step:
         p = p.replace(time={"dt_s": TENSION_MAX_SPACE_DT_S})
     q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin.forced import SplineBackend
-        backend = SplineBackend(q, p.discretisation.elements, rtol=1e-9, atol=1e-11)
-    else:
-        from rawehelix.solvers.forced import FEBackend
-        # full Newton: the study measures discretisation errors down to 1e-6
-        backend = FEBackend(p, MPI.COMM_SELF, options={
-            **FEBackend.FULL_NEWTON, **({"ts_type": method.ts_type} if method.ts_type else {})})
+    backend = scheme.forced_backend(p, MPI.COMM_SELF, accurate=True, ts_type=method.ts_type)
     result, _, _ = periodic_response(backend, q, TENSION_MAX_F1_HZ, backend.stationary(), 0.0,
                                      p.sweep, lead_in=True)
     return np.array([result.tension_max_N])
