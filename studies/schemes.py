@@ -208,7 +208,7 @@ class Spline(Scheme):
 
 #: every scheme by name
 SCHEME_REGISTRY: dict[str, Scheme] = {s.name: s for s in (FE(), Spline())}
-assert tuple(SCHEME_REGISTRY) == SCHEMES, "the registry and parameters.SCHEMES name the same schemes"
+assert tuple(SCHEME_REGISTRY) == SCHEMES, "the registry names the schemes of parameters.SCHEMES"
 
 
 def get(name: str) -> Scheme:

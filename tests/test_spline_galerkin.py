@@ -240,3 +240,23 @@ def test_modes_run_failure_leaves_no_output(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError):
         run_modes(params, tmp_path / "x")
     assert not (tmp_path / "x").exists()
+
+
+def test_scheme_registry_refuses_an_unknown_name_as_a_scene_does():
+    from rawehelix.parameters import SCHEMES, ParameterError
+    assert tuple(schemes.SCHEME_REGISTRY) == SCHEMES
+    with pytest.raises(ParameterError, match=r"must be one of \('fe', 'spline'\)"):
+        schemes.get("fd")
+    with pytest.raises(scene.SceneError, match=r"must be one of \('fe', 'spline'\)"):
+        scene.load("stationary_table2", scheme="fd")
+
+
+def test_both_schemes_of_the_registry_give_the_shooting_tension():
+    """T(0) of each scheme, asked of the registry, against the shooting reference."""
+    from rawehelix.references import shooting
+    for name, N in (("fe", 4), ("spline", 8)):
+        params = scene.load("stationary_table2", scheme=name, elements=N)
+        assert schemes.of(params).name == name
+        q = params.normalised()
+        expected = q.tension_N(shooting.solve(q).tension(0.0))
+        assert schemes.of(params).stationary_tension_N(params) == pytest.approx(expected, rel=1e-3)

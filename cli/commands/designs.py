@@ -19,9 +19,9 @@ def _converge_arguments(p):
 
 def _converge(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import converge
-    if args.quantity not in converge.quantities():
+    if args.quantity not in quantities.refined():
         raise SceneError("--quantity", args.quantity,
-                         f"is not one of {', '.join(converge.quantities())}")
+                         f"is not one of {', '.join(quantities.refined())}")
     converge.run(params, args.quantity, outdir, name=params.name,
                  log=lambda m: say(comm, m), comm=comm)
     return 0

@@ -1,7 +1,10 @@
-"""The quantities of the refinement studies: what each one evaluates, and the
-methods (refinement ladders) each one is run with.
+"""How the refinement studies evaluate a quantity: the methods (refinement
+ladders), one run of a method (:func:`with_method`, each scheme's evaluation
+asked of :mod:`rawehelix.studies.schemes`) and the ladders of each quantity.
+The quantities themselves, by name, are in the one registry
+:mod:`rawehelix.studies.quantities` (their :class:`Refinement`).
 
-A quantity is a function (params, method, ladder value) -> array of values
+An evaluator is a function (params, method, ladder value) -> array of values
 that computes no more than it needs: the stationary ones solve the
 stationary problem only, the modal one linearises about it and never
 integrates in time, the Sec. 5.2 ones integrate the spin-up, and T max the
@@ -38,10 +41,10 @@ class Method:
         return 1.0 / value if self.variable == "elements" else float(value)
 
 
-@dataclass
-class Quantity:
-    name: str
-    unit: str
+@dataclass(frozen=True)
+class Refinement:
+    """How ``rawehelix converge`` refines a quantity: its methods and reference."""
+
     methods: list
     reference: str  # label of the reference method (its finest run is the reference)
     evaluate: object  # (params, method, ladder value) -> np.ndarray of values
@@ -76,7 +79,7 @@ def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
     return np.array([schemes.of(p).stationary_tension_N(p)])
 
 
-def _shooting_tension_s0(params: Parameters):
+def shooting_tension_s0(params: Parameters):
     from rawehelix.references import shooting
     q = params.normalised()
     return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
@@ -172,35 +175,15 @@ TENSION_MAX_DTS = {"alpha2": (5e-4, 2.5e-4, 1.25e-4, 3.125e-5), "cn": (1e-3, 5e-
 DT_LADDER_ELEMENTS = 8
 
 
-def quantities() -> dict:
-    """Every quantity of ``rawehelix converge`` by name, with its methods."""
-    fe = [Method(f"FE p={p}", "fe", p, FE_LADDER) for p in (2, 3, 4)]
-    spline = Method("spline", "spline", None, SPLINE_LADDER)
-    N = DT_LADDER_ELEMENTS
-    return {
-        "tension_s0": Quantity("tension_s0", "N", fe + [spline], "FE p=4", tension_s0,
-                               ["T(0)"], _shooting_tension_s0),
-        "eigenvalues": Quantity("eigenvalues", "1/s",
-                                [Method(f"FE p={p}", "fe", p, (2, 4, 8, 16, 32)) for p in (2, 3, 4)]
-                                + [Method("spline", "spline", None, (2, 4, 8, 16))],
-                                "FE p=4", eigenvalues, list(VIBRATIONS)),
-        **{name: Quantity(name, unit, _dynamic_methods(ladder_fe, ladder_spline, dts, N), "FE p=4",
-                          fn, [label], time_reference=f"FE N={N} p=3 alpha2 (dt)",
-                          **(SPIN_SCALE if name == "spin_overshoot" else {}))
-           for name, unit, fn, label, ladder_fe, ladder_spline, dts in (
-               ("spin_overshoot", "rpm", spin_overshoot, "overshoot", (2, 4, 8, 16), (2, 4, 8),
-                SPIN_DTS),
-               ("settling_time", "s", settling_time, "settling", (2, 4, 8, 16), (2, 4, 8),
-                SPIN_DTS),
-               ("tension_max", "N", tension_max, "T max at 10 Hz", (4, 8, 16), (2, 3, 4, 6),
-                TENSION_MAX_DTS))},
-    }
+def space_methods(ladder: tuple, spline_ladder: tuple) -> list:
+    """FE p = 2, 3, 4 and the spline reference, refined in space (elements N)."""
+    return ([Method(f"FE p={p}", "fe", p, ladder) for p in (2, 3, 4)]
+            + [Method("spline", "spline", None, spline_ladder)])
 
 
-def _dynamic_methods(ladder_fe, ladder_spline, dts: dict, N: int) -> list:
+def dynamic_methods(ladder_fe, ladder_spline, dts: dict, N: int) -> list:
     """FE p = 2, 3, 4 in space (adaptive alpha2), the spline reference, and two
     TS schemes with fixed steps at N elements, p = 3 (the dt ladder)."""
-    return ([Method(f"FE p={p}", "fe", p, ladder_fe) for p in (2, 3, 4)]
-            + [Method("spline", "spline", None, ladder_spline)]
+    return (space_methods(ladder_fe, ladder_spline)
             + [Method(f"FE N={N} p=3 {ts} (dt)", "fe", 3, dts[ts], "dt_s", ts, N)
                for ts in ("alpha2", "cn")])
