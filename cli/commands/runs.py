@@ -9,12 +9,17 @@ from rawehelix.cli.commands.base import Command, say
 from rawehelix.studies.scene import SceneError
 
 
+def _written(comm, result, text: str, outdir, before: str = "\n  ") -> int:
+    """A run's files (``result.write``) and its report with where they are."""
+    result.write(outdir)
+    say(comm, text + f"{before}wrote {outdir}/")
+    return 0
+
+
 def _stationary(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import stationary
     result = rh.stationary(params, comm)
-    result.write(outdir)
-    say(comm, stationary.report(result) + f"\n  wrote {outdir}/")
-    return 0
+    return _written(comm, result, stationary.report(result), outdir)
 
 
 def _modes_arguments(p):
@@ -25,9 +30,7 @@ def _modes_arguments(p):
 def _modes(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import modes
     result = rh.modes(params, count=args.count, comm=comm)
-    result.write(outdir)
-    say(comm, modes.report(result) + f"\nwrote {outdir}/")
-    return 0
+    return _written(comm, result, modes.report(result), outdir, before="\n")
 
 
 def _simulate_arguments(p):
@@ -80,9 +83,7 @@ def _sweep(rh, params, args, outdir, comm) -> int:
 def _response(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import response
     result = rh.response(params, comm=comm)
-    result.write(outdir)
-    say(comm, response.report(result) + f"\n  wrote {outdir}/")
-    return 0
+    return _written(comm, result, response.report(result), outdir)
 
 
 def _orbits_arguments(p):
