@@ -10,8 +10,9 @@ import math
 import pytest
 from mpi4py import MPI
 
-from rawehelix.studies import converge, quantities, scene
+from rawehelix.studies import quantities, scene
 from rawehelix.studies.converge import Method
+from rawehelix.studies.converge import study as converge
 
 
 def study(tmp_path, quantity, scene_name, methods):

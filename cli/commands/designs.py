@@ -18,7 +18,7 @@ def _converge_arguments(p):
 
 
 def _converge(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import converge
+    from rawehelix.studies.converge import study as converge
     if args.quantity not in quantities.refined():
         raise SceneError("--quantity", args.quantity,
                          f"is not one of {', '.join(quantities.refined())}")

@@ -23,9 +23,11 @@ Modules, one job each:
 - :mod:`.study`: the loop over the ladders, errors and observed orders;
 - :mod:`.cache`: finished (and failed) runs in ``DIR/runs/``, for resuming;
 - :mod:`.report`: ``converge.csv``, ``converge.md``, ``work_precision.png``.
+
+The package imports only :mod:`.methods` (light: no PETSc), which the one
+registry of quantities imports; the study is :func:`.study.run`.
 """
 
 from rawehelix.studies.converge.methods import Method, Refinement
-from rawehelix.studies.converge.study import Run, run
 
-__all__ = ["Method", "Refinement", "Run", "run"]
+__all__ = ["Method", "Refinement"]

@@ -1,5 +1,5 @@
 """The report of a refinement study: ``converge.csv``, ``converge.md`` and
-``work_precision.png``, from the summary of :func:`rawehelix.studies.converge.run`.
+``work_precision.png``, from the summary of :func:`rawehelix.studies.converge.study.run`.
 
 The functions take data (the summary, the runs by method, the quantity) and
 return text or write one file; they never solve.
