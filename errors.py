@@ -1,4 +1,5 @@
-"""The two errors a user of rawehelix meets (no heavy imports: importable anywhere)."""
+"""The errors a user of rawehelix meets: bad input, a failed solve, an output file
+not written (no heavy imports: importable anywhere)."""
 
 
 class SceneError(ValueError):
@@ -15,6 +16,22 @@ class SceneError(ValueError):
 
 class SolverError(RuntimeError):
     """A solve failed; the message says what, where and what to try."""
+
+
+class OutputFault(OSError):
+    """A file of the output folder could not be written (exit status 1)."""
+
+    @classmethod
+    def of(cls, err: OSError, path) -> "OutputFault":
+        """``err`` (raised writing ``path``) as an OutputFault; one already is one."""
+        if isinstance(err, OutputFault):
+            return err
+        return cls(err.errno, err.strerror or str(err), str(err.filename or path))
+
+    def __str__(self):
+        return (f"{self.filename}: not written: {self.strerror} (errno {self.errno}); "
+                f"free space or use another -o directory, then run the same command again "
+                f"(every point stored so far is kept)")
 
 
 # -- Ctrl-C ------------------------------------------------------------------------------

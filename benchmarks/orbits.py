@@ -57,7 +57,7 @@ def _parts(stats: pstats.Stats) -> dict:
 
 def bench_point_cost(elements: int, points: int = 4) -> dict:
     """CPU time per continuation point, the former map against the chord one."""
-    from rawehelix.solvers.continuation import Branch
+    from rawehelix.studies.orbits import branch as Branch  # the study's observable and guards
     from rawehelix.solvers.orbits import AlphaMap
     from rawehelix.studies.orbits import LEAD_IN_PERIODS
 

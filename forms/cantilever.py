@@ -4,7 +4,7 @@ The segment is clamped on a wall at s = 0 and loaded at its free end s = 1.
 r(0) = 0 and alpha(0) = 0 are Dirichlet conditions (solvers/cantilever.py);
 the clamp's slope condition, the tangent along the wall's axis e, is a
 Nitsche term of the interior-penalty bending energy: the wall is a node whose
-outer side has the tangent e, so the node terms of forms/rod.py::bending
+outer side has the tangent e, so the node terms of forms/interior_penalty.py::bending
 (-{{r''}}.[[r']] + alpha_ip/2 |[[r']]|^2) get the boundary value [[r']] =
 (P r'(0)) n, n = -1 the outward normal and P = I - e e the projection normal
 to e (the dolfinx biharmonic demo's clamped-edge terms, in 1D):
@@ -39,30 +39,21 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms.extensible import unit_tangent
-from rawehelix.forms.kinematics import d
-
-
-def normal_part(f, axis):
-    """P f = f - (f.e) e: the part of f normal to the unit axis e."""
-    return f - ufl.dot(f, axis) * axis
-
 
 def wall_weight(mesh):
     """1 at s = 0 (the wall) and 0 at s = 1 (the free end): selects the wall in ds."""
     return 1 - ufl.SpatialCoordinate(mesh)[0]
 
 
-def clamp_energy(r, axis, mu, kinematics: str, degree: int, penalty, ds):
+def clamp_energy(r, axis, mu, kinematics, degree: int, penalty, ds):
     """U_clamp at the wall s = 0 (see above); ``mu`` (a number, constant or UFL
-    field) includes the bending switch, ``penalty`` is eta (discretisation.penalty)."""
+    field) includes the bending switch, ``penalty`` is eta (discretisation.penalty);
+    ``kinematics`` the component (c.kinematics): its jump and moment measure at
+    the wall, [[r']] n and r'' (paper) or [[t]] n and t' (extensible)."""
     mesh = ds.ufl_domain()
     n = ufl.FacetNormal(mesh)[0]
     alpha_ip = penalty * degree**2 / ufl.CellDiameter(mesh)
-    if kinematics == "extensible":
-        jump, moment = unit_tangent(r) - axis, d(unit_tangent(r))  # [[t]] n, t'
-    else:
-        jump, moment = normal_part(d(r), axis), d(r, 2)  # [[r']] n, r''
+    jump, moment = kinematics.clamp(r, axis)
     return wall_weight(mesh) * mu * (-ufl.dot(moment, jump) * n
                                      + 0.5 * alpha_ip * ufl.dot(jump, jump)) * ds
 

@@ -40,7 +40,7 @@ is the local mu(eps) of the state (EI(T) tau_b: "the elastic modulus x the
 retardation time"), at the nodes as {{mu b}} and {{mu}}.
 
 Discretisation (C0 Lagrange, interior penalty): D_b is the IP energy of the
-rate, as the elastic bending form is that of r (forms/rod.py::bending) or of t
+rate, as the elastic bending form is that of r (forms/interior_penalty.py::bending) or of t
 (forms/extensible.py),
 
     D_b = 1/2 int |b|^2 dx - sum_nodes {{b}}.[[j]]_t + alpha_ip/2 sum_nodes |[[j]]_t|^2,
@@ -49,49 +49,26 @@ with [[j]] the node jump of r' (paper) or t (extensible) and [[j]]_t =
 [[j_t]] - {{w}} x [[j]] its co-rotational rate.  About a straight state it is
 1/2 B(r_t, r_t) (paper) or U_b(t_t) (extensible): symmetric and coercive on
 the jumps like the elastic form.  The mixed bending form and the spline
-scheme are refused (parameters.py).
+scheme are refused (parameters/damping.py::check).
 """
 
 from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms import extensible
-from rawehelix.forms.kinematics import d, stretch, twist
-from rawehelix.forms.rod import Coefficients, ip_penalty, jump_d
+from rawehelix.forms.interior_penalty import ip_penalty
+from rawehelix.forms.kinematics import d, frenet_torsion_rate, tangent_rate, unit_tangent
 
 
-def tangent_rate(r, r_t):
-    """t_t = (I - t t) r_t' / |r'|, the rate of t = r'/|r'|."""
-    t = extensible.unit_tangent(r)
-    return (d(r_t) - ufl.dot(t, d(r_t)) * t) / stretch(r)
-
-
-def frenet_torsion_rate(r, r_t, eps):
-    """d gamma/dt along r_t of the regularised Frenet torsion of Eq. (34),
-    gamma = r'.(r'' x r''')/(|r''|^2 + eps^2) (forms/kinematics.py::frenet_torsion)."""
-    r1, r2, r3 = d(r), d(r, 2), d(r, 3)
-    u1, u2, u3 = d(r_t), d(r_t, 2), d(r_t, 3)
-    num = ufl.dot(r1, ufl.cross(r2, r3))
-    num_t = (ufl.dot(u1, ufl.cross(r2, r3)) + ufl.dot(r1, ufl.cross(u2, r3))
-             + ufl.dot(r1, ufl.cross(r2, u3)))
-    den = ufl.dot(r2, r2) + eps**2
-    return num_t / den - num * 2 * ufl.dot(r2, u2) / den**2
-
-
-def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
+def strain_rates(r, r_t, alpha_t, c, n):
     """(eps_t, tau_t, b, [[j]]_t) of the module docstring at the state r, each linear
     in (r_t, alpha_t); ``alpha_t`` None (the planar model): tau_t None."""
-    t, t_t = extensible.unit_tangent(r), tangent_rate(r, r_t)
+    t, t_t = unit_tangent(r), tangent_rate(r, r_t)
     w = ufl.cross(t, t_t)  # the tangent's spin
 
-    def jump(f):  # [[f]] at a node
-        return f("+") * n("+")[0] + f("-") * n("-")[0]
-
-    if c.kinematics == "extensible":  # q = t', [[j]] = [[t]]
-        q, q_t, j, j_t = d(t), d(t_t), jump(t), jump(t_t)
-    else:  # q = r'', [[j]] = [[r']]
-        q, q_t, j, j_t = d(r, 2), d(r_t, 2), jump_d(r, n), jump_d(r_t, n)
+    # the kinematics component's curvature measure: q = r'', [[j]] = [[r']] (paper)
+    # or q = t', [[j]] = [[t]] (extensible)
+    q, q_t, j, j_t = c.kinematics.bending_measure(r, r_t, t, t_t, n)
     b = q_t - ufl.cross(w, q)
     jb = j_t - ufl.cross(0.5 * (w("+") + w("-")), j)
     eps_t = ufl.dot(t, d(r_t))  # d|r'|/dt
@@ -100,39 +77,40 @@ def strain_rates(r, r_t, alpha_t, c: Coefficients, n):
     return eps_t, tau_t, b, jb
 
 
-def _bilinear(x, y, r, c: Coefficients, degree: int, penalty, measures):
+def _bilinear(x, y, r, c, degree: int, penalty, measures):
     """The symmetric form B(x, y) of D = 1/2 B(x, x), x = :func:`strain_rates` at the
     state r (which sets the bending modulus under the EI law)."""
     dx, dS, _ = measures
+    kv = c.damping  # the retardation times of the KelvinVoigt component
     (ea, ta, ba, ja), (eb, tb, bb, jb) = x, y
     alpha_ip = ip_penalty(degree, penalty, dS)
-    if c.bending_law:  # m_v = EI(T) tau_b b: the modulus at the nodes as in forms/extensible.py
-        mu = extensible.bending_modulus(r, c)
+    if c.bending_law.field:  # m_v = EI(T) tau_b b: the modulus at the nodes as in forms/extensible.py
+        mu = c.bending_law.modulus(r, c)
 
         def avg(f):
             return 0.5 * (f("+") + f("-"))
         B_b = (mu * ufl.dot(ba, bb) * dx
                + (-ufl.dot(avg(mu * ba), jb) - ufl.dot(avg(mu * bb), ja)
                   + alpha_ip * avg(mu) * ufl.dot(ja, jb)) * dS)
-        B = c.sigma * c.tau_a * ea * eb * dx + c.tau_b * B_b
+        B = c.sigma * kv.tau_a * ea * eb * dx + kv.tau_b * B_b
     else:
         B_b = (ufl.dot(ba, bb) * dx
                + (-ufl.dot(0.5 * (ba("+") + ba("-")), jb) - ufl.dot(0.5 * (bb("+") + bb("-")), ja)
                   + alpha_ip * ufl.dot(ja, jb)) * dS)
-        B = c.sigma * c.tau_a * ea * eb * dx + c.bending * c.mu * c.tau_b * B_b
+        B = c.sigma * kv.tau_a * ea * eb * dx + c.bending * c.mu * kv.tau_b * B_b
     if ta is not None:
-        B += c.beta * c.tau_t * ta * tb * dx
+        B += c.beta * kv.tau_t * ta * tb * dx
     return B
 
 
-def dissipation(r, r_t, alpha_t, c: Coefficients, degree: int, penalty, measures):
+def dissipation(r, r_t, alpha_t, c, degree: int, penalty, measures):
     """D of the module docstring at the state r and the rates (r_t, alpha_t);
     ``alpha_t`` None (the planar model) drops the torsion term."""
     x = strain_rates(r, r_t, alpha_t, c, ufl.FacetNormal(measures[0].ufl_domain()))
     return 0.5 * _bilinear(x, x, r, c, degree, penalty, measures)
 
 
-def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, penalty, measures):
+def viscous_residual(r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures):
     """dD/d(r_t, alpha_t) in the direction (v, delta/beta psi): the viscous forces.
 
     The rates are linear in (r_t, alpha_t), so this derivative is B(x(r_t, alpha_t),
@@ -144,3 +122,42 @@ def viscous_residual(r, r_t, alpha_t, v, psi, c: Coefficients, degree: int, pena
     x = strain_rates(r, r_t, None if planar else alpha_t, c, n)
     y = strain_rates(r, v, None if planar else c.delta / c.beta * psi, c, n)
     return _bilinear(x, y, r, c, degree, penalty, measures)
+
+
+class KelvinVoigt:
+    """The damping component (the scene's ``[damping]``, parameters/damping.py): its
+    retardation times / t_scale (numbers or constants) and its contributions, the
+    dissipation potential D and the viscous residual dD/dw_t.  It adds no field
+    and every solver runs it (its scene refusals: parameters/damping.py)."""
+
+    fields = ()
+    refuses = {}
+
+    def __init__(self, tau_a, tau_b, tau_t):
+        self.tau_a, self.tau_b, self.tau_t = tau_a, tau_b, tau_t
+
+    @classmethod
+    def from_normalised(cls, q, make=float):
+        """From :class:`rawehelix.parameters.Normalised`; the null object when all are 0."""
+        if not q.damped:
+            return NoneDamping()
+        return cls(make(q.tau_axial), make(q.tau_bending), make(q.tau_torsion))
+
+    def dissipation(self, r, r_t, alpha_t, c, degree: int, penalty, measures):
+        return dissipation(r, r_t, alpha_t, c, degree, penalty, measures)
+
+    def residual(self, r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures):
+        return viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
+
+
+class NoneDamping:
+    """No structural damping (the paper's model): no dissipation, no viscous force."""
+
+    fields = ()
+    refuses = {}
+
+    def dissipation(self, r, r_t, alpha_t, c, degree: int, penalty, measures):
+        return None
+
+    def residual(self, r, r_t, alpha_t, v, psi, c, degree: int, penalty, measures):
+        return 0

@@ -35,9 +35,9 @@ from __future__ import annotations
 
 import ufl
 
-from rawehelix.forms.kinematics import d, internal_force, stretch, tension, twist
-from rawehelix.forms import extensible, mixed
-from rawehelix.forms.rod import K_E, Coefficients, bending, ip_penalty
+from rawehelix.forms.coefficients import Coefficients
+from rawehelix.forms.kinematics import d, twist
+from rawehelix.forms.rod import K_E
 
 
 def kinetic(r_t, alpha_t, c: Coefficients, dx):
@@ -50,15 +50,10 @@ def potential(r, alpha, c: Coefficients, degree: int, penalty, measures, kappa=N
     B(r, r) = int |kappa|^2 with the curvature field ``kappa``."""
     dx, dS, _ = measures
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    if c.kinematics == "extensible":
-        return ((0.5 * c.beta * tau**2 - c.gravity * ufl.dot(K_E, r)) * dx
-                + extensible.rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS))
-    lam = stretch(r)
-    bend = (0.5 * bending(r, r, degree, penalty, dx, dS) if kappa is None
-            else mixed.energy(kappa, dx))
-    return ((c.sigma * (lam**3 / 3 - lam**2 / 2) + 0.5 * c.beta * tau**2
-             - c.gravity * ufl.dot(K_E, r)) * dx
-            + c.bending * c.mu * bend)
+    # stretch and bending: the kinematics component's (forms/paper.py, forms/extensible.py)
+    return ((0.5 * c.beta * tau**2 - c.gravity * ufl.dot(K_E, r)) * dx
+            + c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa)
+            + sum(comp.energy(r, c, dx) for comp in c.extra))  # forms/coefficients.py
 
 
 def non_variational_power(r, alpha, r_t, c: Coefficients, dx, kappa=None):
@@ -66,9 +61,5 @@ def non_variational_power(r, alpha, r_t, c: Coefficients, dx, kappa=None):
     P = int (T r' - F_NL) . r_t' = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t',
     with F_NL of Eq. (32) and its variational part T r'."""
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    if c.kinematics == "extensible":
-        f = -extensible.twist_coupling(r, tau, c.beta)
-    else:
-        f = (tension(r, c.sigma) * d(r)
-             - internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa))  # (29), (32)
+    f = c.kinematics.non_variational_force(r, tau, c, kappa=kappa)  # (29), (32)
     return ufl.inner(f, d(r_t)) * dx

@@ -34,7 +34,7 @@ The paper's -mu kappa^2 r' (the inextensibility's part of F_NL) has no place
 here: the variation of U takes its role.
 
 Discretisation: C0 Lagrange r, so t = r'/|r'| jumps at the nodes.  The
-interior-penalty energy of the dolfinx biharmonic demo (forms/rod.py::bending,
+interior-penalty energy of the dolfinx biharmonic demo (forms/interior_penalty.py::bending,
 whose symmetric form is the variation of 1/2 B(r, r) with [[r']] and {{r''}})
 is written on the unit tangent instead:
 
@@ -49,7 +49,7 @@ and lateral jumps).  The jump is taken of t, not of r': a stretch jump
 t' = 0 (zero moment, the extensible form of r'' = 0, Eq. 37) is natural, as
 in the paper's form.  The mixed form (forms/mixed.py) would need a Lagrange
 multiplier for kappa = r'' under a nonlinear energy; it is not offered
-(parameters.py refuses ``discretisation.bending = "mixed"``).
+(parameters/sections.py::check_kinematics refuses ``discretisation.bending = "mixed"``).
 
 Tension-dependent bending (``helix.EI_law``, EI = a T + b at the local
 tension T = EA eps, Eq. 64 and Fig. 4).  Normalised (parameters.Normalised:
@@ -72,7 +72,7 @@ moment mu t') and alpha_ip/2 {{mu}} |[[t]]|^2 (coercive while mu > 0, i.e.
 T > -b/a).  The energy is convex in (eps, kappa) while mu(eps) > mu_a^2
 sigma kappa^2 (the determinant of its Hessian); for Eq. (64) on Table 2 the
 right side is 2e-3 of the left.  The law is refused with the paper's
-kinematics (parameters.py): its forces are not the variation of an energy
+kinematics (parameters/eilaw.py::check): its forces are not the variation of an energy
 (the -mu kappa^2 r' of Eq. 32) and its bending acts on axial motion, so
 "the consistent axial term" has no meaning there.
 
@@ -90,12 +90,8 @@ from ufl.algorithms.apply_derivatives import apply_derivatives
 from ufl.algorithms.map_integrands import map_integrands
 from ufl.algorithms.transformer import strip_variables
 
-from rawehelix.forms.kinematics import d, stretch
-
-
-def unit_tangent(r):
-    """t = r'/|r'|."""
-    return d(r) / stretch(r)
+from rawehelix.forms.interior_penalty import ip_penalty, jump
+from rawehelix.forms.kinematics import d, stretch, unit_tangent
 
 
 def strain(r):
@@ -105,20 +101,18 @@ def strain(r):
 
 def bending_modulus(r, c):
     """The bending modulus of the stored energy, times the bending switch: mu,
-    or with the EI law (``c.bending_law``) mu(eps) = mu_a sigma eps + mu_b (see above)."""
-    if not c.bending_law:
-        return c.bending * c.mu
-    return c.bending * (c.mu_a * c.sigma * strain(r) + c.mu_b)
+    or with the EI law (``c.bending_law``, forms/eilaw.py) mu(eps) = mu_a sigma eps + mu_b (see above)."""
+    return c.bending_law.modulus(r, c)  # the EI-law component (forms/eilaw.py)
 
 
 def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
     """U = int sigma/2 eps^2 + mu U_b(t), U_b the interior-penalty energy of
     1/2 int |t'|^2 on the unit tangent (see above); ``alpha_ip`` the penalty
-    eta p^2 / h_avg (forms/rod.py::ip_penalty), ``mu`` includes the bending switch.
+    eta p^2 / h_avg (forms/interior_penalty.py::ip_penalty), ``mu`` includes the bending switch.
     ``field``: mu is a field (the EI law), taken at the nodes as {{mu t'}} and {{mu}}."""
     n = ufl.FacetNormal(dS.ufl_domain())
     t = unit_tangent(r)
-    jump_t = t("+") * n("+")[0] + t("-") * n("-")[0]  # [[t]] at a node
+    jump_t = jump(t, n)  # [[t]] at a node
     cells = (0.5 * sigma * strain(r)**2 + 0.5 * mu * ufl.dot(d(t), d(t))) * dx
     if field:
         avg_m = 0.5 * (mu("+") * d(t)("+") + mu("-") * d(t)("-"))  # {{mu t'}}
@@ -130,10 +124,10 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
 
 
 def rod_energy(r, c, alpha_ip, dx, dS):
-    """:func:`stored_energy` with the coefficients ``c`` (forms/rod.py::Coefficients):
+    """:func:`stored_energy` with the coefficients ``c`` (forms/coefficients.py::Coefficients):
     the bending modulus of :func:`bending_modulus`, built from ``r`` itself, so
     that its variation carries 1/2 mu'(eps) kappa^2."""
-    return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS, field=c.bending_law)
+    return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS, field=c.bending_law.field)
 
 
 def variation(energy, r, v, domain):
@@ -164,3 +158,33 @@ def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS):
     def energy(x):
         return rod_energy(x, c, alpha_ip, dx, dS)
     return variation(energy, r, v, dx.ufl_domain()) + ufl.inner(twist_coupling(r, tau, c.beta), d(v)) * dx
+
+
+class ExtensibleKinematics:
+    """The kinematics component ``model.kinematics = "extensible"``: the centre-line
+    forces are the variation of :func:`rod_energy` (see above), bending acts on t."""
+
+    name = "extensible"
+
+    def centre_line_residual(self, r, v, tau, c, degree: int, penalty, dx, dS, kappa=None, eta=None):
+        """delta U(r; v) + the twist coupling (IP bending only: no ``kappa``)."""
+        return centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
+
+    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None):
+        return rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS)
+
+    def non_variational_force(self, r, tau, c, kappa=None):
+        """-beta tau (r' x r''): the twist coupling, the one non-variational part of F_NL."""
+        return -twist_coupling(r, tau, c.beta)
+
+    def bending_measure(self, r, r_t, t, t_t, n):
+        """(q, q_t, [[j]], [[j]]_t) of forms/damping.py: q = t', [[j]] = [[t]]."""
+        return d(t), d(t_t), jump(t, n), jump(t_t, n)
+
+    def bending_modulus(self, r, c):
+        return bending_modulus(r, c)
+
+    def clamp(self, r, axis):
+        """([[t]] n, t') at a clamped wall (forms/cantilever.py)."""
+        t = unit_tangent(r)
+        return t - axis, d(t)

@@ -17,7 +17,7 @@ tau_t: a loop is a curve in the (tau, m) plane, whatever the speed).  A
 virgin material (z = 0) has the tangent GJ (rho + (1 - rho) A); loading
 saturates z at z_u = (A / (beta + gamma))^(1/n), and the loop is traversed
 clockwise in (tau, m) and dissipates (Wen's condition beta > 0, |gamma| <=
-beta, parameters.py).  rho = 1 is the paper's elastic rod.  Normalised like
+beta, parameters/hysteresis.py).  rho = 1 is the paper's elastic rod.  Normalised like
 the twist (tau~ = L0 tau, z~ = L0 z), so beta~ = beta / L0^n
 (parameters.Normalised).
 
@@ -64,12 +64,10 @@ compares with the scipy reference.
 
 from __future__ import annotations
 
-import ufl
-
 
 def moment(tau, z, c):
     """m = rho tau + (1 - rho) z: the torsional moment / GJ (normalised twist units)."""
-    return c.bw_rho * tau + (1 - c.bw_rho) * z
+    return c.hysteresis.moment(tau, z)
 
 
 def _power(x, n: float):
@@ -79,10 +77,11 @@ def _power(x, n: float):
 
 def rate(z, tau_t, c):
     """Bouc-Wen: z_t = A tau_t - beta |tau_t| |z|^(n-1) z - gamma tau_t |z|^n (Wen 1976)."""
-    n = c.bw_n
+    bw = c.hysteresis
+    n = bw.n
     z_abs = abs(z)
     odd = z if n == 1 else _power(z_abs, n - 1) * z  # |z|^(n-1) z
-    return c.bw_A * tau_t - c.bw_beta * abs(tau_t) * odd - c.bw_gamma * tau_t * _power(z_abs, n)
+    return bw.A * tau_t - bw.beta * abs(tau_t) * odd - bw.gamma * tau_t * _power(z_abs, n)
 
 
 def evolution_residual(z, z_t, tau_t, zeta, dx, c):
@@ -93,3 +92,57 @@ def evolution_residual(z, z_t, tau_t, zeta, dx, c):
 def virgin_residual(z, zeta, dx):
     """int z zeta: the stationary z = 0 (a state without a rate keeps the virgin z)."""
     return z * zeta * dx
+
+
+#: what the component cannot run with: solver -> (scene key, message) (models/base.py::refuse)
+REFUSES = {
+    "first_order": ("torsion_hysteresis",
+                    "runs with the second-order integrator only (-rawehelix_ts_type alpha2, the "
+                    "default): the first-order TS types are not set up for its internal twist z "
+                    "(forms/hysteresis.py)"),
+    "modal": ("torsion_hysteresis",
+              "the modal solver does not linearise the hysteretic torsion "
+              "(forms/hysteresis.py); it runs in time only ('simulate')"),
+}
+
+
+class BoucWen:
+    """The hysteresis component (the scene's ``[torsion_hysteresis]``,
+    parameters/hysteresis.py): its normalised rho, A, beta, gamma (numbers or
+    constants) and n (a number: it chooses the form's shape); it adds the field
+    z (``fields``), shares the moment with it and contributes z's equation."""
+
+    fields = ("internal_twist",)  # z on DG_(p-1), compat.rod_element(internal=True)
+    refuses = REFUSES
+
+    def __init__(self, rho, A, beta, gamma, n: float):
+        self.rho, self.A, self.beta, self.gamma, self.n = rho, A, beta, gamma, n
+
+    @classmethod
+    def from_normalised(cls, q, make=float):
+        """From :class:`rawehelix.parameters.Normalised`; the null object when rho = 1."""
+        if not q.hysteretic:
+            return NoneHysteresis()
+        return cls(make(q.bw_rho), make(q.bw_A), make(q.bw_beta), make(q.bw_gamma), q.bw_n)
+
+    def moment(self, tau, z):
+        return self.rho * tau + (1 - self.rho) * z
+
+    def residual(self, z, z_t, tau_t, zeta, dx, c):
+        """z's equation: the virgin z = 0 without a rate (``z_t`` or ``tau_t`` None)."""
+        if z_t is None or tau_t is None:
+            return virgin_residual(z, zeta, dx)
+        return evolution_residual(z, z_t, tau_t, zeta, dx, c)
+
+
+class NoneHysteresis:
+    """The paper's elastic moment GJ tau: no field, no equation, refuses nothing."""
+
+    fields = ()
+    refuses = {}
+
+    def moment(self, tau, z):
+        return tau
+
+    def residual(self, z, z_t, tau_t, zeta, dx, c):
+        return 0

@@ -79,3 +79,31 @@ def internal_force(r, tau, sigma, mu, beta, k=None):
     """F_NL = (T - mu kappa^2) r' + beta tau (r' x r''), Eq. (32)."""
     return (tension(r, sigma) - mu * curvature_squared(r, k)) * d(r) \
         + beta * tau * ufl.cross(d(r), curvature(r, k))
+
+
+def unit_tangent(r):
+    """t = r'/|r'|."""
+    return d(r) / stretch(r)
+
+
+def tangent_rate(r, r_t):
+    """t_t = (I - t t) r_t' / |r'|, the rate of t = r'/|r'|."""
+    t = unit_tangent(r)
+    return (d(r_t) - ufl.dot(t, d(r_t)) * t) / stretch(r)
+
+
+def frenet_torsion_rate(r, r_t, eps):
+    """d gamma/dt along r_t of the regularised Frenet torsion of Eq. (34),
+    gamma = r'.(r'' x r''')/(|r''|^2 + eps^2) (forms/kinematics.py::frenet_torsion)."""
+    r1, r2, r3 = d(r), d(r, 2), d(r, 3)
+    u1, u2, u3 = d(r_t), d(r_t, 2), d(r_t, 3)
+    num = ufl.dot(r1, ufl.cross(r2, r3))
+    num_t = (ufl.dot(u1, ufl.cross(r2, r3)) + ufl.dot(r1, ufl.cross(u2, r3))
+             + ufl.dot(r1, ufl.cross(r2, u3)))
+    den = ufl.dot(r2, r2) + eps**2
+    return num_t / den - num * 2 * ufl.dot(r2, u2) / den**2
+
+
+def normal_part(f, axis):
+    """P f = f - (f.e) e: the part of f normal to the unit axis e."""
+    return f - ufl.dot(f, axis) * axis

@@ -22,7 +22,7 @@ B) are instead the variation of the extensible rod's stored energy,
 :mod:`rawehelix.forms.extensible`; :func:`elastic_residual` is the one place
 that chooses.
 
-With ``[torsion_hysteresis]`` (``c.hysteretic``) the state has a third
+With ``[torsion_hysteresis]`` (``c.hysteresis``) the state has a third
 field, the Bouc-Wen internal twist z (a DG field), every GJ tau is the moment
 of :mod:`rawehelix.forms.hysteresis` and the residual has z's equation; the
 functions below see it as ``z`` (and its test ``zeta``).
@@ -33,79 +33,13 @@ and return UFL.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any
-
 import ufl
 
-from rawehelix.forms import extensible, mixed
-from rawehelix.forms.kinematics import d, internal_force, tension, twist
+from rawehelix.forms.coefficients import Coefficients
+from rawehelix.forms.kinematics import d, frenet_torsion_rate, tension, twist
 
 K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
 I_E = ufl.as_vector((1.0, 0.0, 0.0))  # i_E: the wind blows along -i_E
-
-
-@dataclass
-class Coefficients:
-    """The normalised groups of Eqs. (26)-(27) as UFL-ready values.
-
-    Each field is a number or a constant (for instance ``dolfinx.fem.Constant``)
-    so that a solver can change it (torques in time) without recompiling.
-    """
-
-    sigma: Any
-    mu: Any
-    beta: Any
-    nu: Any
-    delta: Any
-    v_w0: Any
-    m0: Any = 0.0  # torque at s = 0, Eq. (38)
-    mN: Any = 0.0  # torque at s = 1, Eq. (39)
-    gravity: Any = 1.0  # 1 switches gravity on, 0 off
-    drag: Any = 1.0
-    bending: Any = 1.0
-    gamma_eps: Any = 1.0e-3
-    gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
-    kinematics: str = "paper"  # model.kinematics: "extensible" is forms/extensible.py
-    # structural damping (forms/damping.py): retardation times / t_scale; ``damped``
-    # False leaves the viscous terms out of the forms altogether
-    tau_a: Any = 0.0
-    tau_b: Any = 0.0
-    tau_t: Any = 0.0
-    damped: bool = False
-    # the EI law (helix.EI_law, forms/extensible.py::bending_modulus): mu(eps) =
-    # mu_a sigma eps + mu_b; ``bending_law`` False: mu
-    mu_a: Any = 0.0
-    mu_b: Any = 0.0
-    bending_law: bool = False
-    # hysteretic torsion (forms/hysteresis.py): Bouc-Wen rho, A, beta, gamma
-    # (normalised) and the exponent n (a number: it chooses the form's shape);
-    # ``hysteretic`` False: no z field, the elastic moment
-    bw_rho: Any = 1.0
-    bw_A: Any = 1.0
-    bw_beta: Any = 0.0
-    bw_gamma: Any = 0.0
-    bw_n: float = 1.0
-    hysteretic: bool = False
-
-    @classmethod
-    def from_normalised(cls, q, model, make=float):
-        """From :class:`rawehelix.parameters.Normalised` and a scene's
-        ``model``; ``make`` wraps each number (e.g. into a dolfinx Constant)."""
-        return cls(
-            sigma=make(q.sigma), mu=make(q.mu), beta=make(q.beta), nu=make(q.nu),
-            delta=make(q.delta), v_w0=make(q.v_w0), m0=make(0.0), mN=make(0.0),
-            gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
-            gamma_eps=make(model.gamma_eps),
-            gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
-            kinematics=model.kinematics,
-            tau_a=make(q.tau_axial), tau_b=make(q.tau_bending), tau_t=make(q.tau_torsion),
-            damped=q.damped,
-            mu_a=make(q.mu_per_tension), mu_b=make(q.mu_at_zero_tension),
-            bending_law=q.bending_law,
-            bw_rho=make(q.bw_rho), bw_A=make(q.bw_A), bw_beta=make(q.bw_beta),
-            bw_gamma=make(q.bw_gamma), bw_n=q.bw_n, hysteretic=q.hysteretic,
-        )
 
 
 def quadrature_degree(degree: int, chosen: int = 0) -> int | None:
@@ -135,37 +69,6 @@ def measures(mesh, degree: int, chosen: int = 0):
     return (ufl.dx(domain=mesh, metadata=metadata), ufl.dS(domain=mesh), ufl.ds(domain=mesh))
 
 
-def jump_d(f, n):
-    """[[f']] = f'(+) n(+) + f'(-) n(-): the jump of the normal derivative at a node."""
-    return d(f)("+") * n("+")[0] + d(f)("-") * n("-")[0]
-
-
-def avg_d2(f):
-    """{{f''}}: the average of the second derivative at a node."""
-    return 0.5 * (d(f, 2)("+") + d(f, 2)("-"))
-
-
-def ip_penalty(degree: int, penalty, dS):
-    """The interior-penalty factor eta p^2 / h_avg at a node; eta is
-    ``discretisation.penalty``."""
-    h = ufl.CellDiameter(dS.ufl_domain())
-    return penalty * degree**2 / (0.5 * (h("+") + h("-")))
-
-
-def bending(r, v, degree: int, penalty, dx, dS):
-    """C0 interior-penalty form of int r''.v'' (the dolfinx biharmonic demo, in 1D).
-
-    The penalty eta p^2 / h_avg (:func:`ip_penalty`) scales with the degree
-    and the element size.
-    """
-    n = ufl.FacetNormal(dS.ufl_domain())
-    alpha_ip = ip_penalty(degree, penalty, dS)
-    return (ufl.inner(d(r, 2), d(v, 2)) * dx
-            - ufl.inner(avg_d2(r), jump_d(v, n)) * dS
-            - ufl.inner(jump_d(r, n), avg_d2(v)) * dS
-            + alpha_ip * ufl.inner(jump_d(r, n), jump_d(v, n)) * dS)
-
-
 def aerodynamic_force(r_t, c: Coefficients):
     """F~_A = -nu |v_A| v_A with v_A = r_t + v_w0 i_E, Eqs. (14) and (28).
 
@@ -192,43 +95,19 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     (IP bending only; the twist terms are the same)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    if z is not None:  # the moment / GJ, hysteretic (Fig. 5)
-        from rawehelix.forms import hysteresis
-        tau = hysteresis.moment(tau, z, c)
-    if c.kinematics == "extensible":  # stretch and bending from the stored energy
-        F = extensible.centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
-    elif kappa is None:
-        F = (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta), d(v)) * dx  # (32)
-             + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS))  # (33)
-    else:  # (33) and kappa = r'' with kappa = 0 at the ends (37), forms/mixed.py
-        F = (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta, k=kappa), d(v)) * dx
-             + c.bending * c.mu * mixed.bending_force(kappa, v, dx)
-             - c.mu * mixed.curvature_equation(r, kappa, eta, dx))
+    if z is not None:  # the moment / GJ of the hysteresis component (Fig. 5)
+        tau = c.hysteresis.moment(tau, z)
+    # the kinematics component: the paper's F_NL (32)-(33) (forms/paper.py) or the
+    # variation of the extensible rod's stored energy (forms/extensible.py)
+    F = c.kinematics.centre_line_residual(r, v, tau, c, degree, penalty, dx, dS,
+                                          kappa=kappa, eta=eta)
+    for comp in c.extra:  # the energy components (forms/energy_component.py): delta W(r; v)
+        F += comp.residual(r, v, c, dx)
     if psi is None:  # the planar model: no twist equation
         return F
     return (F + c.delta * tau * d(psi) * dx  # (31)
             # (38)-(39): tau(0) = m0, tau(1) = mN; x = 0 or 1 on the two ends
             - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)
-
-
-def residual(w, w_t, w_tt, test, c: Coefficients, degree: int, penalty, measures):
-    """The full residual of Eqs. (30)-(31): inertia + elastic - loads.
-
-    ``w``, ``w_t``, ``w_tt``: mixed (r, alpha) fields or their time
-    derivatives; ``w_tt = None`` gives the stationary residual (and ``w_t =
-    None`` zero velocity).  ``measures`` = (dx, dS, ds).  On the space
-    (r, alpha, kappa) of the mixed bending form the third field is kappa
-    (which has no rate: the rates' kappa parts are unused); on (r, alpha, z)
-    (``c.hysteretic``) it is the Bouc-Wen twist z, whose rate is read."""
-    r, alpha, *third = ufl.split(w)
-    r_t, alpha_t, *third_t = ufl.split(w_t) if w_t is not None else (None, None)
-    r_tt, alpha_tt = ufl.split(w_tt)[:2] if w_tt is not None else (None, None)
-    hysteretic = c.hysteretic and bool(third)
-    return residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, test_fields(test), c, degree,
-                              penalty, measures,
-                              kappa=third[0] if third and not hysteretic else None,
-                              alpha_t=alpha_t, z=third[0] if hysteretic else None,
-                              z_t=third_t[0] if hysteretic and third_t else None)
 
 
 def test_fields(test):
@@ -238,12 +117,13 @@ def test_fields(test):
 
 def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, degree: int,
                        penalty, measures, kappa=None, alpha_t=None, z=None, z_t=None):
-    """:func:`residual` on fields given one by one, so that (r, alpha) and
-    their rates may live in a larger mixed space (the first-order form of the
-    dynamics); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
+    """The full residual of Eqs. (30)-(31), inertia + elastic - loads + the
+    components' terms, on fields given one by one (the rod model,
+    models/unshearable.py, splits its state; the first-order form of the
+    dynamics has (r, alpha) and their rates in a larger space); ``r_t``/``r_tt``/``alpha_tt`` may be None (zero).  ``kappa``:
     the curvature field of the mixed bending form, with the test
     ``tests[2]``.  ``alpha_t``: the twist rate, read by the structural damping
-    (``c.damped``, forms/damping.py) and the hysteresis only.  ``z``, ``z_t``:
+    (``c.damping``, forms/damping.py) and the hysteresis only.  ``z``, ``z_t``:
     the Bouc-Wen twist and its rate, with the test ``tests[2]``
     (forms/hysteresis.py); ``z_t`` None (a stationary residual) holds z = 0."""
     dx, dS, ds = measures
@@ -255,17 +135,13 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
                           kappa=kappa, eta=third[0] if third and kappa is not None else None,
                           z=z)
          - ufl.inner(body_force(r_t, c), v) * dx)
-    if z is not None:  # the Bouc-Wen equation of z (forms/hysteresis.py)
-        from rawehelix.forms import damping, hysteresis  # (both build on this module)
-        if z_t is None or not moving:
-            F += hysteresis.virgin_residual(z, third[0], dx)
-        else:  # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate
-            tau_t = (c.gamma_coupling * damping.frenet_torsion_rate(r, r_t, c.gamma_eps)
-                     + d(alpha_t))
-            F += hysteresis.evolution_residual(z, z_t, tau_t, third[0], dx, c)
-    if c.damped and moving:  # Kelvin-Voigt, from the dissipation potential
-        from rawehelix.forms import damping  # (damping builds on this module)
-        F += damping.viscous_residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
+    if z is not None:  # z's equation, of the hysteresis component (forms/hysteresis.py)
+        # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate (None at rest)
+        tau_t = (c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps) + d(alpha_t)
+                 if moving and z_t is not None else None)
+        F += c.hysteresis.residual(z, z_t, tau_t, third[0], dx, c)
+    if moving:  # the damping component: Kelvin-Voigt from its dissipation potential, or none
+        F += c.damping.residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
     return F

@@ -31,7 +31,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.forms import cantilever, extensible, kinematics
+from rawehelix.forms import cantilever, kinematics
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import petsc_options
 from rawehelix.solvers.discrete import RodDiscretisation
@@ -56,14 +56,15 @@ class CantileverRod(RodDiscretisation):
 
     def _set_up_end_conditions(self, pin_twist: bool):
         wall = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 0.0))
-        self.V_r, _ = compat.collapse(self.W.sub(0))
-        self.V_a, _ = compat.collapse(self.W.sub(1))
+        W_r, W_a = self.sub("centre_line"), self.sub("twist")  # the model's fields
+        self.V_r, _ = compat.collapse(W_r)
+        self.V_a, _ = compat.collapse(W_a)
         self.r_bottom = dolfinx.fem.Function(self.V_r)
         self.alpha_zero = dolfinx.fem.Function(self.V_a)
-        dofs_r = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, wall)
-        dofs_a = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, wall)
-        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_r, self.W.sub(0)),
-                    dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, self.W.sub(1))]
+        dofs_r = dolfinx.fem.locate_dofs_topological((W_r, self.V_r), 0, wall)
+        dofs_a = dolfinx.fem.locate_dofs_topological((W_a, self.V_a), 0, wall)
+        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_r, W_r),
+                    dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, W_a)]
         self.twist_bcs = self.curvature_bcs = []
 
 
@@ -82,12 +83,12 @@ class CantileverSolver:
         self.force = dolfinx.fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
         axis = ufl.as_vector(AXIS)
         x = r.centre_line()
-        mu = extensible.bending_modulus(x, c) if c.kinematics == "extensible" else c.bending * c.mu
+        mu = c.kinematics.bending_modulus(x, c)  # with the EI law: mu(eps), forms/eilaw.py
         U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)
         self.newton = NewtonSolver(F, w, r.bcs, prefix=petsc_options.LABTEST_PREFIX)
-        alpha = ufl.split(w)[1]
+        alpha = r.model.split(w)["twist"]
         tau = kinematics.twist(x, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
         T = kinematics.tension(x, c.sigma)  # (29)
         s = ufl.SpatialCoordinate(mesh)[0]
@@ -103,16 +104,16 @@ class CantileverSolver:
         mu = EI_Nm2 / (q.force_scale * q.L0**2)  # (26)
         c.mu.value = mu
         c.delta.value = q.beta * q.sigma / (2 * mu)
-        if c.bending_law:
+        if c.bending_law.field:
             self.set_bending_law(0.0, EI_Nm2)
 
     def set_bending_law(self, a_Nm2_per_N: float, b_Nm2: float):
         """The EI law EI = a T + b of a rod built with one (parameters.Normalised)."""
         q, c = self.q, self.rod.c
-        if not c.bending_law:
+        if not c.bending_law.field:
             raise ValueError("set_bending_law needs a rod built with helix.EI_law")
-        c.mu_a.value = a_Nm2_per_N / q.L0**2
-        c.mu_b.value = b_Nm2 / (q.force_scale * q.L0**2)
+        c.bending_law.mu_a.value = a_Nm2_per_N / q.L0**2
+        c.bending_law.mu_b.value = b_Nm2 / (q.force_scale * q.L0**2)
 
     def _set_loads(self, force_N, torque_Nm: float):
         self.force.value[:] = np.asarray(force_N, dtype=float) / self.q.force_scale

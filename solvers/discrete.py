@@ -24,6 +24,7 @@ from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.state import RodState
 from rawehelix.forms import rod
+from rawehelix.models.unshearable import UnshearableRod
 from rawehelix.parameters import Parameters
 from rawehelix.meshes import interval
 
@@ -40,11 +41,11 @@ class RodDiscretisation:
         self.comm = comm
         self.degree = disc.degree
         self.penalty = disc.penalty
-        self.mixed = disc.bending == "mixed"  # the curvature field kappa, forms/mixed.py
+        self.model = model = UnshearableRod(params)  # its fields and forms, models/
+        self.mixed = model.has("curvature")  # the curvature field kappa, forms/mixed.py
+        self.hysteretic = model.has("internal_twist")  # z, forms/hysteresis.py
         self.mesh = interval.mesh_from_parameters(comm, params)
-        self.hysteretic = params.model.torsion_hysteresis.active  # z, forms/hysteresis.py
-        self.W = compat.function_space(self.mesh, compat.rod_element(
-            self.mesh.ufl_cell(), self.degree, curvature=self.mixed, internal=self.hysteretic))
+        self.W = compat.function_space(self.mesh, model.element(self.mesh.ufl_cell(), self.degree))
         self.w = dolfinx.fem.Function(self.W, name="state")
         self.test = ufl.TestFunction(self.W)
         self.trial = ufl.TrialFunction(self.W)
@@ -54,39 +55,50 @@ class RodDiscretisation:
         self._set_up_end_conditions(pin_twist)
 
     # -- end conditions, Eqs. (35), (36), (66), (70) ------------------------------
+    def sub(self, role: str):
+        """The sub-space of the field ``role`` (models/base.py::ROLES) in W."""
+        return self.W.sub(self.model.index(role))
+
+    def dofs(self, role: str) -> np.ndarray:
+        """The dofs of W (this rank's local indices) of the field ``role``; none if the
+        model has no such field (the internal twist without hysteresis)."""
+        if not self.model.has(role):
+            return np.zeros(0, dtype=int)
+        return np.asarray(compat.collapse(self.sub(role))[1], dtype=int)
+
     def _set_up_end_conditions(self, pin_twist: bool):
+        """The model's end conditions (models/unshearable.py) as dolfinx bcs:
+        ``bcs`` all of them, ``twist_bcs`` alpha = 0 everywhere (model.twist =
+        false), ``curvature_bcs`` kappa = 0 at the ends (mixed form)."""
         mesh = self.mesh
-        bottom = compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 0.0))
-        top = compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 1.0))
-        self.V_r, _ = compat.collapse(self.W.sub(0))
+        vertices = {"bottom": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 0.0)),
+                    "top": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 1.0))}
+        vertices["ends"] = np.concatenate([vertices["bottom"], vertices["top"]]).astype(np.int32)
+        self.V_r, _ = compat.collapse(self.sub("centre_line"))
         self.r_bottom = dolfinx.fem.Function(self.V_r)  # r(0) = 0, Eq. (35)
         self.r_top = dolfinx.fem.Function(self.V_r)  # r(1) = r_N(t), Eq. (36)
         self.set_top_position(self.q.top_position(0.0))
-        dofs_b = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, bottom)
-        dofs_t = dolfinx.fem.locate_dofs_topological((self.W.sub(0), self.V_r), 0, top)
-        self.end_dofs = {"bottom": dofs_b, "top": dofs_t}  # centre-line dofs (W, V_r)
-        self.bcs = [dolfinx.fem.dirichletbc(self.r_bottom, dofs_b, self.W.sub(0)),
-                    dolfinx.fem.dirichletbc(self.r_top, dofs_t, self.W.sub(0))]
-        self.V_a, _ = compat.collapse(self.W.sub(1))
+        self.V_a, _ = compat.collapse(self.sub("twist"))
         self.alpha_zero = dolfinx.fem.Function(self.V_a)
-        # model.twist = false: no twist field, alpha = 0 on every dof (the scene
-        # is torque-free, which Parameters checks); the solvers add these bcs
-        self.twist_bcs = [] if self.params.model.twist else [dolfinx.fem.dirichletbc(
-            self.alpha_zero, self.all_dofs(self.W.sub(1), self.V_a), self.W.sub(1))]
-        if pin_twist:
-            # alpha(0) = 0 removes the free rigid rotation (torque-free ends)
-            dofs_a = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, bottom)
-            self.bcs.append(dolfinx.fem.dirichletbc(self.alpha_zero, dofs_a, self.W.sub(1)))
-        self.bcs += self.twist_bcs
-        self.curvature_bcs = []
-        if self.mixed:  # kappa(0) = kappa(1) = 0, Eq. (37), essential
-            self.V_k, self._kappa_dofs = compat.collapse(self.W.sub(2))
+        spaces = {"centre_line": self.V_r, "twist": self.V_a}
+        zeros = {"centre_line": self.r_bottom, "twist": self.alpha_zero}
+        if self.mixed:
+            self.V_k, self._kappa_dofs = compat.collapse(self.sub("curvature"))
             self.kappa_zero = dolfinx.fem.Function(self.V_k)
-            ends = np.concatenate([bottom, top]).astype(np.int32)
-            dofs_k = dolfinx.fem.locate_dofs_topological((self.W.sub(2), self.V_k), 0, ends)
-            self.curvature_bcs = [dolfinx.fem.dirichletbc(self.kappa_zero, dofs_k, self.W.sub(2))]
+            spaces["curvature"], zeros["curvature"] = self.V_k, self.kappa_zero
             self._curvature_problem = None
-        self.bcs += self.curvature_bcs
+        self.bcs, self.twist_bcs, self.curvature_bcs, self.end_dofs = [], [], [], {}
+        for end in self.model.end_conditions(pin_twist):
+            W_sub, V = self.sub(end.role), spaces[end.role]
+            dofs = (self.all_dofs(W_sub, V) if end.where == "all" else
+                    dolfinx.fem.locate_dofs_topological((W_sub, V), 0, vertices[end.where]))
+            bc = dolfinx.fem.dirichletbc(self.r_top if end.value == "top_position"
+                                         else zeros[end.role], dofs, W_sub)
+            if end.role == "centre_line":
+                self.end_dofs[end.where] = dofs  # centre-line dofs (W, V_r)
+            (self.twist_bcs if end.where == "all" else
+             self.curvature_bcs if end.role == "curvature" else self.bcs).append(bc)
+        self.bcs += self.twist_bcs + self.curvature_bcs
 
     def end_twist_conditions(self):
         """alpha(0) = 0 and alpha(1) = ``self.alpha_top`` (a Function, set by the
@@ -96,8 +108,8 @@ class RodDiscretisation:
         bcs = []
         for x_end, g in ((0.0, self.alpha_zero), (1.0, self.alpha_top)):
             vertices = compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], x_end))
-            dofs = dolfinx.fem.locate_dofs_topological((self.W.sub(1), self.V_a), 0, vertices)
-            bcs.append(dolfinx.fem.dirichletbc(g, dofs, self.W.sub(1)))
+            dofs = dolfinx.fem.locate_dofs_topological((self.sub("twist"), self.V_a), 0, vertices)
+            bcs.append(dolfinx.fem.dirichletbc(g, dofs, self.sub("twist")))
         return bcs
 
     def all_dofs(self, W_sub, V_collapsed):
@@ -127,16 +139,16 @@ class RodDiscretisation:
         """w <- the straight chord r = s r_N, alpha = 0: the default first guess."""
         w = w or self.w
         top = self.q.top_position(0.0)
-        w.sub(0).interpolate(lambda x: np.outer(top, x[0]))
-        w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
+        w.sub(self.model.index("centre_line")).interpolate(lambda x: np.outer(top, x[0]))
+        w.sub(self.model.index("twist")).interpolate(lambda x: np.zeros(x.shape[1]))
         w.x.scatter_forward()
         self.update_curvature(w)
 
     def set_centre_line(self, centre_line, w=None):
         """w <- (r(s) from a callable s -> (n, 3), alpha = 0)."""
         w = w or self.w
-        w.sub(0).interpolate(lambda x: np.asarray(centre_line(x[0])).T)
-        w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
+        w.sub(self.model.index("centre_line")).interpolate(lambda x: np.asarray(centre_line(x[0])).T)
+        w.sub(self.model.index("twist")).interpolate(lambda x: np.zeros(x.shape[1]))
         w.x.scatter_forward()
         self.update_curvature(w)
 
@@ -152,25 +164,25 @@ class RodDiscretisation:
         self._curvature_problem.apply(w or self.w)
 
     def centre_line(self):
-        """r as UFL (the first field of the state)."""
-        return ufl.split(self.w)[0]
+        """r as UFL (the model's centre line)."""
+        return self.model.split(self.w)["centre_line"]
 
     def curvature(self):
         """kappa as UFL (mixed bending form), or None: r'' is then cellwise."""
-        return ufl.split(self.w)[2] if self.mixed else None
+        return self.model.split(self.w)["curvature"]
 
     def internal_twist(self, w=None):
         """z as UFL (hysteretic torsion, forms/hysteresis.py), or None."""
-        return ufl.split(w or self.w)[2] if self.hysteretic else None
+        return self.model.split(w or self.w)["internal_twist"]
 
     def gather_centre_line(self):
         """(s, r (n, 3)) at the Lagrange nodes on rank 0 ((None, None) elsewhere)."""
-        return fields.gather(self.w.sub(0).collapse())
+        return fields.gather(self.w.sub(self.model.index("centre_line")).collapse())
 
     def stationary_residual(self, w=None):
         w = w or self.w
-        return rod.residual(w, None, None, self.test, self.c, self.degree, self.penalty,
-                            self.measures)
+        return self.model.residual(w, None, None, self.test, self.c, self.degree, self.penalty,
+                                   self.measures)
 
     def dof_count(self) -> int:
         im = self.W.dofmap.index_map

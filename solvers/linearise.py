@@ -5,7 +5,7 @@ About a state w0, a small motion w = w0 + x e^{lambda t} obeys
     (lambda^2 M + lambda C + K) x = 0,                                 (*)
 
 with the three Jacobians of the full residual F(w, w_t, w_tt; v) of
-Eqs. (30)-(31) (:func:`rawehelix.forms.rod.residual`):
+Eqs. (30)-(31) (:meth:`rawehelix.models.unshearable.UnshearableRod.residual`):
 
     K = dF/dw     at (w0, 0, 0)   elastic + geometric stiffness (32)-(34),
     C = dF/dw_t   at (w0, 0, 0)   the linearised drag of Eq. (28) and the
@@ -36,7 +36,6 @@ conditions kappa = 0 (37) are in the bcs like the displacement's.
 
 from __future__ import annotations
 
-import dataclasses
 
 import ufl
 from mpi4py import MPI
@@ -44,8 +43,6 @@ from mpi4py import MPI
 import dolfinx.fem
 import dolfinx.fem.petsc
 
-from rawehelix.errors import SceneError
-from rawehelix.forms import rod as rod_forms
 from rawehelix.forms.kinematics import d
 from rawehelix.solvers.state import RodState
 
@@ -63,30 +60,28 @@ class Linearisation:
     evaluates them about a state."""
 
     def __init__(self, rod):
-        if rod.hysteretic:  # forms/hysteresis.py: z = A tau about z = 0, not separated here
-            raise SceneError(rod.params.name, "torsion_hysteresis",
-                             "the modal solver does not linearise the hysteretic torsion "
-                             "(forms/hysteresis.py); it runs in time only ('simulate')")
+        rod.model.refuse("modal", rod.params.name)  # hysteresis: z = A tau about z = 0
         self.rod = rod
         # separate fields for w, w_t, w_tt: the three Jacobians of F at (w0, 0, 0)
         self.w_t = dolfinx.fem.Function(rod.W, name="velocity")
         self.w_tt = dolfinx.fem.Function(rod.W, name="acceleration")
-        F = rod_forms.residual(rod.w, self.w_t, self.w_tt, rod.test, rod.c, rod.degree,
+        F = rod.model.residual(rod.w, self.w_t, self.w_tt, rod.test, rod.c, rod.degree,
                                rod.penalty, rod.measures)  # (30)-(31)
         du = rod.trial
         # structural damping (forms/damping.py): its forces are linear in the rates, so
         # they add nothing to K at w_t = 0; K is taken of the residual without them
         # (the same K, for a fraction of the assembly)
-        F_K = F if not rod.c.damped else rod_forms.residual(
-            rod.w, self.w_t, self.w_tt, rod.test, dataclasses.replace(rod.c, damped=False),
-            rod.degree, rod.penalty, rod.measures)
+        F_K = rod.model.residual(rod.w, self.w_t, self.w_tt, rod.test,
+                                 rod.model.conservative(rod.c), rod.degree, rod.penalty,
+                                 rod.measures)
         self.a_K = dolfinx.fem.form(ufl.derivative(F_K, rod.w, du))
         self.a_C = dolfinx.fem.form(ufl.derivative(F, self.w_t, du))
         self.a_M = dolfinx.fem.form(ufl.derivative(F, self.w_tt, du))
         self.bcs = self._fixed_ends()
         self.a_energy = {kind: {k: dolfinx.fem.form(a) for k, a in forms.items()}
                          for kind, forms in self._energy_forms().items()}
-        self.a_tension = dolfinx.fem.form(rod_forms.tension_of(rod.w, rod.c) * rod.measures[0])
+        self.a_tension = dolfinx.fem.form(rod.model.tension(rod.model.split(rod.w), rod.c)
+                                          * rod.measures[0])
         self.K = self.C = self.M = self.energy = None
         self.mean_tension = None
 
@@ -96,15 +91,16 @@ class Linearisation:
         model.twist = false holds alpha = 0."""
         rod = self.rod
         zero = dolfinx.fem.Function(rod.V_r)
-        return [dolfinx.fem.dirichletbc(zero, dofs, rod.W.sub(0))
+        return [dolfinx.fem.dirichletbc(zero, dofs, rod.sub("centre_line"))
                 for dofs in rod.end_dofs.values()] + rod.twist_bcs + rod.curvature_bcs
 
     def _energy_forms(self) -> dict:
         rod = self.rod
         dx = rod.measures[0]
-        r0 = ufl.split(rod.w)[0]
-        u, a = ufl.split(rod.trial)[:2]
-        v, b = ufl.split(rod.test)[:2]
+        model = rod.model
+        r0 = model.split(rod.w)["centre_line"]
+        u, a = (model.split(rod.trial)[role] for role in ("centre_line", "twist"))
+        v, b = (model.split(rod.test)[role] for role in ("centre_line", "twist"))
         t = d(r0) / ufl.sqrt(ufl.dot(d(r0), d(r0)))  # local tangent of the state
         j = ufl.as_vector((0.0, 1.0, 0.0))
         n = ufl.cross(j, t)

@@ -2,13 +2,13 @@
 
 Second order (TSALPHA2), unknown U = (r, alpha) on the mixed space W:
 
-    F(t, U, V, A) = rod.residual(U, V, A)                 (30)-(31)
+    F(t, U, V, A) = model.residual(U, V, A)               (30)-(31), models/unshearable.py
     J = dF/dU + v_shift dF/dV + a_shift dF/dA             (I2Jacobian)
 
 First order (theta, bdf, arkimex, ... : IFunction), unknown X = (r, alpha,
 r_t, alpha_t) on a doubled mixed space:
 
-    G(t, X, X_t) = int (r_t - v_r).w + (alpha_t - omega) chi + rod.residual(r, alpha; v_r, v_r_t, omega_t)
+    G(t, X, X_t) = int (r_t - v_r).w + (alpha_t - omega) chi + model.residual(r, alpha; v_r, v_r_t, omega_t)
     J = dG/dX + shift dG/dX_t                            (IJacobian)
 
 Both put the ground torque of the controller into the form as a UFL
@@ -48,9 +48,9 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.errors import SceneError
 from rawehelix.solvers.fields import set_constant
-from rawehelix.forms import damping, energy, rod
+from rawehelix.forms import rod
+from rawehelix.models.unshearable import PAIR_ROLES
 from rawehelix.solvers.discrete import RodDiscretisation
 
 
@@ -62,6 +62,20 @@ class Fields:
     def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
         self.kappa, self.z = kappa, z
+
+    @classmethod
+    def of(cls, model, u, v):
+        """The views of the state ``u`` and its rate ``v`` on ``model``'s space
+        (models/base.py): the roles' fields under the paper's names."""
+        f, f_t = model.split(u), model.split(v)
+        return cls(f["centre_line"], f["twist"], f_t["centre_line"], f_t["twist"],
+                   f["curvature"], f["internal_twist"])
+
+    def roles(self) -> tuple[dict, dict]:
+        """(fields, rates) by role, as the model's forms take them."""
+        return ({"centre_line": self.r, "twist": self.alpha, "curvature": self.kappa,
+                 "internal_twist": self.z},
+                {"centre_line": self.r_t, "twist": self.alpha_t})
 
 
 def controller_torque(c: rod.Coefficients, q, fields: Fields, time, offset):
@@ -99,18 +113,16 @@ class _Formulation:
         self.F = dolfinx.fem.form(F)
         self.J = dolfinx.fem.form(J)
         self.fields = fields
-        dx = self.rod.measures[0]
-        self.kinetic = dolfinx.fem.form(energy.kinetic(fields.r_t, fields.alpha_t, self.rod.c, dx))
-        self.potential = dolfinx.fem.form(energy.potential(
-            fields.r, fields.alpha, self.rod.c, self.rod.degree, self.rod.penalty,
-            self.rod.measures, kappa=fields.kappa))
-        self.power_nv = dolfinx.fem.form(energy.non_variational_power(
-            fields.r, fields.alpha, fields.r_t, self.rod.c, dx, kappa=fields.kappa))
+        rod_, model = self.rod, self.rod.model
+        dx = rod_.measures[0]
+        f, f_t = fields.roles()
+        self.kinetic = dolfinx.fem.form(model.kinetic_energy(f_t, rod_.c, dx))
+        self.potential = dolfinx.fem.form(model.stored_energy(
+            f, rod_.c, rod_.degree, rod_.penalty, rod_.measures))
+        self.power_nv = dolfinx.fem.form(model.non_variational_power(f, f_t, rod_.c, dx))
         # 2 D, the power of the structural damping (forms/damping.py); None: undamped
-        self.dissipation = None if not self.rod.c.damped else dolfinx.fem.form(
-            2 * damping.dissipation(fields.r, fields.r_t, fields.alpha_t,
-                                    self.rod.c, self.rod.degree, self.rod.penalty,
-                                    self.rod.measures))
+        D = model.dissipation(f, f_t, rod_.c, rod_.degree, rod_.penalty, rod_.measures)
+        self.dissipation = None if D is None else dolfinx.fem.form(2 * D)
         self.b = compat.create_vector(self.F)
         self._scratch = self.b.duplicate()
         owned = self.b.getLocalSize()
@@ -195,13 +207,10 @@ class SecondOrder(_Formulation):
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.shift_v = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
         self.shift_a = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
-        r, alpha, *third = ufl.split(self.u)  # kappa (mixed bending) or z (hysteresis)
-        r_t, alpha_t = ufl.split(self.v)[:2]
-        fields = Fields(r, alpha, r_t, alpha_t, third[0] if rod_.mixed else None,
-                        third[0] if rod_.hysteretic else None)
+        fields = Fields.of(rod_.model, self.u, self.v)
         c_dyn = self._coefficients(fields)
-        F = rod.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree, rod_.penalty,
-                         rod_.measures)
+        F = rod_.model.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree,
+                                rod_.penalty, rod_.measures)
         J = (ufl.derivative(F, self.u, rod_.trial)
              + self.shift_v * ufl.derivative(F, self.v, rod_.trial)
              + self.shift_a * ufl.derivative(F, self.a, rod_.trial))
@@ -253,33 +262,23 @@ class FirstOrder(_Formulation):
     second_order = False
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
-        if rod_.hysteretic:
-            raise SceneError(
-                rod_.params.name, "torsion_hysteresis",
-                "runs with the second-order integrator only (-rawehelix_ts_type alpha2, the "
-                "default): the first-order TS types are not set up for its internal twist z "
-                "(forms/hysteresis.py)")
-        if rod_.mixed:
-            raise SceneError(
-                rod_.params.name, "discretisation.bending",
-                "'mixed' runs with the second-order integrator "
-                "only (-rawehelix_ts_type alpha2, the default): the first-order TS types "
-                "are not set up for its algebraic curvature field")
+        model = rod_.model
+        model.refuse("first_order", rod_.params.name)  # models/unshearable.py
         mesh = rod_.mesh
-        self.W2 = compat.function_space(mesh, compat.rod_pair_element(mesh.ufl_cell(), rod_.degree))
+        self.W2 = compat.function_space(mesh, model.pair_element(mesh.ufl_cell(), rod_.degree))
         self.x = dolfinx.fem.Function(self.W2, name="state")
         self.x_t = dolfinx.fem.Function(self.W2, name="rate")
         super().__init__(rod_, self._end_conditions(rod_))
         self.shift = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
-        r, alpha, v_r, omega = ufl.split(self.x)
-        r_t, alpha_t, v_r_t, omega_t = ufl.split(self.x_t)
-        w_r, chi, v, psi = ufl.split(ufl.TestFunction(self.W2))
-        fields = Fields(r, alpha, v_r, omega)
+        f, vel = model.split_pair(self.x)  # X = (fields, velocities)
+        f_t, acc = model.split_pair(self.x_t)  # X_t = (rates, accelerations)
+        tests, tests_v = model.split_pair(ufl.TestFunction(self.W2))
+        fields = Fields(f["centre_line"], f["twist"], vel["centre_line"], vel["twist"])
         c_dyn = self._coefficients(fields)
         dx = rod_.measures[0]
-        F = (ufl.inner(r_t - v_r, w_r) + (alpha_t - omega) * chi) * dx \
-            + rod.residual_of_fields(r, alpha, v_r, v_r_t, omega_t, (v, psi), c_dyn,
-                                     rod_.degree, rod_.penalty, rod_.measures, alpha_t=omega)
+        F = sum(ufl.inner(f_t[role] - vel[role], tests[role]) for role in PAIR_ROLES) * dx \
+            + model.residual_of_fields(f, vel, acc, tuple(tests_v[role] for role in PAIR_ROLES),
+                                       c_dyn, rod_.degree, rod_.penalty, rod_.measures)
         trial = ufl.TrialFunction(self.W2)
         J = ufl.derivative(F, self.x, trial) + self.shift * ufl.derivative(F, self.x_t, trial)
         self._compile(F, J, fields, c_dyn)
@@ -295,14 +294,17 @@ class FirstOrder(_Formulation):
         zero = dolfinx.fem.Function(self.V_r)
         self._set_top_functions(0.0, rod_.q)
         bcs = []
-        for sub, values in ((0, {"bottom": zero, "top": self.r_top}),
-                            (2, {"bottom": zero, "top": self.r_top_t})):
+        model = rod_.model  # the fields and their rates in W2 (models/unshearable.py)
+        r_sub, r_t_sub = model.pair_index("centre_line"), model.pair_index("centre_line", True)
+        twist_subs = (model.pair_index("twist"), model.pair_index("twist", True))
+        for sub, values in ((r_sub, {"bottom": zero, "top": self.r_top}),
+                            (r_t_sub, {"bottom": zero, "top": self.r_top_t})):
             for end, g in values.items():
                 dofs = dolfinx.fem.locate_dofs_topological((W2.sub(sub), self.V_r), 0, ends[end])
                 bcs.append(dolfinx.fem.dirichletbc(g, dofs, W2.sub(sub)))
         if not rod_.params.model.twist:  # alpha = alpha_t = 0 everywhere
             bcs += [dolfinx.fem.dirichletbc(rod_.alpha_zero, rod_.all_dofs(W2.sub(sub), rod_.V_a),
-                                            W2.sub(sub)) for sub in (1, 3)]
+                                            W2.sub(sub)) for sub in twist_subs]
         return bcs
 
     def _set_top_functions(self, t, q):
@@ -336,8 +338,9 @@ class FirstOrder(_Formulation):
 
     def initial_vectors(self):
         """X0 = (r, alpha) of ``rod.w``, zero rates."""
-        self.x.sub(0).interpolate(self.rod.w.sub(0))
-        self.x.sub(1).interpolate(self.rod.w.sub(1))
+        model = self.rod.model
+        for role in PAIR_ROLES:
+            self.x.sub(model.pair_index(role)).interpolate(self.rod.w.sub(model.index(role)))
         self.x.x.scatter_forward()
         return compat.petsc_vec(self.x).copy(), None
 

@@ -26,23 +26,19 @@ from __future__ import annotations
 
 import hashlib
 import json
-import logging
-import os
-import time
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from rawehelix.studies import writers
+from rawehelix.studies.quarantine import CORRUPT, set_aside  # noqa: F401  (re-exported)
 
 SEAL = "_seal"
-CORRUPT = "corrupt"
 NUMBER = (int, float)
 OPTIONAL_NUMBER = (int, float, type(None))
 #: PETSc options that change no result: monitors, viewers, logging, help
 HARMLESS = ("monitor", "view", "log_", "options_left", "help", "version", "malloc_debug")
-log = logging.getLogger("rawehelix.checkpoints")
 
 
 class Corrupt(ValueError):
@@ -137,35 +133,3 @@ def load_npz(path: Path, sha256: str | None, keys=()) -> dict:
     if missing:
         raise Corrupt(f"its state {path.name} has no {', '.join(missing)}")
     return arrays
-
-
-def set_aside(paths, outdir: Path, reason: str, then: str = "computed again") -> list[Path]:
-    """Move the files ``paths`` (those that exist) into ``outdir/corrupt/<UTC
-    time>/`` (their paths below ``outdir`` kept) and warn, naming the first
-    file, ``reason`` and what happens ``then``.  Another rank may have moved
-    them first: not an error."""
-    from rawehelix.studies.outdir_lock import OutputFault
-    outdir = Path(outdir)
-    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
-    moved = []
-    for path in map(Path, paths):
-        try:
-            relative = path.resolve().relative_to(outdir.resolve())
-        except ValueError:
-            relative = Path(path.name)
-        target = outdir / CORRUPT / stamp / relative
-        n = 1
-        while target.exists():  # set aside twice in one second: keep both
-            target = outdir / CORRUPT / f"{stamp}-{n}" / relative
-            n += 1
-        try:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(path, target)
-        except FileNotFoundError:
-            continue
-        except OSError as err:
-            raise OutputFault.of(err, target) from err
-        moved.append(target)
-    if moved:
-        log.warning(f"{paths[0]}: {reason}; moved to {moved[0].parent}/ and {then}")
-    return moved

@@ -2,7 +2,7 @@
 
 The first orbit (at the start of the f1 window) is found by shooting from
 the stationary state after a few lead-in periods; the branch is then traced
-by pseudo-arclength continuation (:mod:`rawehelix.solvers.continuation`),
+by pseudo-arclength continuation (:mod:`rawehelix.periodic_orbits.continuation`),
 through folds, until f1 leaves the window.  Every point carries its Floquet
 multipliers' largest modulus and its stability.  The torque ramp (69) is
 at its final value (the summary says so).
@@ -18,7 +18,7 @@ stops the others at their next point, and every rank raises.
 Resumable (``outdir``): every point is stored as it is found (its entry,
 multipliers and state, and the continuation's state after it), one
 directory per window, whole or not at all and checked when read
-(:class:`WindowStore`); a rerun continues after the last stored point.
+(:class:`~rawehelix.studies.orbits_store.WindowStore`); a rerun continues after the last stored point.
 
 Both schemes: the FE generalised-alpha map (:mod:`rawehelix.solvers.orbits`)
 and the paper's spline-Galerkin flow (:mod:`rawehelix.references.spline_galerkin.orbits`),
@@ -29,7 +29,8 @@ linearisation (the families the end's circle drives; the FE's SLEPc modes or
 the spline scheme's eigenvalues, :func:`driven_frequencies`) give the k:1
 sites f_n / k (k in ``superharmonics``, default 2 and 3) inside the window,
 where the continuation's step closes in on the multiplier's crossing of +1
-(:mod:`rawehelix.solvers.continuation`).
+(the step guards of :mod:`rawehelix.periodic_orbits.resonances`, given to the
+continuation by :func:`branch` with T max, the branch's observable).
 
 Not yet: the free twist rotation without a controller
 (refused).
@@ -39,7 +40,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,16 +48,11 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import checkpoints, outdir_lock, schemes, writers
-from rawehelix.studies.checkpoints import NUMBER
+from rawehelix.studies import schemes, writers
+from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
-HEADER = "orbits.json"
 ABORT_TAG = 713  # a rank's failure, sent to the others
-
-
-class OrbitsStoreError(ValueError):
-    """The output directory holds another branch."""
 
 
 @dataclass
@@ -156,131 +151,6 @@ def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
     return writers._finish(fig, path, title)
 
 
-def _pairs(values) -> list:
-    """Complex numbers as [re, im] pairs (JSON)."""
-    return [[float(m.real), float(m.imag)] for m in values]
-
-
-def _complex(pairs) -> np.ndarray:
-    """The complex numbers of :func:`_pairs`."""
-    return np.array([complex(re, im) for re, im in pairs])
-
-
-#: what a stored orbit's record must hold (checkpoints.check_schema)
-SCHEMA = {"entry": dict, "entry.f1_Hz": NUMBER, "entry.tension_max_N": NUMBER,
-          "entry.tension_min_N": NUMBER, "entry.newton_iterations": int,
-          "entry.residual": NUMBER, "entry.steps_per_period": (int, type(None)),
-          "entry.wall_s": NUMBER,
-          "delta": NUMBER, "events": list, "multipliers": list}
-STATE_KEYS = ("X", "state_tau", "state_A", "state_gf", "state_w", "state_ds")
-
-
-class WindowStore:
-    """The points of one window in ``DIR/window<k>``: per point ``p<i>.npz`` (X
-    and the continuation's state after the point, ``state_*``), then ``p<i>.json``
-    (entry, multipliers, events), sealed with the fingerprint of the branch and
-    the PETSc options and the .npz's checksum (studies/checkpoints.py): written
-    last, the record is the point's completeness marker, so a point is stored
-    whole or not at all; and ``computed.log`` (one line per point computed).
-    :meth:`open` locks ``DIR`` first (studies/outdir_lock.py)."""
-
-    def __init__(self, directory: Path, base: str = ""):
-        self.dir = Path(directory)
-        self.dir.mkdir(parents=True, exist_ok=True)
-        self.options = checkpoints.petsc_options()
-        self.fingerprint = checkpoints.fingerprint(base, self.options)
-
-    @classmethod
-    def open(cls, outdir: Path, header: dict, comm) -> "WindowStore":
-        """Lock ``outdir``, refuse another branch's (:func:`open_directory`), and
-        this rank's window's store (collective)."""
-        lock = outdir_lock.hold(outdir, comm)
-        open_directory(Path(outdir), header, comm)
-        store = cls(Path(outdir) / f"window{comm.rank}", writers.digest(header))
-        store._lock = lock
-        return store
-
-    def save(self, orbit, events, state):
-        k = len(list(self.dir.glob("p*.json")))
-        record = {"entry": orbit.entry(), "delta": orbit.delta, "events": events,
-                  "multipliers": _pairs(orbit.multipliers)}
-        if orbit.internal_multipliers is not None:  # the carried variables' (floquet.py)
-            record["internal_multipliers"] = _pairs(orbit.internal_multipliers)
-        npz = writers.write_npz(self.dir / f"p{k:04d}.npz",
-                                {"X": orbit.X, **{f"state_{n}": a for n, a in state.arrays().items()}})
-        files = {"npz": writers.file_sha256(npz)}
-        writers.write_json(self.dir / f"p{k:04d}.json",
-                           checkpoints.seal(record, self.fingerprint, self.options, files))
-        writers.append_line(self.dir / "computed.log", f"{k} {orbit.f1_Hz!r} pid {os.getpid()}")
-
-    def _point(self, k: int):
-        """(record, arrays) of point k, checked; raises checkpoints.Corrupt."""
-        record, stamp = checkpoints.read(self.dir / f"p{k:04d}.json", self.fingerprint,
-                                         self.options, SCHEMA)
-        arrays = checkpoints.load_npz(self.dir / f"p{k:04d}.npz", stamp["files"].get("npz"),
-                                      STATE_KEYS)
-        return record, arrays
-
-    def load(self):
-        """(orbits, state, folds, bifurcations, peaks) of the stored points, or None.
-        The points are read in order up to the first that fails its checks: it and
-        the points after it (continued from it) are set aside and computed again;
-        a .npz without its record (written before an interruption) is removed."""
-        from rawehelix.solvers.continuation import State
-        from rawehelix.solvers.floquet import Orbit
-        root = self.dir.parent
-        legacy = self.dir / "state.npz"  # an older rawehelix's: its points have no seal either
-        if legacy.exists():
-            checkpoints.set_aside([legacy], root, "the continuation state of an older store",
-                                  then="no longer read")
-        orbits, events, arrays = [], {"fold": [], "peak": [], "bifurcation": []}, None
-        k = 0
-        while (self.dir / f"p{k:04d}.json").exists():
-            try:
-                record, arrays_k = self._point(k)
-            except checkpoints.Corrupt as err:
-                bad = [self.dir / f"p{k:04d}.json", self.dir / f"p{k:04d}.npz"]
-                checkpoints.set_aside(bad, root, str(err))
-                later = sorted(p for p in self.dir.glob("p*.*") if p.name > bad[1].name)
-                if later:
-                    checkpoints.set_aside(later, root, f"continued from p{k:04d}, set aside")
-                break
-            arrays = arrays_k
-            e = record["entry"]
-            mu = _complex(record["multipliers"])
-            internal = record.get("internal_multipliers")
-            if internal is not None:
-                internal = _complex(internal)
-            orbits.append(Orbit(f1_Hz=e["f1_Hz"], X=arrays["X"], delta=record["delta"],
-                                tension_max_N=e["tension_max_N"], tension_min_N=e["tension_min_N"],
-                                multipliers=mu, newton_iterations=e["newton_iterations"],
-                                residual=e["residual"], steps=e["steps_per_period"],
-                                wall_s=e["wall_s"], defects=e.get("defects", {}),
-                                internal_multipliers=internal))
-            for ev in record["events"]:
-                kind = "peak" if ev["kind"] == "superharmonic" else ev["kind"]
-                events.get(kind, events["bifurcation"]).append(ev)
-            k += 1
-        for stray in self.dir.glob("p*.npz"):  # beyond the last record: not whole
-            if int(stray.stem[1:]) >= k:
-                stray.unlink()
-        if not orbits:
-            return None
-        state = State.from_arrays({n[len("state_"):]: a for n, a in arrays.items()
-                                   if n.startswith("state_")})
-        return orbits, state, events["fold"], events["bifurcation"], events["peak"]
-
-
-def open_directory(outdir: Path, header: dict, comm):
-    """Refuse a directory that holds another branch, then write its header (collective)."""
-    old = writers.claim_directory(Path(outdir) / HEADER, header, comm)
-    if old is not None:
-        raise OrbitsStoreError(f"{Path(outdir) / HEADER}: holds another branch (scene "
-                               f"{old.get('scene')!r}, f1 windows {old.get('windows')}, "
-                               f"tension_step {old.get('tension_step')}); use another -o "
-                               f"directory or delete it")
-
-
 def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[float]]:
     """The f1 window cut into ``ranks`` equal windows, each traced from its first end."""
     edges = np.linspace(f1_start_Hz, f1_stop_Hz, ranks + 1)
@@ -302,10 +172,31 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[flo
     return schemes.of(params).driven_frequencies(params, m, f_max_Hz, natural_modes)
 
 
+def tension_max(m):
+    """T max [N] over a period, the branch's observable: of the samples of the
+    period map ``m`` (the tension at s = 0, normalised) or of a finished orbit."""
+    from rawehelix.periodic_orbits.problem import Observable
+    return Observable("tension_max_N", lambda samples: m.q.tension_N(samples).max(),
+                      lambda orbit: orbit.tension_max_N)
+
+
+def branch(m, tension_step: float | None = None, sites=(), **options):
+    """The continuation of the periodic-orbit problem ``m`` with this study's
+    observable (T max) and step guards: T max's relative step (``tension_step``,
+    default TENSION_STEP) and its peaks, then the superharmonic ``sites``
+    (periodic_orbits/resonances.py); ``options``: Branch's (ds, ds_min, ds_max, tol, max_it)."""
+    from rawehelix.periodic_orbits.continuation import Branch
+    from rawehelix.periodic_orbits.resonances import TENSION_STEP, Peaks, Sites
+    observable = tension_max(m)
+    step = TENSION_STEP if tension_step is None else tension_step
+    return Branch(m, observable=observable, guards=(Peaks(observable, step), Sites(sites)),
+                  **options)
+
+
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
                   superharmonics=()):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
-    from rawehelix.solvers.continuation import Branch, sites_for
+    from rawehelix.periodic_orbits.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
 
     start_f1, stop_f1 = window
@@ -322,15 +213,15 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
         else:
             sites = sites_for(f_n, lo, hi, superharmonics, tension_N=T0)
             about["sites"] = [{"f1_Hz": x.f1_Hz, "f_n_Hz": x.f_n_Hz, "order": x.k} for x in sites]
-    branch = Branch(m, tension_step=tension_step, sites=sites)
+    traced = branch(m, tension_step, sites)
     stored = store.load() if store else None
     if stored:
-        branch.resume(*stored)
+        traced.resume(*stored)
     else:
         first = m.orbit(m.X_stationary, start_f1, lead_in=LEAD_IN_PERIODS)
-        branch.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
+        traced.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
         if store:
-            store.save(first, [], branch.state)
+            store.save(first, [], traced.state)
         if progress:
             progress(first)
 
@@ -339,10 +230,10 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
         if progress:
             progress(orbit)
 
-    branch.trace(None, stop_f1, max_points=max_points, progress=each,
+    traced.trace(None, stop_f1, max_points=max_points, progress=each,
                  on_point=store.save if store else None)
-    entries = [o.entry() for o in branch.points]
-    return entries, branch.folds, branch.bifurcations, branch.peaks, about
+    entries = [o.entry() for o in traced.points]
+    return entries, traced.folds, traced.bifurcations, traced.peaks, about
 
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
@@ -352,7 +243,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     of ``comm``; with ``outdir``, stored point by point and resumed from it.
     ``superharmonics``: the orders k of the k:1 sites the step closes in on
     (default SUPERHARMONIC_ORDERS; () for none)."""
-    from rawehelix.solvers.continuation import SUPERHARMONIC_ORDERS, TENSION_STEP
+    from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
     if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
@@ -452,7 +343,7 @@ def report(result: OrbitsResult) -> str:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
     defects = [p["defects"] for p in s["branch"] if "defects" in p]
-    if defects:  # carried entries (hysteretic torsion: z, solvers/floquet.py)
+    if defects:  # carried entries (hysteretic torsion: z, periodic_orbits/floquet.py)
         internal = [p["internal_multipliers"] for p in s["branch"]
                     if p.get("internal_multipliers", {}).get("count")]
         lines.append("  carried along by the shooting (hysteretic torsion's z): largest drift of "

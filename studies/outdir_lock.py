@@ -33,7 +33,7 @@ import time
 import weakref
 from pathlib import Path
 
-from rawehelix.errors import SceneError
+from rawehelix.errors import OutputFault, SceneError  # noqa: F401  (OutputFault re-exported)
 
 LOCK = ".lock"
 #: the errors of a disk, not of the program: turned into OutputFault by :func:`hold`
@@ -49,21 +49,6 @@ class FolderBusy(SceneError):
         super().__init__("-o", self.folder, f"is in use by another run ({holder}); wait for "
                                             f"it to end or use another -o directory")
 
-
-class OutputFault(OSError):
-    """A file of the output folder could not be written (exit status 1)."""
-
-    @classmethod
-    def of(cls, err: OSError, path) -> "OutputFault":
-        """``err`` (raised writing ``path``) as an OutputFault; one already is one."""
-        if isinstance(err, OutputFault):
-            return err
-        return cls(err.errno, err.strerror or str(err), str(err.filename or path))
-
-    def __str__(self):
-        return (f"{self.filename}: not written: {self.strerror} (errno {self.errno}); "
-                f"free space or use another -o directory, then run the same command again "
-                f"(every point stored so far is kept)")
 
 
 def _holder_of(path: Path) -> str:

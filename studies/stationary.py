@@ -90,8 +90,9 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     not_applicable = shooting.not_applicable(q)
     reference = None
     if not_applicable is None:
-        reference = (shooting.solve_extensible(q) if params.model.kinematics == "extensible"
-                     else shooting.solve(q))
+        # the reference of each kinematics (model.kinematics), by name
+        solve_reference = {"paper": shooting.solve, "extensible": shooting.solve_extensible}
+        reference = solve_reference[params.model.kinematics](q)
         residual_at_shooting = solver.residual_at(reference.centre_line)  # collective
     out = Stationary(params, None, None, None, None, None, state=result.state, rank=comm.rank)
     summary = None

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rawehelix.errors import OutputFault
+
 
 def _jsonable(obj):
     if isinstance(obj, dict):
@@ -50,7 +52,6 @@ def _atomic(path: Path, fill) -> Path:
     ``path``: a reader never sees half a file.  On any failure (a full disk,
     Ctrl-C) the temporary file is removed; an OSError of the disk becomes an
     :class:`OutputFault` naming ``path``."""
-    from rawehelix.studies.outdir_lock import OutputFault
     path = Path(path)
     tmp = None
     try:
@@ -79,7 +80,6 @@ def write_text(path: Path, text: str) -> Path:
 def append_line(path: Path, line: str) -> Path:
     """Append one line to a log file in one write() (a full disk: no half line
     is left for the next run to append to; :class:`OutputFault`)."""
-    from rawehelix.studies.outdir_lock import OutputFault
     path = Path(path)
     try:
         fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
@@ -133,8 +133,8 @@ def claim_directory(path: Path, header: dict, comm) -> dict | None:
             try:
                 stored = json.loads(path.read_text())
             except (ValueError, UnicodeDecodeError) as err:
-                from rawehelix.studies import checkpoints
-                checkpoints.set_aside([path], path.parent, f"not JSON ({err})",
+                from rawehelix.studies.quarantine import set_aside
+                set_aside([path], path.parent, f"not JSON ({err})",
                                       then="written again")
         if stored is None:
             write_json(path, header)
@@ -163,8 +163,7 @@ def _finish(fig, path: Path, title: str, dpi: int = 110) -> Path:
     try:
         fig.savefig(path, dpi=dpi)
     except OSError as err:
-        from rawehelix.studies.outdir_lock import OutputFault
-        raise OutputFault.of(err, path) from err
+            raise OutputFault.of(err, path) from err
     finally:
         plt.close(fig)
     return path

@@ -427,14 +427,14 @@ def test_load_npz_names_a_truncated_file_without_a_checksum(tmp_path):
 
 # -- orbits: the window's store ----------------------------------------------------------------
 def orbit(k):
-    from rawehelix.solvers.floquet import Orbit
+    from rawehelix.periodic_orbits.floquet import Orbit
     return Orbit(f1_Hz=9.0 + 0.1 * k, X=np.arange(4.0) + k, delta=0.5, tension_max_N=100.0 + k,
                  tension_min_N=90.0, multipliers=np.array([0.9 + 0.01j, 0.5]),
                  newton_iterations=3, residual=1e-9, steps=64, wall_s=1.0)
 
 
 def state(k):
-    from rawehelix.solvers.continuation import State
+    from rawehelix.periodic_orbits.continuation import State
     return State(tau=np.full(5, k), A=np.eye(2) * k, gf=np.ones(4), w=np.ones(5), ds=0.1 * (k + 1))
 
 

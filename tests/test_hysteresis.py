@@ -177,7 +177,7 @@ def test_same_torsion_loop_on_one_and_two_ranks():
 def test_orbit_is_the_sweeps_periodic_point_with_z_carried():
     """Fig. 8 by the orbits with the Fig. 5 law (mobile_end, N = 4, dt = 0.5 ms,
     11.5 Hz; about 12 s).  z and its alpha2 rate and acceleration are carried
-    along by the shooting (solvers/floquet.py, "Carried entries"), Newton on the
+    along by the shooting (periodic_orbits/floquet.py, "Carried entries"), Newton on the
     rod: T max equals the brute-force sweep's periodic point (rh.sweep, same
     scene, N, dt) within 1e-3 (measured 1.5e-5); z drifts by < Z_TOL of itself
     over a period; z's multipliers, one per z dof, are within 1e-6 of 1 (the

@@ -11,7 +11,8 @@ from mpi4py import MPI
 import dolfinx.fem
 
 from rawehelix.errors import SceneError
-from rawehelix.solvers import analytic, shooting
+from rawehelix.references import shooting
+from rawehelix.solvers import analytic
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.stationary import StationarySolver

@@ -8,7 +8,7 @@ from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.solvers.forced import FEBackend
-from rawehelix.solvers.floquet import PeriodMap
+from rawehelix.periodic_orbits.floquet import PeriodMap
 from rawehelix.solvers.orbits import AlphaMap
 from rawehelix.solvers.periodic import periodic_response
 
@@ -44,7 +44,7 @@ def test_broyden_updates_meet_the_secant_condition():
     """floquet.Broyden against the dense update it stands for: after each update
     H y = s (the secant condition), H is the inverse of B_k + (y - B_k s) s^T /
     (s^T s) ("good" Broyden) to 1e-10, and H^T solves with its transpose."""
-    from rawehelix.solvers.floquet import Broyden
+    from rawehelix.periodic_orbits.floquet import Broyden
 
     rng = np.random.default_rng(3)
     B = np.eye(6) + 0.3 * rng.standard_normal((6, 6))
@@ -268,12 +268,12 @@ def test_continuation_points_are_orbits_and_the_command_writes_the_branch(alpha_
     branch, folds, bifurcations and peaks and the diagram."""
     import json
 
-    from rawehelix.solvers.continuation import Branch
     from rawehelix.cli import main as cli
+    from rawehelix.studies.orbits import branch as orbits_branch
 
     m = alpha_map
     first = m.orbit(m.X_stationary, 9.0, lead_in=5)
-    points = Branch(m).trace(first, 9.25)
+    points = orbits_branch(m).trace(first, 9.25)
     assert len(points) >= 3 and points[-1].f1_Hz > 9.25
     assert np.all(np.diff([p.f1_Hz for p in points]) > 0)  # no fold below the resonance
     mid = points[1]
@@ -392,11 +392,11 @@ def s_curve(alpha_map):
     """The N = 4 branch from 11.5 Hz up through the primary peak, the fold at
     12.70 Hz, down the unstable branch to the fold at 11.97 Hz and up the lower
     stable branch past 12.9 Hz (49 points, ~110 s)."""
-    from rawehelix.solvers.continuation import Branch
+    from rawehelix.studies.orbits import branch as orbits_branch
 
     m = alpha_map
     first = m.orbit(m.X_stationary, 11.5, lead_in=5)
-    branch = Branch(m)
+    branch = orbits_branch(m)
     branch.trace(first, 12.9)
     return branch
 
@@ -412,7 +412,7 @@ def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map, s_curve
     finer trace is higher (to 1e-5), its highest point is within 2e-4 of the
     height and 0.02 Hz, and its own located peak within 1e-5 and 0.01 Hz (the
     peak is flat: T'' ~ 600 N/Hz^2, so 1e-5 in T is 4e-3 Hz in f1)."""
-    from rawehelix.solvers.continuation import Branch
+    from rawehelix.studies.orbits import branch as orbits_branch
 
     points = s_curve.points
     T = np.array([p.tension_max_N for p in points])
@@ -420,7 +420,7 @@ def test_the_primary_peak_is_located_as_a_finer_trace_sees_it(alpha_map, s_curve
     (peak,) = s_curve.peaks
     assert peak["located"] == "refined" and peak["tension_max_N"] > T.max()
     k = int(np.argmax(T))
-    fine = Branch(alpha_map, ds=0.01, ds_max=0.02, tension_step=0.005)
+    fine = orbits_branch(alpha_map, 0.005, ds=0.01, ds_max=0.02)
     fine_points = fine.trace(points[k - 1], points[k + 1].f1_Hz)
     Tf = np.array([p.tension_max_N for p in fine_points])
     top = int(np.argmax(Tf))
@@ -484,7 +484,7 @@ def test_the_bisection_locates_a_synthetic_crossing(kind):
     (0.8 + 0.34 s) e^{+-1.2 i} (Neimark-Sacker) crosses the unit circle at
     s* = 1/1.7; a fold's multiplier 1.2 and a stable one 0.3 ride along
     (they do not count).  The bisection brackets s* to the f1 width 1e-4 Hz."""
-    from rawehelix.solvers.continuation import _unstable, bisect_crossing
+    from rawehelix.periodic_orbits.bifurcations import _unstable, bisect_crossing
 
     def path(s):
         if kind == "period_doubling":
@@ -512,11 +512,12 @@ def test_fold_location_is_the_hermite_extremum():
     error estimate is the distance to the linear interpolant, 0.06 Hz."""
     from types import SimpleNamespace
 
-    from rawehelix.solvers.continuation import fold_between
+    from rawehelix.periodic_orbits.bifurcations import fold_between
+    from rawehelix.studies.orbits import tension_max
 
     f = lambda s: 12.7 - (s - 0.3) ** 2  # noqa: E731
     a, b = (SimpleNamespace(f1_Hz=f(s), tension_max_N=500.0 - 100 * s) for s in (0.0, 0.5))
-    fold = fold_between(a, b, 0.6, -0.4, 0.5)
+    fold = fold_between(a, b, 0.6, -0.4, 0.5, tension_max(None))
     assert fold["f1_Hz"] == pytest.approx(12.7, abs=1e-12)
     assert fold["f1_error_Hz"] == pytest.approx(0.06, abs=1e-12)
     assert fold["tension_max_N"] == pytest.approx(470.0)
@@ -605,7 +606,7 @@ class _LinearMap(PeriodMap):
         G = (M - np.eye(self.size)) @ (X - self.fixed(f1))
         return G, np.array([100.0 + 10.0 * f1]), (M if tangent else None)
 
-    def finish(self, X, f1, delta, its, res, start, steps=None):
+    def orbit_through(self, X, f1, delta, its, res, start, steps=None):
         from rawehelix.solvers.orbits import Orbit
         M = self.monodromy(f1)
         mu = np.linalg.eigvals(M)
@@ -620,11 +621,11 @@ def test_the_branch_locates_period_doubling_and_neimark_sacker(kind):
     flagged between two branch points, bisected in arclength (correctors from
     the earlier point) to within 1e-4 Hz, reported once with its kind and the
     crossing multiplier on the unit circle (to the bracket's width)."""
-    from rawehelix.solvers.continuation import Branch
+    from rawehelix.studies.orbits import branch as orbits_branch
 
     m = _LinearMap(kind)
-    first = m.finish(m.fixed(10.0), 10.0, 0.0, 1, 0.0, 0.0)
-    branch = Branch(m, ds=0.1, ds_max=0.2)
+    first = m.finish(m.fixed(10.0), 10.0, 1, 0.0, 0.0)
+    branch = orbits_branch(m, ds=0.1, ds_max=0.2)
     points = branch.trace(first, 11.0)
     assert points[-1].f1_Hz > 11.0 and not branch.folds
     (bif,) = branch.bifurcations
@@ -648,16 +649,17 @@ def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     and reports nothing, and so does a site whose linearised state's tension is
     not the orbits' (their mean T(0) ~ 75 N here; the site's 50 N: a prediction
     that holds nowhere on the branch, as on a resonance's S-curve)."""
-    from rawehelix.solvers import continuation
-    from rawehelix.solvers.continuation import Branch, Site, sites_for
+    from rawehelix.periodic_orbits import resonances
+    from rawehelix.periodic_orbits.resonances import Site, sites_for
+    from rawehelix.studies.orbits import branch as orbits_branch
 
     m = _LinearMap("superharmonic")
-    first = m.finish(m.fixed(4.6), 4.6, 0.0, 1, 0.0, 0.0)
+    first = m.finish(m.fixed(4.6), 4.6, 1, 0.0, 0.0)
     T0 = 50.0 if with_sites == "far from the linearised state" else 75.0
     sites = sites_for([10.0], 4.6, 5.4, tension_N=T0) if with_sites else ()
     assert list(sites) == ([Site(10.0, 2, T0)] if with_sites else [])
     assert sites_for([10.0, 10.0002], 4.6, 5.4) == [Site(10.0, 2)]  # a lateral pair: one site
-    branch = Branch(m, ds=0.2, ds_max=0.5, sites=sites)
+    branch = orbits_branch(m, sites=sites, ds=0.2, ds_max=0.5)
     points = branch.trace(first, 5.4)
     found = [p for p in branch.peaks if p["kind"] == "superharmonic"]
     f = np.array([p.f1_Hz for p in points])
@@ -669,7 +671,7 @@ def test_the_step_closes_in_on_a_superharmonic_site(with_sites):
     assert res["distance"] == pytest.approx(0.05, rel=1e-9)
     # the points close in: steps of ~angle_step |mu - 1| / (d theta / d f1) there, the
     # resonance's half-width (|mu - 1| / (d theta / d f1)) times angle_step
-    step = continuation.ANGLE_STEP * 0.05 / (2 * np.pi * 10.0 / 5.0**2)
+    step = resonances.ANGLE_STEP * 0.05 / (2 * np.pi * 10.0 / 5.0**2)
     assert np.min(np.abs(f - 5.0)) < step
     assert np.max(np.diff(f)[np.abs(f[:-1] - 5.0) < 2 * step]) < 1.5 * step
     assert len(points) < 60
@@ -706,11 +708,11 @@ def test_the_branch_crosses_the_quasi_static_band_in_natural_steps(alpha_map):
     (its own steps per period), and the orbit at the end equals the shooting's
     from the stationary state there.  The last natural step lands on the
     window's end, 1 Hz, instead of past it."""
-    from rawehelix.solvers import continuation
-    from rawehelix.solvers.continuation import Branch
+    from rawehelix.periodic_orbits import bifurcations, continuation
+    from rawehelix.studies.orbits import branch as orbits_branch
 
     m = alpha_map
-    branch = Branch(m)
+    branch = orbits_branch(m)
     points = branch.trace(m.orbit(m.X_stationary, 3.0, lead_in=3), 1.0, direction=-1.0,
                           max_points=12)
     assert points[-1].f1_Hz == pytest.approx(1.0, rel=1e-9)
@@ -719,7 +721,7 @@ def test_the_branch_crosses_the_quasi_static_band_in_natural_steps(alpha_map):
     assert len(natural) >= 3
     for a, b in zip(points, points[1:]):
         assert b.f1_Hz < a.f1_Hz and b.f1_Hz >= (1 - continuation.NATURAL_STEP) * a.f1_Hz - 1e-9
-        assert continuation.far_from_folds(b.multipliers) and b.stable
+        assert bifurcations.far_from_folds(b.multipliers) and b.stable
     last = points[-1]
     G, _, _ = m.shooting_residual(last.X, last.f1_Hz, m.rotation(last.f1_Hz))
     assert np.linalg.norm(G) / np.linalg.norm(last.X) < 1e-7
@@ -778,3 +780,25 @@ def test_the_diagram_draws_each_run_of_stability_as_one_line(tmp_path):
     assert [(line.get_linestyle(), len(line.get_xdata())) for line in drawn] == [
         ("-", 5), ("--", 42), ("-", 5)]
     assert (tmp_path / "o.png").stat().st_size > 5_000
+
+
+def test_the_problems_linear_case_is_the_harmonic_response():
+    """The periodic-orbit problem's linear case is solvers/response.py's one-harmonic
+    response (N = 4, f1 = 3 Hz, the scene torque- and controller-free, as
+    test_small_amplitude_orbit_is_the_linear_response, with R1 = 1e-4 m, 1e-3 of
+    the scene's: the tension's first harmonic stands above the shooting's floor):
+    the first harmonic of the orbit's samples over a period (the interface's
+    ``samples``: T(0)) is the linear response's |dT(0)| within 1e-4 (measured
+    7.7e-6; 8e-5 at R1 = 1e-3 m, the nonlinearity's share)."""
+    from rawehelix.solvers.response import HarmonicResponse
+
+    f1 = 3.0
+    params = rh.load_scene("mobile_end", elements=4, degree=3,
+                           overrides={**FREE, "ends.circle_radius_m": 1e-4,
+                                      "ends.circle_frequency_Hz": f1})
+    linear = HarmonicResponse.from_stationary(params).at(f1).tension_amplitude_N
+    m = AlphaMap(params)
+    orbit = m.orbit(m.X_stationary, f1, lead_in=2, tol=3e-7)
+    T = m.q.tension_N(m.samples(orbit.X, f1))
+    first = 2 * abs(np.fft.rfft(T)[1]) / T.size  # equally spaced over one period
+    assert first == pytest.approx(linear, rel=1e-4)

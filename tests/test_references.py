@@ -49,8 +49,8 @@ FE_MODULES = ("dolfinx", "ufl", "basix", "ffcx", "petsc4py", "slepc4py", "rawehe
               "rawehelix.compat", "rawehelix.meshes")
 REFERENCES = ("rawehelix.references.shooting", "rawehelix.references.spline_galerkin")
 # scheme-independent numpy code the references may use: the shooting Newton and
-# the Floquet multipliers of a period map (no FE module)
-SHARED = ("rawehelix.solvers.floquet",)
+# the Floquet multipliers of a period map, the periodic-orbit problem (no FE module)
+SHARED = ("rawehelix.periodic_orbits.floquet", "rawehelix.periodic_orbits.problem")
 
 _PROBE = """
 import importlib, pkgutil, sys

@@ -68,3 +68,36 @@ def test_the_orbits_command_takes_the_scenes_scheme(scheme, kind):
     from rawehelix.studies.orbits import period_map
     params = rh.load_scene("mobile_end", scheme=scheme, elements=2, overrides=SCENE)
     assert type(period_map(params)).__name__ == kind
+
+
+
+@pytest.mark.parametrize("scheme", ["spline", "fe"])
+def test_each_scheme_is_a_periodic_orbit_problem(scheme, spline_map, orbit):
+    """The shooting of each scheme through the periodic-orbit interface
+    (periodic_orbits/problem.py; the spline at N = 2, the FE at N = 4, p = 3): at
+    the 10 Hz orbit G is within the shooting's tolerance; the orbit at 10.05 Hz,
+    solved by the problem's own Newton, moves X as the interface's two Jacobians
+    predict (dX/df1 = -G_X^-1 G_f1, to the step's second order: 2e-2 of the
+    change); the multipliers and the samples of one period from X are the
+    orbit's (the same periods: to round-off)."""
+    from rawehelix.periodic_orbits.problem import PeriodicOrbitProblem
+    from rawehelix.solvers.orbits import AlphaMap
+
+    m = spline_map
+    if scheme == "fe":
+        m = AlphaMap(rh.load_scene("mobile_end", elements=4, degree=3, overrides=SCENE))
+        orbit = m.orbit(m.X_stationary, 10.0, lead_in=5)
+    assert isinstance(m, PeriodicOrbitProblem) and m.carried.size == 0
+    steps = m.resolution(10.0)
+    G, samples, J = m.residual(orbit.X, 10.0, jacobian=True, resolution=steps)
+    assert m.norm(G, orbit.X) <= 1e-6
+    gf = m.residual_f1(orbit.X, 10.0, steps, G)
+    df = 0.05
+    moved = m.orbit(orbit.X, 10.0 + df, steps=steps)
+    predicted = -np.linalg.solve(J, gf) * df
+    change = moved.X - orbit.X
+    assert np.linalg.norm(predicted - change) <= 2e-2 * np.linalg.norm(change)
+    assert np.allclose(m.multipliers(orbit.X, 10.0), orbit.multipliers, rtol=1e-8, atol=1e-10)
+    T = m.q.tension_N(m.samples(orbit.X, 10.0))
+    assert T.max() == pytest.approx(orbit.tension_max_N, rel=1e-10)
+    assert T.min() == pytest.approx(orbit.tension_min_N, rel=1e-10)

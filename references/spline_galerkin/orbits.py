@@ -29,9 +29,12 @@ then periodic by itself when Delta = alpha_dot* T1, and the reduced map's
 multipliers are the physical ones.
 
 The shooting Newton, the rotation Delta and the orbit's summary are the
-scheme-independent ones of :class:`rawehelix.solvers.floquet.PeriodMap`
-(numpy only: no FE code); only the period map is this scheme's own, so the continuation (:mod:`rawehelix.solvers.continuation`)
-traces the paper's N = 2 curve with its unstable branch as it does the FE's.
+scheme-independent ones of :class:`rawehelix.periodic_orbits.floquet.PeriodMap`
+(numpy only: no FE code), so :class:`SplineMap` is a periodic-orbit problem
+(:class:`rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`) as the FE
+shooting is; only the period map is this scheme's own, so the continuation
+(:mod:`rawehelix.periodic_orbits.continuation`) traces the paper's N = 2 curve with its
+unstable branch as it does the FE's.
 """
 
 from __future__ import annotations
@@ -44,7 +47,7 @@ from scipy.integrate import solve_ivp
 
 from rawehelix.parameters import Parameters
 from rawehelix.errors import SolverError
-from rawehelix.solvers.floquet import PeriodMap
+from rawehelix.periodic_orbits.floquet import PeriodMap
 
 from . import stationary
 from .dynamics import initial_state

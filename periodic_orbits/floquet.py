@@ -1,5 +1,7 @@
 """Periodic orbits by shooting, scheme-independent: the shooting Newton, the
-twist's rotation per period and the Floquet multipliers of an orbit.
+twist's rotation per period and the Floquet multipliers of an orbit.  Shooting
+is one :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`
+(:class:`PeriodMap`), which the continuation traces.
 
 A scheme supplies the period map (:meth:`PeriodMap.period`: the state after
 one forcing period, the tension at s = 0 over it and, on request, the
@@ -29,7 +31,7 @@ monodromy set to zero (:meth:`PeriodMap.newton_matrix`): its step sets them
 to P's (substitution, X_c <- P_c(X)) and solves the other entries with the
 change of X_c included (their columns are kept); the residual measured
 (:meth:`PeriodMap.shooting_norm`) is that of the other entries; the orbit's
-carried entries are P's at the converged X.  :meth:`PeriodMap.finish`
+carried entries are P's at the converged X.  :meth:`PeriodMap.orbit_through`
 measures what remains (``Orbit.defects``, :meth:`PeriodMap.defects`) and
 refuses the orbit where a defect exceeds its entry of ``defect_tolerances``.
 Multipliers that belong to the carried variables (:meth:`PeriodMap.set_aside`)
@@ -40,13 +42,13 @@ No FE code (numpy only), so that the spline reference stays free of it.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 
 import numpy as np
 import scipy.linalg
 
 from rawehelix.errors import SolverError
+from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem  # noqa: F401  (Orbit re-exported)
 
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
 #: a Newton iteration on a held monodromy (a chord) that leaves more than this fraction of
@@ -89,60 +91,61 @@ class Broyden:
             self.terms.append((s - Hy, sH / d))
 
 
-@dataclasses.dataclass
-class Orbit:
-    """A periodic orbit at one f1 (normalised state, SI outputs)."""
+class PeriodMap(PeriodicOrbitProblem):
+    """Shooting on a scheme's period map (see the module's docstring): the
+    :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem` whose unknowns
+    are the state at the start of the period and whose resolution is the steps
+    per period.  ``carried``: entries of X the Newton does not solve for (module
+    docstring, "Carried entries")."""
 
-    f1_Hz: float
-    X: np.ndarray  # (U, V, A) at the start of the period, phase 0
-    delta: float  # twist rotation per period (normalised)
-    tension_max_N: float
-    tension_min_N: float
-    multipliers: np.ndarray  # Floquet multipliers, by decreasing modulus (the
-    # free twist rotation's pair without a controller set aside: symmetry_multiplier)
-    newton_iterations: int
-    residual: float  # |G| / |X| at the orbit
-    steps: int  # steps per period
-    wall_s: float
-    monodromy: np.ndarray | None = dataclasses.field(default=None, repr=False)  # dP/dX at X
-    symmetry_multiplier: complex | None = None  # the free rotation's pair (no controller)
-    #: the scheme's periodicity defects at the orbit (``PeriodMap.defects``; {}: none)
-    defects: dict = dataclasses.field(default_factory=dict)
-    #: multipliers of the carried variables, set aside (``PeriodMap.set_aside``; None: none)
-    internal_multipliers: np.ndarray | None = dataclasses.field(default=None, repr=False)
-    #: G = P(X) - X - Delta e_alpha at X, from the Floquet period (None: not kept)
-    G: np.ndarray | None = dataclasses.field(default=None, repr=False)
+    # -- the periodic-orbit problem (periodic_orbits/problem.py) ---------------------------
+    def continuable(self):
+        if not self.controller:
+            raise SolverError("continuation: a scene without the controller's integral action "
+                              "(k1 = 0) has a free twist rotation; continue it at fixed f1 steps "
+                              "(AlphaMap.orbit) instead")
 
-    @property
-    def max_multiplier(self) -> float:
-        return float(np.abs(self.multipliers[0]))
+    def resolution(self, f1_Hz: float) -> int:
+        return self.steps_per_period(f1_Hz)
 
-    @property
-    def stable(self) -> bool:
-        return self.max_multiplier < 1.0
+    def residual(self, X, f1_Hz: float, jacobian: bool = False, resolution: int | None = None):
+        """G = P(X) - X - Delta e_alpha with Delta fixed by the controller, the
+        tension over the period and, with ``jacobian``, the Newton matrix."""
+        G, tension, Phi = self.shooting_residual(X, f1_Hz, self.rotation(f1_Hz), tangent=jacobian,
+                                                 steps=resolution)
+        return G, tension, (self.newton_matrix(Phi) if jacobian else None)
 
-    def entry(self) -> dict:
-        out = {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
-               "tension_min_N": self.tension_min_N, "stable": self.stable,
-               "max_multiplier": self.max_multiplier,
-               "newton_iterations": self.newton_iterations, "residual": self.residual,
-               "steps_per_period": self.steps, "wall_s": self.wall_s}
-        if self.defects:
-            out["defects"] = dict(self.defects)
-        if self.internal_multipliers is not None:
-            mu = self.internal_multipliers
-            out["internal_multipliers"] = {
-                "count": int(mu.size),
-                "max_modulus": float(np.abs(mu).max()) if mu.size else None,
-                "max_distance_to_1": float(np.abs(mu - 1.0).max()) if mu.size else None}
-        return out
+    def residual_f1(self, X, f1_Hz: float, resolution: int, G=None, eps=1e-5) -> np.ndarray:
+        """dG/df1 at fixed steps per period: forward differences from ``G`` (G at
+        (X, f1), one more period), or central ones without it."""
+        G_at = lambda f1: self.residual(X, f1, resolution=resolution)[0]  # noqa: E731
+        if G is None:
+            gf = (G_at(f1_Hz + eps) - G_at(f1_Hz - eps)) / (2 * eps)
+        else:
+            gf = (G_at(f1_Hz + eps) - G) / eps
+        gf[self.carried] = 0.0  # carried entries: not on the tangent
+        return gf
 
+    def jacobian(self, orbit: Orbit) -> np.ndarray:
+        return self.newton_matrix(orbit.monodromy)
 
-class PeriodMap:
-    """Shooting on a scheme's period map (see the module's docstring)."""
+    def norm(self, G, X) -> float:
+        return self.shooting_norm(G, X)
 
-    #: entries of X the Newton does not solve for (module docstring, "Carried entries")
-    carried = np.zeros(0, dtype=int)
+    def finish(self, X, f1_Hz, iterations, residual, start, resolution=None) -> Orbit:
+        """The orbit through X with Delta fixed by the controller (:meth:`orbit_through`)."""
+        return self.orbit_through(X, f1_Hz, self.rotation(f1_Hz), iterations, residual, start,
+                                  resolution)
+
+    def multipliers(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
+        """The multipliers of a tangent period from X (Delta: the controller's)."""
+        _, _, Phi = self.period(X, f1_Hz, tangent=True, steps=resolution)
+        return self.floquet(Phi)[0]
+
+    def samples(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
+        return self.period(X, f1_Hz, steps=resolution)[1]
+
+    # -- shooting -----------------------------------------------------------------
 
     def newton_matrix(self, Phi):
         """M - I, the carried entries' rows of the monodromy M set to zero."""
@@ -213,7 +216,6 @@ class PeriodMap:
         PX, tension, Phi = self.period(X, f1_Hz, tangent=tangent, steps=steps)
         return PX - X - delta * self.e_alpha, tension, Phi
 
-    # -- shooting ----------------------------------------------------------------
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
               steps: int | None = None, linear: bool = False) -> Orbit:
         """Newton on G(X) = P(X) - X - Delta e_alpha = 0 with a held monodromy
@@ -296,9 +298,9 @@ class PeriodMap:
         else:
             raise SolverError(f"orbits: shooting did not converge at f1 = {f1_Hz} Hz in "
                               f"{max_it} iterations (|G|/|X| = {res:.3g} > {tol:g})")
-        return self.finish(X, f1_Hz, delta, its, res, start, steps)
+        return self.orbit_through(X, f1_Hz, delta, its, res, start, steps)
 
-    def finish(self, X, f1_Hz, delta, its, res, start, steps=None) -> Orbit:
+    def orbit_through(self, X, f1_Hz, delta, its, res, start, steps=None) -> Orbit:
         """The orbit through X: one more period with the tangent gives the
         Floquet multipliers at the orbit itself, and the tension over it."""
         PX, tension, Phi = self.period(X, f1_Hz, tangent=True, steps=steps)
@@ -311,6 +313,20 @@ class PeriodMap:
                     f"orbits: at f1 = {f1_Hz} Hz the orbit's {name} defect is "
                     f"{value:.3g} > {limit:g}: {self.defect_meaning(name)} (docs/explanation/orbits.md, "
                     f"'carried entries')")
+        mu, symmetry, internal = self.floquet(Phi)
+        T = self.q.tension_N(tension)
+        orbit = Orbit(f1_Hz=f1_Hz, X=X, delta=delta, tension_max_N=float(T.max()),
+                      tension_min_N=float(T.min()), multipliers=mu, newton_iterations=its,
+                      residual=float(res), steps=steps or self.steps_per_period(f1_Hz),
+                      wall_s=time.perf_counter() - start, monodromy=Phi,
+                      symmetry_multiplier=symmetry, defects=defects,
+                      internal_multipliers=internal, G=G)
+        return orbit
+
+    def floquet(self, Phi):
+        """The Floquet multipliers of the monodromy Phi by decreasing modulus, the
+        free rotation's pair (without the controller; else None) and the carried
+        variables' multipliers (:meth:`set_aside`; None: none)."""
         internal = None
         if self.needs_vectors:
             mu, vectors = np.linalg.eig(Phi)
@@ -329,11 +345,4 @@ class PeriodMap:
             symmetry = complex(np.mean(mu[pair]))
             mu = np.delete(mu, pair)
         mu = mu[np.argsort(-np.abs(mu))]
-        T = self.q.tension_N(tension)
-        orbit = Orbit(f1_Hz=f1_Hz, X=X, delta=delta, tension_max_N=float(T.max()),
-                      tension_min_N=float(T.min()), multipliers=mu, newton_iterations=its,
-                      residual=float(res), steps=steps or self.steps_per_period(f1_Hz),
-                      wall_s=time.perf_counter() - start, monodromy=Phi,
-                      symmetry_multiplier=symmetry, defects=defects,
-                      internal_multipliers=internal, G=G)
-        return orbit
+        return mu, symmetry, internal

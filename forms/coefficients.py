@@ -1,0 +1,74 @@
+"""The normalised groups of Eqs. (26)-(27) as the forms read them (:class:`Coefficients`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from rawehelix.forms.damping import KelvinVoigt, NoneDamping
+from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
+from rawehelix.forms.extensible import ExtensibleKinematics
+from rawehelix.forms.hysteresis import BoucWen, NoneHysteresis
+from rawehelix.forms.paper import PaperKinematics
+
+#: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py)
+KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics}
+
+#: the components that add a stored energy per length W(r) and nothing else
+#: (forms/energy_component.py): the residual gets their variation (forms/rod.py), the
+#: energy W (forms/energy.py).  Each is a class with from_normalised(q, make) (its
+#: null object when off); a new one is appended here.
+ENERGY_COMPONENTS = ()
+
+
+@dataclass
+class Coefficients:
+    """The normalised groups of Eqs. (26)-(27) as UFL-ready values.
+
+    Each field is a number or a constant (for instance ``dolfinx.fem.Constant``)
+    so that a solver can change it (torques in time) without recompiling.
+    """
+
+    sigma: Any
+    mu: Any
+    beta: Any
+    nu: Any
+    delta: Any
+    v_w0: Any
+    m0: Any = 0.0  # torque at s = 0, Eq. (38)
+    mN: Any = 0.0  # torque at s = 1, Eq. (39)
+    gravity: Any = 1.0  # 1 switches gravity on, 0 off
+    drag: Any = 1.0
+    bending: Any = 1.0
+    gamma_eps: Any = 1.0e-3
+    gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
+    # the kinematics, a component chosen by model.kinematics (:data:`KINEMATICS`)
+    kinematics: Any = field(default_factory=PaperKinematics)
+    # structural damping, a component (forms/damping.py): KelvinVoigt, or the null
+    # object NoneDamping that leaves the viscous terms out of the forms altogether
+    damping: Any = field(default_factory=NoneDamping)
+    # the EI law, a component (forms/eilaw.py): TensionDependentBending, or the
+    # null object ConstantBending (mu)
+    bending_law: Any = field(default_factory=ConstantBending)
+    # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
+    # object NoneHysteresis (no z field, the elastic moment)
+    hysteresis: Any = field(default_factory=NoneHysteresis)
+    # the ENERGY_COMPONENTS of the scene
+    extra: tuple = ()
+
+    @classmethod
+    def from_normalised(cls, q, model, make=float):
+        """From :class:`rawehelix.parameters.Normalised` and a scene's
+        ``model``; ``make`` wraps each number (e.g. into a dolfinx Constant)."""
+        return cls(
+            sigma=make(q.sigma), mu=make(q.mu), beta=make(q.beta), nu=make(q.nu),
+            delta=make(q.delta), v_w0=make(q.v_w0), m0=make(0.0), mN=make(0.0),
+            gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
+            gamma_eps=make(model.gamma_eps),
+            gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
+            kinematics=KINEMATICS[model.kinematics](),
+            damping=KelvinVoigt.from_normalised(q, make),
+            bending_law=TensionDependentBending.from_normalised(q, make),
+            hysteresis=BoucWen.from_normalised(q, make),
+            extra=tuple(cls.from_normalised(q, make) for cls in ENERGY_COMPONENTS),
+        )

@@ -1,0 +1,117 @@
+"""The rod-model interface: the fields of a rod, their layout, its forms and what it refuses.
+
+A solver asks the model instead of naming r, alpha, kappa or z:
+
+* the fields, by role (:data:`ROLES`), in the order of the mixed space:
+  :meth:`RodModel.index`, :meth:`RodModel.has`, :meth:`RodModel.split`;
+* the element of the mixed space, :meth:`RodModel.element`;
+* the forms: the residual (inertia + elastic + dissipative - loads), the
+  stored energy, the kinetic energy, the dissipation potential and the power
+  of the non-variational terms;
+* the observables: tension and twist;
+* the end conditions, :meth:`RodModel.end_conditions`;
+* the capabilities: :meth:`RodModel.refuse` raises the one refusal of a
+  component (or of the discretisation) for a solver that cannot run it.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import ufl
+
+from rawehelix.errors import SceneError
+
+#: the roles of a rod's fields; the unshearable rod has the first two always,
+#: "curvature" with the mixed bending form, "internal_twist" with hysteresis
+ROLES = ("centre_line", "twist", "curvature", "internal_twist")
+
+#: the solvers a model is asked about (:meth:`RodModel.refuse`)
+SOLVERS = ("stationary", "second_order", "first_order", "modal")
+
+
+@dataclass(frozen=True)
+class EndCondition:
+    """A Dirichlet condition: ``role``'s field at ``where`` ("bottom", "top",
+    "ends" or "all" dofs) is ``value`` ("zero" or "top_position", Eq. 36)."""
+
+    role: str
+    where: str
+    value: str = "zero"
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """A solver a component cannot run with: the scene key to name and the message."""
+
+    key: str
+    message: str
+
+
+class RodModel(abc.ABC):
+    """A rod model on a mixed space whose fields have the roles :attr:`fields`."""
+
+    fields: tuple[str, ...] = ()
+
+    def index(self, role: str) -> int:
+        """The position of the field ``role`` in the mixed space."""
+        return self.fields.index(role)
+
+    def has(self, role: str) -> bool:
+        return role in self.fields
+
+    def split(self, w) -> dict:
+        """role -> UFL view of a mixed function (or trial/test function) ``w``;
+        the roles this model lacks are None."""
+        parts = ufl.split(w)
+        return {role: parts[self.index(role)] if self.has(role) else None for role in ROLES}
+
+    def rates(self, w_t) -> dict:
+        """:meth:`split` of a rate, or every role None when ``w_t`` is None."""
+        return self.split(w_t) if w_t is not None else dict.fromkeys(ROLES)
+
+    @abc.abstractmethod
+    def element(self, cell, degree: int):
+        """The mixed element of :attr:`fields`."""
+
+    @abc.abstractmethod
+    def residual(self, w, w_t, w_tt, test, c, degree: int, penalty, measures):
+        """The full residual; ``w_tt`` None: no inertia, ``w_t`` None: at rest."""
+
+    @abc.abstractmethod
+    def stored_energy(self, fields: dict, c, degree: int, penalty, measures):
+        """U of the fields (:meth:`split`)."""
+
+    @abc.abstractmethod
+    def kinetic_energy(self, rates: dict, c, dx):
+        """K of the rates (:meth:`split` of w_t)."""
+
+    @abc.abstractmethod
+    def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):
+        """The dissipation potential D; None: the model dissipates nothing."""
+
+    @abc.abstractmethod
+    def non_variational_power(self, fields: dict, rates: dict, c, dx):
+        """The power of the terms that are not the variation of an energy."""
+
+    @abc.abstractmethod
+    def tension(self, fields: dict, c):
+        """The tension field (an observable)."""
+
+    @abc.abstractmethod
+    def twist(self, fields: dict, c):
+        """The total twist field (an observable)."""
+
+    @abc.abstractmethod
+    def end_conditions(self, pin_twist: bool) -> list[EndCondition]:
+        """The Dirichlet conditions of the ends (and of fields held at zero)."""
+
+    @abc.abstractmethod
+    def refusals(self, solver: str) -> list[Refusal]:
+        """Why ``solver`` (one of :data:`SOLVERS`) cannot run this model; [] if it can."""
+
+    def refuse(self, solver: str, scene: str) -> None:
+        """Raise the first refusal of ``solver`` as a :class:`SceneError` of ``scene``."""
+        for refusal in self.refusals(solver):
+            raise SceneError(scene, refusal.key, refusal.message)

@@ -1,0 +1,24 @@
+"""Fingerprint compatibility: switches added after results were stored."""
+
+from __future__ import annotations
+
+from rawehelix.parameters import components
+from rawehelix.parameters.sections import Helix, Model
+
+#: model switches added after results were stored (sweep checkpoints, the
+#: convergence cache): left out of :meth:`Parameters.as_dict` at their
+#: defaults, so that those results keep their fingerprints: the kinematics and
+#: every component's section (parameters/components.py)
+LATER_MODEL_SWITCHES = {"kinematics": "paper", **components.later_switches("model", Model)}
+#: the same for the helix section (the EI law)
+LATER_HELIX_SWITCHES = components.later_switches("helix", Helix)
+
+
+def drop_later_switches(data: dict) -> dict:
+    """``data`` (Parameters as a dict) without the later switches at their defaults."""
+    for section, switches in (("model", LATER_MODEL_SWITCHES),
+                              ("helix", LATER_HELIX_SWITCHES)):
+        for key, default in switches.items():  # fingerprints stored before them
+            if data[section][key] == default:
+                data[section].pop(key)
+    return data

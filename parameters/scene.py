@@ -1,0 +1,130 @@
+"""A whole scene (:class:`Parameters`) and the cross-checks between its sections."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+from rawehelix.parameters import components, sections
+from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.fingerprint import drop_later_switches
+from rawehelix.parameters.normalised import Normalised
+from rawehelix.parameters.numerics import Discretisation, Sweep, Time
+from rawehelix.parameters.sections import Controller, Ends, Environment, Helix, Model, Torque
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """Everything physical and numerical about one scene, in SI units."""
+
+    helix: Helix
+    ends: Ends
+    environment: Environment = field(default_factory=Environment)
+    torque: Torque = field(default_factory=Torque)
+    controller: Controller = field(default_factory=Controller)
+    model: Model = field(default_factory=Model)
+    discretisation: Discretisation = field(default_factory=Discretisation)
+    time: Time = field(default_factory=Time)
+    sweep: Sweep = field(default_factory=Sweep)
+    name: str = "scene"  # the scene file's stem: labels outputs, changes no number
+    title: str = ""  # the scene's title, for figures
+
+    def __post_init__(self):
+        if not self.model.twist:
+            # model.twist = false removes the twist field: alpha = 0 everywhere
+            if self.torque.top_Nm != 0 or self.controller.active:
+                raise ParameterError("model.twist", False,
+                                     "needs a torque-free scene (torque.top_Nm = 0, controller off): "
+                                     "torque is carried by the twist, Eq. (31)")
+            if self.discretisation.scheme != "fe":
+                raise ParameterError("model.twist", False, "is implemented by the FE scheme only")
+        # each component's refusals of what it cannot run with
+        sections.check_kinematics(self)
+        components.check(self)
+
+        self._check_groups()
+
+    def _check_groups(self):
+        """The groups of Eqs. (25)-(29) a solve starts from must be floats: finite,
+        and not 0 where the values they scale are not (:data:`GROUP_KEYS`)."""
+        q = Normalised.from_parameters(self)
+        for group, (formula, equation, numerators, others) in GROUP_KEYS.items():
+            scaled = [self.value(k) for k in numerators]
+            value = getattr(q, group)
+            if None in scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
+                continue
+            keys = [*numerators, *others]
+            # named: the key of the most extreme size, the likeliest culprit
+            culprit = max(keys, key=lambda k: abs(math.log10(abs(self.value(k)) or 1.0)))
+            raise ParameterError(
+                culprit, self.value(culprit),
+                f"makes {group} = {formula} = {value!r} ({equation}), out of a float's range "
+                f"(1e-308 to 1e308): {', '.join(keys)} must keep it finite and not 0")
+
+    def value(self, key: str):
+        """The value of a dotted scene key (``damping.axial_s``, ``helix.EI_law.b_Nm2``);
+        None below an absent EI law."""
+        section, *names = key.split(".")
+        obj = getattr(self, section) if hasattr(self, section) else getattr(self.model, section)
+        for name in names:
+            obj = None if obj is None else getattr(obj, name)
+        return obj
+
+    def replace(self, **sections) -> "Parameters":
+        """A copy with some fields of some sections changed:
+        ``p.replace(discretisation={"elements": 32})``; ``damping={...}`` changes
+        the model's damping (the scene's ``[damping]`` section), ``torsion_hysteresis={...}``
+        its hysteretic torsion."""
+        sections = dict(sections)
+        for nested in components.nested("model"):  # held by Model
+            if nested in sections:
+                value = dataclasses.replace(getattr(self.model, nested), **sections.pop(nested))
+                sections["model"] = {**sections.get("model", {}), nested: value}
+        changed = {name: values if isinstance(values, str)
+                   else dataclasses.replace(getattr(self, name), **values)
+                   for name, values in sections.items()}
+        return dataclasses.replace(self, **changed)
+
+    def as_dict(self) -> dict:
+        """Every section as plain data, without the labels (name, title): what
+        fingerprints of results hash."""
+        data = dataclasses.asdict(self)
+        data.pop("name")
+        data.pop("title")
+        return drop_later_switches(data)
+
+    def normalised(self) -> "Normalised":
+        return Normalised.from_parameters(self)
+
+    def describe_model(self, planar: bool = False) -> str:
+        """:meth:`Model.describe` and the helix's EI law when it has one: summary.json's "model"."""
+        text = self.model.describe(planar)
+        return text if self.helix.EI_law is None else f"{text}; {self.helix.EI_law.describe()}"
+
+
+_L0, _M, _g, _GJ = "helix.length_m", "helix.mass_kg", "environment.g_m_s2", "helix.GJ_Nm2"
+_T = (_L0, _g)  # t_scale = sqrt(L0/g)
+#: the normalised groups made of more than one scene value, Eqs. (25)-(29): group ->
+#: (formula, equation, the keys whose values it scales, the keys it is scaled by);
+#: Parameters refuses a scene whose group is not finite, or 0 where those it
+#: scales are not (a float's range is exceeded)
+GROUP_KEYS = {
+    "t_scale": ("sqrt(L0/g)", "Eq. 25", (_L0,), (_g,)),
+    "force_scale": ("M g", "Eq. 29", (_M, _g), ()),
+    "torque_scale": ("GJ/L0", "Eqs. 38-39", (_GJ,), (_L0,)),
+    "sigma": ("EA/(M g)", "Eq. 27", ("helix.EA_N",), (_M, _g)),
+    "mu": ("EI/(M g L0^2)", "Eq. 26", ("helix.EI_Nm2",), (_M, _g, _L0)),
+    "beta": ("GJ/(M g L0^2)", "Eq. 26", (_GJ,), (_M, _g, _L0)),
+    "nu": ("rho0 l_a L0^2 C_D/(2 M)", "Eq. 26",
+           ("environment.air_density_kg_m3", "helix.drag_length_m", "helix.drag_coefficient"),
+           (_L0, _M)),
+    "delta": ("beta sigma/(2 mu)", "Eq. 27", (_GJ, "helix.EA_N"), ("helix.EI_Nm2", _M, _g)),
+    "v_w0": ("v_w0/sqrt(g L0)", "Eq. 27", ("environment.wind_speed_m_s",), _T),
+    "r1": ("R1/L0", "Eq. 70", ("ends.circle_radius_m",), (_L0,)),
+    "omega1": ("2 pi f1 sqrt(L0/g)", "Eq. 70", ("ends.circle_frequency_Hz",), _T),
+    "mN0": ("M_N0 L0/GJ", "Eq. 69", ("torque.top_Nm",), (_L0, _GJ)),
+    "t0": ("t0/sqrt(L0/g)", "Eq. 69", ("torque.rise_time_s",), _T),
+    "spin_target": ("alpha_dot* sqrt(L0/g)", "Eq. 40", ("controller.target_rpm",), _T),
+    **components.group_keys(),
+}

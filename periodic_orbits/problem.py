@@ -1,0 +1,183 @@
+"""The periodic-orbit problem: what a method for the periodic orbits of the forced
+rod provides, apart from how it discretises the period (in the manner of
+BifurcationKit's ``AbstractPeriodicOrbitProblem``, whose ``ShootingProblem``,
+``PeriodicOrbitTrapProblem`` and ``PeriodicOrbitOCollProblem`` are continued by
+the same ``continuation``).
+
+An orbit at the forcing frequency f1 is a zero of a residual G(X, f1) in the
+problem's unknowns X; the pseudo-arclength continuation
+(:mod:`rawehelix.periodic_orbits.continuation`) asks a :class:`PeriodicOrbitProblem` for
+G, its Jacobians in X and in f1, the problem's Newton at fixed f1 and the orbit
+with its Floquet multipliers, and nothing else.  The implementations:
+
+- shooting, :class:`rawehelix.periodic_orbits.floquet.PeriodMap`: X the state at the
+  start of the period, G = P(X) - X - Delta e_alpha with P a scheme's period
+  map; the FE generalised-alpha map (:class:`rawehelix.solvers.orbits.AlphaMap`)
+  and the paper's spline-Galerkin flow
+  (:class:`rawehelix.references.spline_galerkin.orbits.SplineMap`).  The
+  Jacobian in X is the monodromy less the identity, the multipliers the
+  monodromy's eigenvalues, the resolution the steps per period;
+- harmonic balance, next to shooting (not yet written): X the Fourier
+  coefficients of (U, alpha, ...) up to H harmonics of f1 (the twist's steady
+  rotation Delta t / T1 taken out as a known secular term), G the Galerkin
+  projection of the rod's residual F(t, U, U_t, U_tt) onto those harmonics,
+  evaluated by the alternating frequency-time method on ``resolution`` =
+  2H + 1 or more samples per period (the same operator F and its F_U, F_V,
+  F_A as the shooting's, :class:`~rawehelix.solvers.rod_operator.RodOperator`,
+  at each sample: dG/dX = sum over samples of the DFT of F_U + i k w F_V - k^2
+  w^2 F_A), dG/df1 by the chain rule through w = 2 pi f1, the orbit's samples
+  its inverse DFT, and the Floquet multipliers by Hill's method (the
+  eigenvalues of the Hill matrix sorted by the symmetry of their
+  eigenvectors, mu = exp(lambda T1)).  Its internal variables (z of the
+  hysteretic torsion) are carried the same way: their rows of dG/dX replaced
+  by substitution;
+- its linear case, one harmonic about the stationary state with the forcing
+  at small amplitude, is the harmonic response of
+  :mod:`rawehelix.solvers.response` ((K - w^2 M + i w C) X = f): the shooting
+  orbit at small amplitude is that response, its midpoint's lateral ellipse
+  and the first harmonic of its samples (T(0)) the response's
+  (tests/test_orbits.py, ``test_small_amplitude_orbit_is_the_linear_response``,
+  ``test_the_problems_linear_case_is_the_harmonic_response``).
+
+No FE code (numpy only): the spline reference implements it.
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+from typing import Callable
+
+import numpy as np
+
+
+@dataclasses.dataclass
+class Orbit:
+    """A periodic orbit at one f1 (normalised state, SI outputs)."""
+
+    f1_Hz: float
+    X: np.ndarray  # (U, V, A) at the start of the period, phase 0
+    delta: float  # twist rotation per period (normalised)
+    tension_max_N: float
+    tension_min_N: float
+    multipliers: np.ndarray  # Floquet multipliers, by decreasing modulus (the
+    # free twist rotation's pair without a controller set aside: symmetry_multiplier)
+    newton_iterations: int
+    residual: float  # |G| / |X| at the orbit
+    steps: int  # steps per period
+    wall_s: float
+    monodromy: np.ndarray | None = dataclasses.field(default=None, repr=False)  # dP/dX at X
+    symmetry_multiplier: complex | None = None  # the free rotation's pair (no controller)
+    #: the scheme's periodicity defects at the orbit (``PeriodMap.defects``; {}: none)
+    defects: dict = dataclasses.field(default_factory=dict)
+    #: multipliers of the carried variables, set aside (``PeriodMap.set_aside``; None: none)
+    internal_multipliers: np.ndarray | None = dataclasses.field(default=None, repr=False)
+    #: G = P(X) - X - Delta e_alpha at X, from the Floquet period (None: not kept)
+    G: np.ndarray | None = dataclasses.field(default=None, repr=False)
+
+    @property
+    def max_multiplier(self) -> float:
+        return float(np.abs(self.multipliers[0]))
+
+    @property
+    def stable(self) -> bool:
+        return self.max_multiplier < 1.0
+
+    def entry(self) -> dict:
+        out = {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
+               "tension_min_N": self.tension_min_N, "stable": self.stable,
+               "max_multiplier": self.max_multiplier,
+               "newton_iterations": self.newton_iterations, "residual": self.residual,
+               "steps_per_period": self.steps, "wall_s": self.wall_s}
+        if self.defects:
+            out["defects"] = dict(self.defects)
+        if self.internal_multipliers is not None:
+            mu = self.internal_multipliers
+            out["internal_multipliers"] = {
+                "count": int(mu.size),
+                "max_modulus": float(np.abs(mu).max()) if mu.size else None,
+                "max_distance_to_1": float(np.abs(mu - 1.0).max()) if mu.size else None}
+        return out
+
+
+@dataclasses.dataclass(frozen=True)
+class Observable:
+    """A scalar the caller reads off the orbits (BifurcationKit's
+    ``record_from_solution``): ``of_samples`` from one period's samples
+    (:meth:`PeriodicOrbitProblem.samples`, a corrected point before its
+    Floquet period), ``of_orbit`` from a finished :class:`Orbit`; ``name``: its
+    key in the events reported."""
+
+    name: str
+    of_samples: Callable[[np.ndarray], float]
+    of_orbit: Callable[[Orbit], float]
+
+    def __post_init__(self):
+        if not self.name:
+            raise ValueError("Observable: a name is needed (the events' key)")
+
+
+class PeriodicOrbitProblem(abc.ABC):
+    """The periodic orbits of the forced rod as a problem in unknowns X and f1 [Hz]
+    (see the module docstring).  ``resolution``: the discretisation of the period
+    (steps per period, harmonics, samples), an argument of every evaluation so that
+    a continuation can hold it over a corrector."""
+
+    #: the internal variables the problem carries: entries of X its Newton does not
+    #: solve for but sets to what one period makes of them (floquet.py, "Carried
+    #: entries"); their multipliers are reported apart
+    carried = np.zeros(0, dtype=int)
+
+    @abc.abstractmethod
+    def continuable(self) -> None:
+        """Raise SolverError if the problem's orbits cannot be continued in f1
+        (a family of orbits at each f1)."""
+
+    @abc.abstractmethod
+    def resolution(self, f1_Hz: float) -> int:
+        """The problem's own discretisation of the period at f1."""
+
+    @abc.abstractmethod
+    def residual(self, X, f1_Hz: float, jacobian: bool = False, resolution: int | None = None):
+        """(G(X, f1), the orbit's samples over the period, dG/dX or None): dG/dX
+        with ``jacobian``, the carried entries' rows those of the substitution."""
+
+    @abc.abstractmethod
+    def residual_f1(self, X, f1_Hz: float, resolution: int, G=None) -> np.ndarray:
+        """dG/df1 at fixed resolution (``G``: G at (X, f1) if known), zero in the
+        carried entries."""
+
+    @abc.abstractmethod
+    def jacobian(self, orbit: Orbit) -> np.ndarray:
+        """dG/dX at an orbit of :meth:`finish`, as :meth:`residual` gives it."""
+
+    @abc.abstractmethod
+    def norm(self, G, X) -> float:
+        """|G| relative to X over the entries the Newton solves for."""
+
+    @abc.abstractmethod
+    def settle(self, X, G) -> np.ndarray:
+        """X with its carried entries set to what a period makes of them (G at X)."""
+
+    @abc.abstractmethod
+    def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
+              steps: int | None = None, linear: bool = False) -> Orbit:
+        """The orbit near X0 at fixed f1 by the problem's own Newton (``steps``: the
+        resolution; ``linear``: a cheap first Jacobian, where the problem has one)."""
+
+    @abc.abstractmethod
+    def finish(self, X, f1_Hz: float, iterations: int, residual: float, start: float,
+               resolution: int | None = None) -> Orbit:
+        """The orbit through the solution X at f1, with its Floquet multipliers,
+        its samples' extremes and its Jacobian (``start``: perf_counter at the
+        Newton's start, for the wall time)."""
+
+    @abc.abstractmethod
+    def multipliers(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
+        """The Floquet multipliers of the orbit through X, by decreasing modulus
+        (the internal variables' and a symmetry's set aside)."""
+
+    @abc.abstractmethod
+    def samples(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
+        """The orbit's samples over one period from X: the tension at s = 0
+        (normalised) at the resolution's times."""

@@ -1,0 +1,97 @@
+"""The architecture is checked, not only described (issue 28; docs/explanation/architecture.md).
+
+* the import contracts of .importlinter hold (``lint-imports``): the layers run
+  one way, and the paper's references import no FE code;
+* no two modules import each other, directly or round a longer loop, not even
+  inside a function (import-linter has no such contract: grimp's graph, the one
+  it reads, searched here for strongly connected components);
+* no product module is longer than MAX_LINES unless it is listed in LONG with
+  the one job it does.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+importlinter = pytest.importorskip("importlinter.cli")
+grimp = pytest.importorskip("grimp")
+
+ROOT = Path(__file__).resolve().parents[1]
+MAX_LINES = 400  # "no product module over about 400 lines holds more than one job"
+#: the longer modules and their one job
+LONG: dict[str, str] = {
+}
+
+
+def test_import_contracts_hold():
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        assert importlinter.lint_imports(config_filename=str(ROOT / ".importlinter"),
+                                         no_cache=True) == 0
+    finally:
+        os.chdir(cwd)
+
+
+def _cycles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components with more than one module (Tarjan)."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in edges.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    for v in sorted(edges):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_cycle_search_finds_a_loop():
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_import_cycles():
+    graph = grimp.build_graph("rawehelix", include_external_packages=False)
+    edges = {m: set(graph.find_modules_directly_imported_by(m)) for m in graph.modules}
+    # a package's __init__ that re-exports its own modules is not a loop of jobs
+    for m, targets in edges.items():
+        edges[m] = {t for t in targets if not m.startswith(t + ".")}
+    assert _cycles(edges) == []
+
+
+def _product_modules():
+    skip = {"tests", "docs", "benchmarks", "scripts", ".venv", "build"}
+    for path in sorted(ROOT.rglob("*.py")):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in skip or rel.parts[0].startswith(".") or "egg-info" in rel.parts[0]:
+            continue
+        yield str(rel), len(path.read_text().splitlines())
+
+
+def test_long_modules_each_do_one_named_job():
+    long = {name: n for name, n in _product_modules() if n > MAX_LINES}
+    unnamed = {name: n for name, n in long.items() if name not in LONG}
+    assert not unnamed, f"over {MAX_LINES} lines: split them or name their one job in LONG"
+    assert not set(LONG) - set(long), "LONG names a module that is short now: drop it"
