@@ -14,7 +14,7 @@ omega^2) / 2 at the mean tension T (normalised, k = n pi):
 * lateral, tau_b: mu k^4 of T k^2 + mu k^4 (the pinned string-beam).
 
 The cost: CPU time (time.process_time) of stationary + modes
-(``studies.modes.fe_modes``) with all three on against none, and of a 1 s
+(``studies.modes.compute``) with all three on against none, and of a 1 s
 run of ``nominal_operation`` at N = 4 (alpha2, adaptive), median of
 ``--repeats`` after one run that compiles the forms.
 
@@ -37,7 +37,7 @@ from mpi4py import MPI  # noqa: E402
 from rawehelix.families import FAMILY_LABELS, VIBRATIONS  # noqa: E402
 from rawehelix.solvers.dynamics import DynamicsSolver  # noqa: E402
 from rawehelix.studies import scene  # noqa: E402
-from rawehelix.studies.modes import fe_modes  # noqa: E402
+from rawehelix.studies.modes import compute  # noqa: E402
 
 MECHANISMS = ("axial_s", "bending_s", "torsion_s")
 
@@ -45,7 +45,7 @@ MECHANISMS = ("axial_s", "bending_s", "torsion_s")
 def modes(N: int, **damping):
     params = scene.load("stationary_table2", elements=N, degree=3).replace(damping=damping)
     start = time.process_time()
-    result = fe_modes(params, comm=MPI.COMM_SELF, scene="stationary_table2")
+    result = compute(params, comm=MPI.COMM_SELF, scene="stationary_table2")
     return result, time.process_time() - start
 
 

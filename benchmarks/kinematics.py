@@ -1,7 +1,7 @@
 """Table 3 with model.kinematics = "paper" and "extensible", and the cost of the switch.
 
 For the Table 2 helix (``stationary_table2``) at N elements of degree 3: the
-stationary state and its modes (``studies.modes.fe_modes``) with both
+stationary state and its modes (``studies.modes.compute``) with both
 kinematics, the lowest three modes of each family side by side (|lambda|
 normalised, frequency, decay rate) and the CPU time (time.process_time, so
 that other processes on the machine do not count) of stationary + modes,
@@ -29,7 +29,7 @@ from mpi4py import MPI  # noqa: E402
 
 from rawehelix.families import FAMILY_LABELS, VIBRATIONS  # noqa: E402
 from rawehelix.studies import scene  # noqa: E402
-from rawehelix.studies.modes import fe_modes  # noqa: E402
+from rawehelix.studies.modes import compute  # noqa: E402
 
 KINEMATICS = ("paper", "extensible")
 
@@ -38,7 +38,7 @@ def run(kinematics: str, N: int):
     params = scene.load("stationary_table2", elements=N, degree=3).replace(
         model={"kinematics": kinematics})
     start = time.process_time()
-    result = fe_modes(params, comm=MPI.COMM_SELF, scene="stationary_table2")
+    result = compute(params, comm=MPI.COMM_SELF, scene="stationary_table2")
     return result, time.process_time() - start
 
 

@@ -22,7 +22,8 @@ kinematics, which the law needs): per tension a 1-D root find of a constant
 EI (secant, from the closed-form inverse of solvers/analytic.py), the line
 through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
 small loads (the law's energy couples the axial force to kappa^2, so its
-test softens with the load: docs/explanation/labtest.md).
+test softens with the load: docs/explanation/labtest.md); the fit is
+:mod:`rawehelix.studies.labfit`.
 
 :func:`compute` returns a :class:`LabTest`; :meth:`LabTest.write` writes
 summary.json and labtest.png.  Computing writes nothing.
@@ -41,7 +42,7 @@ from mpi4py import MPI
 from rawehelix.errors import SolverError
 from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.solvers import analytic
-from rawehelix.studies import writers
+from rawehelix.studies import labfit, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -57,8 +58,6 @@ DEFAULT_TENSIONS_N = {"axial": (50.0, 100.0, 150.0, 200.0, 250.0),
 DEFAULT_LOADS = {"bending": (2.5, 5.0, 7.5, 10.0),  # F_N [N]
                  "fit": (0.1, 0.2, 0.3, 0.4),  # F_N [N]: the small-load limit (docs/explanation/labtest.md)
                  "torsion": (5.0, 10.0, 15.0, 20.0, 25.0)}  # M_t [Nm], up to ~25 Nm (Sec. 4)
-FIT_TOLERANCE = 1e-4  # relative: the per-tension root find of the intrinsic EI
-FIT_TARGET = 0.01  # the law's simulated test reproduces Eq. (64) within 1 %
 
 
 def eq64(tension_N):
@@ -145,32 +144,6 @@ def torsion_test(solver, tension_N: float, torques_Nm) -> dict:
             "apparent_GJ_Nm2": slope(np.asarray(angle) / L0, torques_Nm)}
 
 
-def intrinsic_EI(solver, tension_N: float, target_Nm2: float, loads_N,
-                 rtol: float = FIT_TOLERANCE, max_iterations: int = 12):
-    """The constant EI of the rod whose simulated bending test at T_e reads
-    ``target_Nm2`` by Eq. (63): secant on log EI from the closed-form inverse."""
-    L0 = solver.q.L0
-
-    def misfit(EI):
-        solver.set_bending_stiffness(EI)
-        return np.log(bending_test(solver, tension_N, loads_N)["apparent_EI_Nm2"] / target_Nm2)
-
-    guess = analytic.cantilever_intrinsic_EI(target_Nm2, tension_N, L0)
-    if guess is None:
-        raise SceneError("labtest --fit", f"T_e = {tension_N:g} N",
-                         f"Eq. (64)'s EI = {target_Nm2:.4g} N m^2 is below the string's "
-                         f"T L0^2 / 3 = {tension_N * L0**2 / 3:.4g} N m^2: no intrinsic EI")
-    x0, x1 = np.log(guess), np.log(guess) + 0.01
-    f0, f1 = misfit(np.exp(x0)), misfit(np.exp(x1))
-    for _ in range(max_iterations):
-        x0, x1, f0 = x1, x1 - f1 * (x1 - x0) / (f1 - f0), f1
-        f1 = misfit(np.exp(x1))
-        if abs(f1) < rtol:
-            return float(np.exp(x1))
-    raise SceneError("labtest --fit", f"T_e = {tension_N:g} N",
-                     f"the root find of the intrinsic EI did not converge (misfit {f1:.2e})")
-
-
 # -- the study ----------------------------------------------------------------------------
 
 NORMAL = np.array([0.0, 0.0, 1.0])  # F_N along k_E: down, with gravity (Fig. 2b's ballast)
@@ -241,7 +214,7 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
                        torque_Nm=list(loads),
                        apparent_GJ_Nm2=[r["apparent_GJ_Nm2"] for r in rows])
     elif fit:
-        rows, law_summary = _fit(solver, tensions, loads)
+        rows, law_summary = labfit.fit(solver, tensions, eq64(tensions), loads, bending_test)
         summary.update(law_summary)
         summary["model"] = _describe(params.replace(helix={"EI_law": law_summary["law"]}))
     else:
@@ -277,57 +250,6 @@ def closed_form_apparent_EI(params, rod_EI, tensions) -> list:
         T, EI_t = analytic.cantilever_transverse(T_e, EI, params.helix.EA_N, params.model.kinematics)
         out.append(float(analytic.cantilever_apparent_EI(EI_t, T, LAB_LENGTH_M)))
     return out
-
-
-def _fit(solver, tensions, loads):
-    """The intrinsic law EI = a T + b (see the module doc): the roots of a constant
-    EI per tension, the line through them, then (a, b) refined by Gauss-Newton
-    on the law's own simulated tests (the law in the rod at the local tension)."""
-    targets = eq64(tensions)
-    roots = [intrinsic_EI(solver, T, t, loads) for T, t in zip(tensions, targets)]
-    line = np.polyfit(tensions, roots, 1)
-    law, rows, misfit, iterations = _refine_law(solver, tensions, targets, loads, line)
-    a, b = law
-    apparent = np.array([r["apparent_EI_Nm2"] for r in rows])
-    error = apparent / targets - 1
-    intrinsic = a * np.asarray(tensions) + b
-    return rows, {
-        "fit": True, "tension_N": list(tensions), "load_N": list(loads),
-        "law": {"a_Nm2_per_N": float(a), "b_Nm2": float(b)},
-        "law_applied_as": "helix.EI_law in the rod: EI = a T + b at the local tension T = EA eps",
-        "gauss_newton_iterations": iterations,
-        "intrinsic_EI_Nm2": intrinsic.tolist(),
-        "constant_EI_roots_Nm2": roots,
-        "line_through_roots": {"a_Nm2_per_N": float(line[0]), "b_Nm2": float(line[1])},
-        "apparent_EI_Nm2": apparent.tolist(), "eq64_EI_Nm2": targets.tolist(),
-        "relative_error": error.tolist(),
-        "within_1_percent": bool(np.all(np.abs(error) <= FIT_TARGET)),
-        "eq64_over_intrinsic": (targets / intrinsic).tolist(),
-    }
-
-
-def _refine_law(solver, tensions, targets, loads, start, max_iterations: int = 8):
-    """Gauss-Newton on (a, b) for log(apparent EI / Eq. 64) at the tensions, the law
-    in the rod; from ``start``, finite-difference Jacobian.  (law, rows, misfit, its)."""
-    def run(law):
-        solver.set_bending_law(*law)
-        rows = [bending_test(solver, T, loads) for T in tensions]
-        return rows, np.log(np.array([r["apparent_EI_Nm2"] for r in rows]) / targets)
-
-    law = np.asarray(start, dtype=float)
-    rows, misfit = run(law)
-    for iteration in range(max_iterations):
-        if np.abs(misfit).max() < FIT_TOLERANCE:
-            return law, rows, misfit, iteration
-        steps = 1e-3 * np.abs(law)
-        J = np.column_stack([(run(law + h * np.eye(2)[k])[1] - misfit) / h
-                             for k, h in enumerate(steps)])
-        step = np.linalg.lstsq(J, -misfit, rcond=None)[0]
-        law = law + step
-        rows, misfit = run(law)
-        if np.all(np.abs(step) <= 1e-6 * np.abs(law)):  # the least-squares floor
-            return law, rows, misfit, iteration + 1
-    return law, rows, misfit, max_iterations
 
 
 def _check(test, tensions, loads, fit, rod_EI):

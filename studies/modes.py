@@ -34,6 +34,7 @@ import numpy as np
 
 from rawehelix.families import FAMILY_LABELS, OVERDAMPED, VIBRATIONS
 from rawehelix.parameters import Parameters
+from rawehelix.studies import limits, schemes
 
 PER_FAMILY = 3  # modes of each family in the default selection
 OVERDAMPED_SHOWN = 2 * PER_FAMILY  # real roots in it: both of PER_FAMILY overdamped pairs
@@ -203,60 +204,10 @@ def check_count(count):
         raise SceneError("modes", "count", "must be an integer >= 1")
 
 
-def spline_modes(params: Parameters, count: int | None = None) -> ModesResult:
-    """Stationary state (Newton from the shooting solution) and spectrum, spline scheme."""
-    from rawehelix.references.spline_galerkin import spectrum, stationary
-    from rawehelix.references.spline_galerkin.system import SplineGalerkin
-
-    start = time.perf_counter()
-    q = params.normalised()
-    system = SplineGalerkin(q, params.discretisation.elements)
-    found = spectrum.modes(system, stationary.solve(system).x)
-    chosen = select(found, count)
-    info = {"scheme": "spline", "elements": params.discretisation.elements,
-            "gamma": "off", "model": params.describe_model(),
-            "missing_families": _missing(found, VIBRATIONS) if count is None else {},
-            "wall_s": time.perf_counter() - start}
-    return ModesResult([ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions, q)
-                        for m in chosen], info, radius_m=params.helix.radius_m)
-
-
-def fe_modes(params: Parameters, count: int | None = None, comm=None,
-             scene: str = "scene") -> ModesResult:
-    """Stationary state and its modes (SLEPc), FE scheme; the same result on every rank."""
-    from mpi4py import MPI
-
-    from rawehelix.solvers.modal import ModalSolver
-
-    comm = comm or MPI.COMM_WORLD
-    start = time.perf_counter()
-    q = params.normalised()
-    disc = params.discretisation
-    solver = ModalSolver.from_stationary(params, comm, scene=scene)
-    nev = None if count is None else 2 * count + 4  # both of each pair, the rigid one
-    found = solver.solve(nev=nev, require_families=False)
-    chosen = select(found, count)
-    shapes = [solver.mode_shape(m) for m in chosen]  # collective
-    _, x0 = solver.centre_line()  # collective
-    result = None
-    if comm.rank == 0:
-        info = {"scheme": "fe", "elements": disc.elements, "degree": disc.degree,
-                "dofs": solver.rod.dof_count(), "ranks": comm.size, "gamma": params.model.gamma,
-                "model": params.describe_model(),
-                "mean_tension_N": float(q.tension_N(solver.mean_tension_value)),
-                "missing_families": solver.missing if count is None else {},
-                "wall_s": time.perf_counter() - start}
-        result = ModesResult([ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions, q,
-                                            shape) for m, shape in zip(chosen, shapes)],
-                             info, x0_m=q.length_m(x0), radius_m=params.helix.radius_m)
-    result = comm.bcast(result, root=0)
-    result.rank = comm.rank
-    return result
-
-
 def compute(params: Parameters, count: int | None = None, comm=None,
             scene: str | None = None) -> ModesResult:
-    """Modes of the stationary state for ``params.discretisation.scheme``.
+    """Modes of the stationary state for ``params.discretisation.scheme``
+    (:mod:`rawehelix.studies.schemes`).
 
     Parameters
     ----------
@@ -269,16 +220,29 @@ def compute(params: Parameters, count: int | None = None, comm=None,
     Raises SceneError for a bad count, SolverError if a solve fails.
     """
     check_count(count)
-    from rawehelix.studies import limits
     limits.check_bending_resolution(params, "modes")
-    scheme = params.discretisation.scheme
-    if scheme == "fe":
-        result = fe_modes(params, count, comm, scene or params.name)
-    elif scheme == "spline":
-        result = spline_modes(params, count)
-    else:
-        raise ValueError(f"unknown scheme {scheme!r}")
-    result.info = {"scene": params.name, **result.info}
+    start = time.perf_counter()
+    q = params.normalised()
+    disc = params.discretisation
+    nev = None if count is None else 2 * count + 4  # both of each pair, the rigid one
+    spectrum = schemes.of(params).spectrum(params, comm, scene or params.name, nev)
+    chosen = select(spectrum.modes, count)
+    shapes = spectrum.shapes(chosen)  # collective (FE)
+    x0 = spectrum.centre_line()  # collective (FE)
+    result = None
+    if spectrum.comm is None or spectrum.comm.rank == 0:
+        missing = _missing(spectrum.modes, VIBRATIONS) if spectrum.missing is None \
+            else spectrum.missing
+        info = {"scene": params.name, "scheme": disc.scheme, "elements": disc.elements,
+                **spectrum.info, "missing_families": missing if count is None else {},
+                "wall_s": time.perf_counter() - start}
+        result = ModesResult([ModeResult.of(m.eigenvalue, m.family, m.dominant, m.fractions, q,
+                                            shape) for m, shape in zip(chosen, shapes)],
+                             info, x0_m=None if x0 is None else q.length_m(x0),
+                             radius_m=params.helix.radius_m)
+    if spectrum.comm is not None:
+        result = spectrum.comm.bcast(result, root=0)
+        result.rank = spectrum.comm.rank
     return result
 
 

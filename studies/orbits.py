@@ -48,7 +48,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import writers
+from rawehelix.studies import schemes, writers
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
@@ -160,11 +160,7 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
 def period_map(params: Parameters):
     """The scene's scheme's period map on this rank: the FE generalised-alpha
     map, or the paper's spline-Galerkin flow (``discretisation.scheme``)."""
-    if params.discretisation.scheme == "spline":
-        from rawehelix.references.spline_galerkin.orbits import SplineMap
-        return SplineMap(params)
-    from rawehelix.solvers.orbits import AlphaMap
-    return AlphaMap(params, comm=MPI.COMM_SELF)
+    return schemes.of(params).period_map(params)
 
 
 def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[float], float]:
@@ -172,27 +168,8 @@ def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[flo
     about its stationary state, in its scheme, on this rank (``m``: the scene's
     period map, whose stationary state the spline scheme linearises about), and
     that state's tension at s = 0 [N] (where the sites' predictions hold)."""
-    from rawehelix.families import LATERAL
-    if params.discretisation.scheme == "spline":
-        from rawehelix.references.spline_galerkin import spectrum
-        to_Hz = 1.0 / (2 * np.pi * m.q_base.t_scale)
-        y0 = m.embed(m.X_stationary)
-        f = [abs(x.eigenvalue.imag) * to_Hz
-             for x in spectrum.modes(m.system, y0) if x.family in LATERAL]
-        T0 = m.q_base.tension_N(m.system.tension(y0, 0.0, s=np.array([0.0])))[0]
-        return sorted(x for x in f if x <= f_max_Hz), float(T0)
-    from rawehelix.solvers.response import HarmonicResponse
     from rawehelix.studies.response import natural_modes
-    # the FE linearisation about the circle's centre (R1 = 0), as `rawehelix response`;
-    # undamped: a site is f_n / k within a 5 % window, which structural damping moves
-    # by its second order (< 0.1 %, docs/explanation/model.md), and the damped pencil is a PEP
-    # that SLEPc does not always close at small N
-    if params.model.damping.active:
-        params = params.replace(damping={"axial_s": 0.0, "bending_s": 0.0, "torsion_s": 0.0})
-    solver = HarmonicResponse.from_stationary(params, MPI.COMM_SELF, scene=params.name)
-    T0 = params.normalised().tension_N(solver.modal.stationary_result.tension)[0]
-    return ([x["frequency_Hz"] for x in natural_modes(solver, f_max_Hz, margin=1.0)
-             if x["family"] in LATERAL], float(T0))
+    return schemes.of(params).driven_frequencies(params, m, f_max_Hz, natural_modes)
 
 
 def tension_max(m):
@@ -343,10 +320,11 @@ def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
         found += p
         info.append({"rank": k, "f1_Hz": cuts[k], "points": len(entries), **sites})
     disc = params.discretisation
-    spline = disc.scheme == "spline"
+    scheme = schemes.of(params)
     return OrbitsResult(scene=params.name, title=params.title, elements=disc.elements,
-                        degree=None if spline else disc.degree,
-                        dt_s=None if spline else params.time.dt_s, scheme=disc.scheme,
+                        degree=disc.degree if scheme.has_degree else None,
+                        dt_s=params.time.dt_s if scheme.fixed_time_step else None,
+                        scheme=disc.scheme,
                         branch=branch, folds=folds,
                         bifurcations=bifurcations, wall_s=wall_s, peaks=found, windows=info,
                         junctions=junctions, tension_step=tension_step)

@@ -1,6 +1,13 @@
-"""The named quantities of parameter studies and calibrations: a scene -> floats.
+"""The one registry of named quantities, for ``study``, ``calibrate`` and ``converge``.
 
-Each quantity belongs to one *stage*, the least computation that gives it:
+A quantity is evaluated in one or both of two ways:
+
+* at a point (``study``, ``calibrate``): a scene -> a float, through the API;
+* refined (``converge``): over refinement ladders in N or dt, each run in its
+  scheme (:class:`rawehelix.studies.converge.methods.Refinement`; the schemes'
+  evaluations are :mod:`rawehelix.studies.schemes`).
+
+At a point, each quantity belongs to one *stage*, the least computation that gives it:
 
     stationary   Newton on the stationary state alone (no shooting reference)
     modes        the stationary state and its modes (never a time integration)
@@ -29,6 +36,8 @@ from typing import Callable
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.families import VIBRATIONS
 from rawehelix.parameters import ParameterError, Parameters
+from rawehelix.studies.converge import methods as ladders
+from rawehelix.studies.converge.methods import Refinement
 
 AT = "@"  # tension_max_N@F1: the quantity at one forcing frequency
 LATERAL = ("lateral_in_plane", "lateral_out_of_plane")
@@ -38,9 +47,15 @@ LATERAL = ("lateral_in_plane", "lateral_out_of_plane")
 class Quantity:
     name: str
     unit: str
-    stage: str  # a key of STAGES, or "sweep@F1"
-    pick: Callable  # stage result -> float (raises QuantityError if the result has none)
+    stage: str | None  # at a point: a key of STAGES, or "sweep@F1"; None: refined only
+    pick: Callable | None  # stage result -> float (raises QuantityError if the result has none)
     doc: str
+    refinement: Refinement | None = None  # refined (converge); None: at a point only
+
+    def __post_init__(self):
+        if (self.stage is None) != (self.pick is None) or (self.stage is None
+                                                          and self.refinement is None):
+            raise ValueError(f"quantity {self.name}: a stage with its pick, or a refinement")
 
 
 class QuantityError(ValueError):
@@ -154,7 +169,34 @@ def _modal(family: str, field: str):
     return lambda modes: float(getattr(_lowest(modes, (family,)), field))
 
 
+def _refined(name: str, unit: str, doc: str, methods: list, evaluate, components: list,
+             **more) -> Quantity:
+    """A quantity of ``converge``: ``methods`` refined against the finest run of FE p = 4."""
+    return Quantity(name, unit, None, None, doc,
+                    Refinement(methods, "FE p=4", evaluate, components, **more))
+
+
+_N = ladders.DT_LADDER_ELEMENTS
+#: the time reference of the dt ladders: the finest run of alpha2 at their N
+_DT_REFERENCE = {"time_reference": f"FE N={_N} p=3 alpha2 (dt)"}
+
+#: every named quantity, at a point or refined
 QUANTITIES = {q.name: q for q in [
+    _refined("tension_s0", "N", "stationary tension at s = 0 (Sec. 5.1)",
+             ladders.space_methods(ladders.FE_LADDER, ladders.SPLINE_LADDER),
+             ladders.tension_s0, ["T(0)"], independent=ladders.shooting_tension_s0),
+    _refined("eigenvalues", "1/s", "|lambda| of the lowest mode of each family (Table 3)",
+             ladders.space_methods((2, 4, 8, 16, 32), (2, 4, 8, 16)), ladders.eigenvalues,
+             list(VIBRATIONS)),
+    _refined("spin_overshoot", "rpm", "largest spin at s = 0 above the target (Sec. 5.2)",
+             ladders.dynamic_methods((2, 4, 8, 16), (2, 4, 8), ladders.SPIN_DTS, _N),
+             ladders.spin_overshoot, ["overshoot"], **_DT_REFERENCE, **ladders.SPIN_SCALE),
+    _refined("settling_time", "s", "when the three spins stay in the settling band (Sec. 5.2)",
+             ladders.dynamic_methods((2, 4, 8, 16), (2, 4, 8), ladders.SPIN_DTS, _N),
+             ladders.settling_time, ["settling"], **_DT_REFERENCE),
+    _refined("tension_max", "N", "T max at s = 0 of the periodic response at 10 Hz (Fig. 8)",
+             ladders.dynamic_methods((4, 8, 16), (2, 3, 4, 6), ladders.TENSION_MAX_DTS, _N),
+             ladders.tension_max, ["T max at 10 Hz"], **_DT_REFERENCE),
     Quantity("tension_s0_N", "N", "stationary", lambda r: r["tension_s0_N"],
              "tension at the ground end s = 0 of the stationary state"),
     Quantity("sag_m", "m", "stationary", lambda r: r["sag_m"],
@@ -182,32 +224,42 @@ QUANTITIES = {q.name: q for q in [
 ]}
 
 
+#: the quantities at a point (``study``, ``calibrate``)
+AT_A_POINT = {name: q for name, q in QUANTITIES.items() if q.stage is not None}
+
+
 def names() -> list[str]:
-    return list(QUANTITIES)
+    """The quantities of ``study`` and ``calibrate``."""
+    return list(AT_A_POINT)
+
+
+def refined() -> dict[str, Quantity]:
+    """The quantities of ``converge`` by name (each with its :class:`Refinement`)."""
+    return {name: q for name, q in QUANTITIES.items() if q.refinement is not None}
 
 
 def parse(name: str, where: str = "--quantity") -> tuple[Quantity, float | None]:
     """The quantity of a name (``tension_max_N@10`` -> the family at f1 = 10 Hz)."""
     base, sep, f1_text = name.partition(AT)
     key = f"{base}{AT}F1" if sep else base
-    if key not in QUANTITIES or (key.endswith(f"{AT}F1") and not sep):
-        raise SceneError(where, name, "unknown quantity; known are " + ", ".join(QUANTITIES))
+    if key not in AT_A_POINT or (key.endswith(f"{AT}F1") and not sep):
+        raise SceneError(where, name, "unknown quantity; known are " + ", ".join(AT_A_POINT))
     if not sep:
-        return QUANTITIES[key], None
+        return AT_A_POINT[key], None
     try:
         f1 = float(f1_text)
     except ValueError:
         f1 = -1.0
     if not (f1 > 0 and math.isfinite(f1)):
         raise SceneError(where, name, f"F1 in {base}{AT}F1 must be a frequency > 0 in Hz")
-    return QUANTITIES[key], f1
+    return AT_A_POINT[key], f1
 
 
 def parse_list(text: str, where: str = "--quantity") -> list[str]:
     """``Q[,Q...]`` -> the names, each checked (:func:`parse`)."""
     items = [t.strip() for t in str(text).split(",") if t.strip()]
     if not items:
-        raise SceneError(where, text, "give at least one quantity: " + ", ".join(QUANTITIES))
+        raise SceneError(where, text, "give at least one quantity: " + ", ".join(AT_A_POINT))
     for item in items:
         parse(item, where)
     return items
@@ -256,4 +308,4 @@ def evaluate(params: Parameters, wanted: list[str], timed_out: Callable | None =
 
 def table() -> str:
     """The quantities, one a line (for --help and docs/explanation/study.md)."""
-    return "\n".join(f"  {q.name:<36} [{q.unit}] ({q.stage}) {q.doc}" for q in QUANTITIES.values())
+    return "\n".join(f"  {q.name:<36} [{q.unit}] ({q.stage}) {q.doc}" for q in AT_A_POINT.values())

@@ -34,7 +34,7 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, metrics, writers
+from rawehelix.studies import limits, metrics, schemes, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -204,9 +204,9 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     from rawehelix.solvers.dynamics import DynamicsSolver
 
     start = time.perf_counter()
-    if params.discretisation.scheme != "fe":
-        raise SceneError(params.name, "discretisation.scheme", "'simulate' runs the FE scheme "
-                         "(the spline reference is solvers.spline_galerkin.dynamics)")
+    refusal = schemes.of(params).simulate_refusal
+    if refusal:
+        raise SceneError(params.name, "discretisation.scheme", refusal)
     if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
         raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
     limits.check_bending_resolution(params, "simulate")

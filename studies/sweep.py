@@ -40,19 +40,13 @@ from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, writers
+from rawehelix.studies import limits, schemes, writers
 from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
 from rawehelix.studies.scene import SceneError
 
 def make_backend(params: Parameters, comm):
     """The integrator for the scene's scheme."""
-    q = params.normalised()
-    disc = params.discretisation
-    if disc.scheme == "spline":
-        from rawehelix.references.spline_galerkin.forced import SplineBackend
-        return SplineBackend(q, disc.elements)
-    from rawehelix.solvers.forced import FEBackend
-    return FEBackend(params, comm)
+    return schemes.of(params).forced_backend(params, comm)
 
 
 def validate_frequencies(f1_Hz) -> list[float]:
@@ -197,7 +191,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     stepsize.check(params, frequencies)  # FE: fixed steps resolve the forcing and omega_L
     disc = params.discretisation
     header = {"scene": params.name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
-              "elements": disc.elements, "degree": disc.degree if disc.scheme == "fe" else None}
+              "elements": disc.elements, "degree": disc.degree if schemes.of(params).has_degree else None}
     if checkpoint is not None:
         store = DirectoryStore(Path(checkpoint), header)
         store.open(comm)

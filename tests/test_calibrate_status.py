@@ -11,7 +11,8 @@ import pytest
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError
-from rawehelix.studies import calibrate, cli, pool, quantities, study
+from rawehelix.cli import main as cli
+from rawehelix.studies import calibrate, pool, quantities, study
 
 N = 4
 TARGET = {"tension_s0_N": 250.0}

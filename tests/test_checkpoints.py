@@ -528,10 +528,11 @@ def test_the_command_line_ends_a_full_disk_with_one_line_and_status_1(tmp_path, 
     itself, as matplotlib's savefig would) is one line naming the file, exit 1,
     and the folder's lock is let go."""
     from rawehelix.cli import main as cli
+    from rawehelix.cli.commands import COMMANDS
 
     def full(rh, params, args, outdir, comm):
         raise OSError(errno.ENOSPC, "No space left on device", str(outdir / "sweep.png"))
-    monkeypatch.setitem(cli.COMMAND, "stationary", full)
+    monkeypatch.setattr(COMMANDS["stationary"], "run", full)
     out = tmp_path / "out"
     assert cli.main(["stationary", "mobile_end", "--elements", "2", "-o", str(out)]) == 1
     err = capsys.readouterr().err

@@ -1,6 +1,6 @@
 """`rawehelix converge`: observed orders, outputs, resuming, and the time-step ladders.
 
-Small ladders of the full study (``studies.converge.quantities``) so that the
+Small ladders of the full study (``studies.quantities``, ``studies.converge.methods``) so that the
 machinery is checked in seconds; the full tables are in docs/converge.
 """
 
@@ -10,8 +10,9 @@ import math
 import pytest
 from mpi4py import MPI
 
-from rawehelix.studies import converge, scene
+from rawehelix.studies import quantities, scene
 from rawehelix.studies.converge import Method
+from rawehelix.studies.converge import study as converge
 
 
 def study(tmp_path, quantity, scene_name, methods):
@@ -49,7 +50,7 @@ def test_time_step_ladder(tmp_path):
     (measured 4.4 then 2.8 on 20/10/5 ms, approaching 2; asserted > 1.5), and
     the outputs name each run's N and dt."""
     time_ref = "FE N=8 p=3 alpha2 (dt)"  # the quantity's time reference: its finest run
-    assert converge.quantities()["spin_overshoot"].time_reference == time_ref
+    assert quantities.refined()["spin_overshoot"].refinement.time_reference == time_ref
     methods = [Method("FE p=4", "fe", 4, (2,)),
                Method("FE N=2 p=3 alpha2", "fe", 3, (0.02, 0.01, 0.005), "dt_s", "alpha2", 2),
                Method(time_ref, "fe", 3, (0.02, 0.00125), "dt_s", "alpha2", 2)]

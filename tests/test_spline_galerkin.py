@@ -14,7 +14,7 @@ from rawehelix.references.spline_galerkin.basis import SplineBasis
 from rawehelix.references.spline_galerkin.system import SplineGalerkin
 from rawehelix.studies import modes as modes_study
 from rawehelix.studies import paper
-from rawehelix.studies import scene
+from rawehelix.studies import scene, schemes
 
 
 @pytest.fixture(scope="module")
@@ -235,8 +235,28 @@ def test_modes_run_fe_failure_leaves_no_output(tmp_path, monkeypatch):
 def test_modes_run_failure_leaves_no_output(tmp_path, monkeypatch):
     def boom(*a, **k):
         raise RuntimeError("Newton did not converge")
-    monkeypatch.setattr(modes_study, "spline_modes", boom)
+    monkeypatch.setattr(schemes.Spline, "spectrum", boom)
     params = scene.load("stationary_table2", scheme="spline", elements=2)
     with pytest.raises(RuntimeError):
         run_modes(params, tmp_path / "x")
     assert not (tmp_path / "x").exists()
+
+
+def test_scheme_registry_refuses_an_unknown_name_as_a_scene_does():
+    from rawehelix.parameters import SCHEMES, ParameterError
+    assert tuple(schemes.SCHEME_REGISTRY) == SCHEMES
+    with pytest.raises(ParameterError, match=r"must be one of \('fe', 'spline'\)"):
+        schemes.get("fd")
+    with pytest.raises(scene.SceneError, match=r"must be one of \('fe', 'spline'\)"):
+        scene.load("stationary_table2", scheme="fd")
+
+
+def test_both_schemes_of_the_registry_give_the_shooting_tension():
+    """T(0) of each scheme, asked of the registry, against the shooting reference."""
+    from rawehelix.references import shooting
+    for name, N in (("fe", 4), ("spline", 8)):
+        params = scene.load("stationary_table2", scheme=name, elements=N)
+        assert schemes.of(params).name == name
+        q = params.normalised()
+        expected = q.tension_N(shooting.solve(q).tension(0.0))
+        assert schemes.of(params).stationary_tension_N(params) == pytest.approx(expected, rel=1e-3)

@@ -50,6 +50,16 @@ def test_unknown_quantity_names_the_known_ones():
     assert quantities.parse("tension_max_N@10")[1] == 10.0
 
 
+def test_one_registry_serves_study_and_converge():
+    """study/calibrate take the quantities at a point, converge the refined ones,
+    all from the one registry; neither accepts the other's."""
+    assert set(quantities.names()) | set(quantities.refined()) == set(quantities.QUANTITIES)
+    assert not set(quantities.names()) & set(quantities.refined())
+    with pytest.raises(rh.SceneError, match="unknown quantity"):
+        quantities.parse("tension_s0")  # converge's, refined only
+    assert all(q.refinement.methods and q.stage is None for q in quantities.refined().values())
+
+
 # -- rawehelix study ------------------------------------------------------------------------
 import json  # noqa: E402
 import math  # noqa: E402

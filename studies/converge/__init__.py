@@ -18,13 +18,16 @@ its own communicator; rank 0 gathers and writes ``converge.csv``,
 
 Modules, one job each:
 
-- :mod:`.quantities`: what each quantity evaluates, and its ladders;
+- :mod:`.methods`: the methods, one run of a method, the ladders (the quantities
+  by name are in the one registry :mod:`rawehelix.studies.quantities`);
 - :mod:`.study`: the loop over the ladders, errors and observed orders;
 - :mod:`.cache`: finished (and failed) runs in ``DIR/runs/``, for resuming;
 - :mod:`.report`: ``converge.csv``, ``converge.md``, ``work_precision.png``.
+
+The package imports only :mod:`.methods` (light: no PETSc), which the one
+registry of quantities imports; the study is :func:`.study.run`.
 """
 
-from rawehelix.studies.converge.quantities import Method, Quantity, quantities
-from rawehelix.studies.converge.study import Run, run
+from rawehelix.studies.converge.methods import Method, Refinement
 
-__all__ = ["Method", "Quantity", "Run", "quantities", "run"]
+__all__ = ["Method", "Refinement"]

@@ -1,5 +1,5 @@
 """The report of a refinement study: ``converge.csv``, ``converge.md`` and
-``work_precision.png``, from the summary of :func:`rawehelix.studies.converge.run`.
+``work_precision.png``, from the summary of :func:`rawehelix.studies.converge.study.run`.
 
 The functions take data (the summary, the runs by method, the quantity) and
 return text or write one file; they never solve.
@@ -37,13 +37,13 @@ def csv_text(summary: dict, unit: str, components: list) -> str:
 def markdown(summary: dict, qty, name: str) -> str:
     """The table of runs, headed by what the errors are measured against."""
     ref, unit = summary["reference"], qty.unit
-    var = qty.methods[0].variable
+    var = qty.refinement.methods[0].variable
     lines = [f"# Convergence of `{qty.name}` ({name})", "",
              f"Error: relative to the finest run of {ref['method']} ({var} = {ref[var]}), "
              f"value {np.array2string(np.asarray(ref['value']), precision=10)} {unit}."]
     if summary.get("error_scale") is not None:
         lines.append(f"Errors are |value - reference| / {summary['error_scale']:g} {unit} (the "
-                     f"value itself is near zero): {qty.scale_note}")
+                     f"value itself is near zero): {qty.refinement.scale_note}")
     tref = summary.get("time_reference")
     if tref is not None:
         lines.append(f"The dt ladders (fixed steps) are measured against {tref['method']} at "
@@ -73,7 +73,7 @@ def work_precision_png(path: Path, by_method: dict, qty, name: str) -> Path:
         pts = [(r.wall_s, r.error) for r in series if r.error > 0 and np.isfinite(r.error)]
         if pts:
             w, e = zip(*pts)
-            timed = qty.time_reference and series[0].method.variable == "dt_s"
+            timed = qty.refinement.time_reference and series[0].method.variable == "dt_s"
             ax.loglog(w, e, "s--" if timed else "o-",
                       label=f"{label}: time error only" if timed else label)
     for level in (1e-2, 1e-3, 1e-4):

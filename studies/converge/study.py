@@ -18,10 +18,10 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import writers
+from rawehelix.studies import quantities, writers
 from rawehelix.studies.converge import report
 from rawehelix.studies.converge.cache import RunCache
-from rawehelix.studies.converge.quantities import Method, Quantity, quantities
+from rawehelix.studies.converge.methods import Method
 
 
 @dataclass
@@ -75,9 +75,9 @@ def step_label(method: Method, value) -> str:
     return f"N = {int(value)}"
 
 
-def _my_runs(qty: Quantity, params, jobs, cache: RunCache, comm, log) -> list:
+def _my_runs(qty: quantities.Quantity, params, jobs, cache: RunCache, comm, log) -> list:
     """(job index, values, wall time, failure) of this rank's share of the jobs."""
-    mine, warm = [], set()
+    mine, warm, evaluate = [], set(), qty.refinement.evaluate
     for k, (method, value) in enumerate(jobs):
         if k % comm.size != comm.rank:
             continue
@@ -89,13 +89,14 @@ def _my_runs(qty: Quantity, params, jobs, cache: RunCache, comm, log) -> list:
             continue
         try:
             if method.label not in warm:  # just-in-time compilation is not part of the cost:
-                qty.evaluate(params, method, method.ladder[0])  # warm up on the cheapest run
+                evaluate(params, method, method.ladder[0])  # warm up on the cheapest run
                 warm.add(method.label)
-            result, wall = _timed(qty.evaluate, params, method, value)
+            result, wall = _timed(evaluate, params, method, value)
             failed = None
         except (SolverError, ArithmeticError, RuntimeError) as err:
             # a run that fails is a result too (a step too long, a mesh too coarse)
-            result, wall, failed = np.full(len(qty.components), math.nan), math.nan, str(err)
+            result, wall = np.full(len(qty.refinement.components), math.nan), math.nan
+            failed = str(err)
         cache.put(method.label, value, result, wall, failed)
         mine.append((k, result, wall, failed))
         log(f"  {method.label:>10} {step_label(method, value)}: "
@@ -109,24 +110,25 @@ def _finest(runs: list[Run], label: str) -> Run | None:
                key=lambda r: r.method.resolution(r.value_of_ladder), default=None)
 
 
-def _summarise(qty: Quantity, params, runs: list[Run], name: str):
+def _summarise(qty: quantities.Quantity, params, runs: list[Run], name: str):
     """(summary, runs by method): errors of the space ladders against the
     finest run of the reference method, of the dt ladders against the finest
     run of the time reference (when the quantity has one)."""
-    ref_run = _finest(runs, qty.reference)
+    how = qty.refinement
+    ref_run = _finest(runs, how.reference)
     reference = ref_run.result
-    time_ref = _finest(runs, qty.time_reference) if qty.time_reference else None
+    time_ref = _finest(runs, how.time_reference) if how.time_reference else None
     space = [r for r in runs if time_ref is None or r.method.variable != "dt_s"]
-    scale = qty.error_scale(params) if qty.error_scale else None
+    scale = how.error_scale(params) if how.error_scale else None
     by_method = errors_and_orders(space, reference, scale)
     if time_ref is not None:
         by_method.update(errors_and_orders([r for r in runs if r not in space], time_ref.result,
                                            scale))
-    independent = qty.independent(params) if qty.independent else None
+    independent = how.independent(params) if how.independent else None
     summary = {
         "scene": name, "quantity": qty.name, "unit": qty.unit,
-        "components": qty.components,
-        "reference": {"method": qty.reference, qty.methods[0].variable: ref_run.value_of_ladder,
+        "components": how.components,
+        "reference": {"method": how.reference, how.methods[0].variable: ref_run.value_of_ladder,
                       "value": reference,
                       "independent": independent,
                       "independent_rel_diff": None if independent is None else
@@ -146,11 +148,13 @@ def _summarise(qty: Quantity, params, runs: list[Run], name: str):
     return summary, by_method
 
 
-def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: Quantity, name: str):
+def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: quantities.Quantity,
+                  name: str):
     """summary.json, converge.csv, converge.md and work_precision.png in ``outdir``."""
     outdir.mkdir(parents=True, exist_ok=True)
     writers.write_json(outdir / "summary.json", summary)
-    writers.write_text(outdir / "converge.csv", report.csv_text(summary, qty.unit, qty.components))
+    writers.write_text(outdir / "converge.csv",
+                       report.csv_text(summary, qty.unit, qty.refinement.components))
     writers.write_text(outdir / "converge.md", report.markdown(summary, qty, name))
     report.work_precision_png(outdir / "work_precision.png", by_method, qty, name)
 
@@ -161,8 +165,8 @@ def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "sce
     default); finished runs are kept in ``outdir/runs/``.  Returns the
     summary on every rank."""
     start = time.perf_counter()
-    qty = quantities()[quantity]
-    methods = methods or qty.methods
+    qty = quantities.refined()[quantity]
+    methods = methods or qty.refinement.methods
     jobs = [(m, v) for m in methods for v in m.ladder]
     cache = RunCache(Path(outdir) / "runs" if outdir is not None else None, params, quantity)
     gathered = comm.gather(_my_runs(qty, params, jobs, cache, comm, log), root=0)

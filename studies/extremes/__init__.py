@@ -23,6 +23,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.solvers import analytic
+from rawehelix.studies import schemes
 
 HERE = Path(__file__).parent
 
@@ -184,14 +185,12 @@ def f1_40hz():
     (725.5 N, measured once: 87 s; FE at dt = 0.5 ms gives 723-727 N, at the
     scene's 0.2 ms 712-717 N); the spline at N = 3 and 4 gives 760 and
     884 N; the paper's N = 2 gives 89 N, a periodic and silently wrong answer."""
-    from rawehelix.solvers.forced import FEBackend
     from rawehelix.solvers.periodic import periodic_response
-    from rawehelix.references.spline_galerkin.forced import SplineBackend
     results = {}
-    for label, N in (("fe_N8", 8), ("fe_N16", 16), ("spline_N2", 2)):
-        params = _load("f1_40Hz", elements=N, scheme="spline" if label.startswith("spline") else "fe")
+    for label, N, scheme in (("fe_N8", 8, "fe"), ("fe_N16", 16, "fe"), ("spline_N2", 2, "spline")):
+        params = _load("f1_40Hz", elements=N, scheme=scheme)
         q = params.normalised()
-        backend = SplineBackend(q, N) if label.startswith("spline") else FEBackend(params)
+        backend = schemes.of(params).forced_backend(params)
         results[label], _, _ = periodic_response(backend, q, 40.0, backend.stationary(), 0.0,
                                                  params.sweep, lead_in=True)
     fe8, fe16, n2 = results["fe_N8"], results["fe_N16"], results["spline_N2"]

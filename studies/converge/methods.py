@@ -1,7 +1,10 @@
-"""The quantities of the refinement studies: what each one evaluates, and the
-methods (refinement ladders) each one is run with.
+"""How the refinement studies evaluate a quantity: the methods (refinement
+ladders), one run of a method (:func:`with_method`, each scheme's evaluation
+asked of :mod:`rawehelix.studies.schemes`) and the ladders of each quantity.
+The quantities themselves, by name, are in the one registry
+:mod:`rawehelix.studies.quantities` (their :class:`Refinement`).
 
-A quantity is a function (params, method, ladder value) -> array of values
+An evaluator is a function (params, method, ladder value) -> array of values
 that computes no more than it needs: the stationary ones solve the
 stationary problem only, the modal one linearises about it and never
 integrates in time, the Sec. 5.2 ones integrate the spin-up, and T max the
@@ -18,8 +21,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.families import VIBRATIONS
-from rawehelix.references.spline_galerkin import spectrum
-from rawehelix.studies import metrics
+from rawehelix.studies import metrics, schemes
 
 
 @dataclass(frozen=True)
@@ -39,10 +41,10 @@ class Method:
         return 1.0 / value if self.variable == "elements" else float(value)
 
 
-@dataclass
-class Quantity:
-    name: str
-    unit: str
+@dataclass(frozen=True)
+class Refinement:
+    """How ``rawehelix converge`` refines a quantity: its methods and reference."""
+
     methods: list
     reference: str  # label of the reference method (its finest run is the reference)
     evaluate: object  # (params, method, ladder value) -> np.ndarray of values
@@ -74,43 +76,20 @@ def with_method(params: Parameters, method: Method, value) -> Parameters:
 def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
     """Stationary tension at s = 0 [N] (Sec. 5.1)."""
     p = with_method(params, method, value)
-    q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin import stationary
-        from rawehelix.references.spline_galerkin.system import SplineGalerkin
-        system = SplineGalerkin(q, p.discretisation.elements)
-        x = stationary.solve(system).x
-        return np.array([q.tension_N(system.tension(x, 0.0, s=np.array([0.0]))[0])])
-    from rawehelix.solvers.stationary import StationarySolver
-    result = StationarySolver(p, MPI.COMM_SELF).solve()
-    return np.array([q.tension_N(result.tension[0])])
+    return np.array([schemes.of(p).stationary_tension_N(p)])
 
 
-def _shooting_tension_s0(params: Parameters):
+def shooting_tension_s0(params: Parameters):
     from rawehelix.references import shooting
     q = params.normalised()
     return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
-
-
-def _fe_modes(p: Parameters) -> list:
-    """The FE modes (:class:`rawehelix.solvers.modal.Mode`) of the linearised
-    stationary state: the one modal call of the studies."""
-    from rawehelix.solvers.modal import ModalSolver
-    solver = ModalSolver.from_stationary(p, MPI.COMM_SELF)
-    return solver.solve(keep_vectors=False, require_families=False)
 
 
 def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:
     """|lambda| [1/s] of the lowest mode of each family (Sec. 5.1, Table 3)."""
     p = with_method(params, method, value)
     q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin import stationary
-        from rawehelix.references.spline_galerkin.system import SplineGalerkin
-        system = SplineGalerkin(q, p.discretisation.elements)
-        modes = spectrum.modes(system, stationary.solve(system).x)
-    else:
-        modes = _fe_modes(p)
+    modes = schemes.of(p).spectrum(p, MPI.COMM_SELF, shapes=False).modes
     lowest = {}
     for m in modes:
         lam = abs(complex(m.eigenvalue)) / q.t_scale  # Eq. (25)
@@ -130,32 +109,8 @@ def _spin_series(params: Parameters, method: Method, value):
     5 ms, or at every step of a fixed-step (dt ladder) run: cutting its steps to
     land on the sample times would make every dt above 5 ms a 5 ms run."""
     p = with_method(params, method, value)
-    q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin.dynamics import time_series
-        ts = time_series(p, until_s=SPIN_RUN_S, output_every_s=SPIN_SAMPLE_S, rtol=1e-9)
-        return ts.time_s, ts.spin_rpm
-    from rawehelix.solvers.dynamics import DynamicsSolver
-    options = {"ts_type": method.ts_type} if method.ts_type else {}
-    if method.variable == "dt_s":
-        options["ts_adapt_type"] = "none"
-    else:  # adaptive steps, tight enough that space dominates the error
-        options.update({"ts_rtol": 1e-6, "ts_atol": 1e-6})
-    solver = DynamicsSolver.from_stationary(p, MPI.COMM_SELF, options=options)
-    rows = []
-
-    def sample(s):
-        v = s.probes.values()
-        rows.append((s.t, v["spin0"], v["spin_mid"], v["spin1"]))
-
-    if method.variable == "dt_s":
-        sample(solver)
-        solver.advance(SPIN_RUN_S / q.t_scale, on_step=sample)
-    else:
-        solver.advance(SPIN_RUN_S / q.t_scale, on_output=sample,
-                       output_every=SPIN_SAMPLE_S / q.t_scale)
-    rows = np.array(rows)
-    return q.time_s(rows[:, 0]), q.spin_rpm(rows[:, 1:])
+    return schemes.of(p).spin_series(p, SPIN_RUN_S, SPIN_SAMPLE_S, method.ts_type,
+                                     fixed_steps=method.variable == "dt_s")
 
 
 def spin_overshoot(params: Parameters, method: Method, value) -> np.ndarray:
@@ -191,17 +146,11 @@ def tension_max(params: Parameters, method: Method, value) -> np.ndarray:
     from rawehelix.solvers.periodic import periodic_response
     p = with_method(params, method, value).replace(
         sweep={"lead_in_s": 3.0, "periodic_tolerance": 5e-4})
-    if method.variable == "elements" and method.scheme == "fe":
+    scheme = schemes.of(p)
+    if method.variable == "elements" and scheme.fixed_time_step:
         p = p.replace(time={"dt_s": TENSION_MAX_SPACE_DT_S})
     q = p.normalised()
-    if method.scheme == "spline":
-        from rawehelix.references.spline_galerkin.forced import SplineBackend
-        backend = SplineBackend(q, p.discretisation.elements, rtol=1e-9, atol=1e-11)
-    else:
-        from rawehelix.solvers.forced import FEBackend
-        # full Newton: the study measures discretisation errors down to 1e-6
-        backend = FEBackend(p, MPI.COMM_SELF, options={
-            **FEBackend.FULL_NEWTON, **({"ts_type": method.ts_type} if method.ts_type else {})})
+    backend = scheme.forced_backend(p, MPI.COMM_SELF, accurate=True, ts_type=method.ts_type)
     result, _, _ = periodic_response(backend, q, TENSION_MAX_F1_HZ, backend.stationary(), 0.0,
                                      p.sweep, lead_in=True)
     return np.array([result.tension_max_N])
@@ -226,35 +175,15 @@ TENSION_MAX_DTS = {"alpha2": (5e-4, 2.5e-4, 1.25e-4, 3.125e-5), "cn": (1e-3, 5e-
 DT_LADDER_ELEMENTS = 8
 
 
-def quantities() -> dict:
-    """Every quantity of ``rawehelix converge`` by name, with its methods."""
-    fe = [Method(f"FE p={p}", "fe", p, FE_LADDER) for p in (2, 3, 4)]
-    spline = Method("spline", "spline", None, SPLINE_LADDER)
-    N = DT_LADDER_ELEMENTS
-    return {
-        "tension_s0": Quantity("tension_s0", "N", fe + [spline], "FE p=4", tension_s0,
-                               ["T(0)"], _shooting_tension_s0),
-        "eigenvalues": Quantity("eigenvalues", "1/s",
-                                [Method(f"FE p={p}", "fe", p, (2, 4, 8, 16, 32)) for p in (2, 3, 4)]
-                                + [Method("spline", "spline", None, (2, 4, 8, 16))],
-                                "FE p=4", eigenvalues, list(VIBRATIONS)),
-        **{name: Quantity(name, unit, _dynamic_methods(ladder_fe, ladder_spline, dts, N), "FE p=4",
-                          fn, [label], time_reference=f"FE N={N} p=3 alpha2 (dt)",
-                          **(SPIN_SCALE if name == "spin_overshoot" else {}))
-           for name, unit, fn, label, ladder_fe, ladder_spline, dts in (
-               ("spin_overshoot", "rpm", spin_overshoot, "overshoot", (2, 4, 8, 16), (2, 4, 8),
-                SPIN_DTS),
-               ("settling_time", "s", settling_time, "settling", (2, 4, 8, 16), (2, 4, 8),
-                SPIN_DTS),
-               ("tension_max", "N", tension_max, "T max at 10 Hz", (4, 8, 16), (2, 3, 4, 6),
-                TENSION_MAX_DTS))},
-    }
+def space_methods(ladder: tuple, spline_ladder: tuple) -> list:
+    """FE p = 2, 3, 4 and the spline reference, refined in space (elements N)."""
+    return ([Method(f"FE p={p}", "fe", p, ladder) for p in (2, 3, 4)]
+            + [Method("spline", "spline", None, spline_ladder)])
 
 
-def _dynamic_methods(ladder_fe, ladder_spline, dts: dict, N: int) -> list:
+def dynamic_methods(ladder_fe, ladder_spline, dts: dict, N: int) -> list:
     """FE p = 2, 3, 4 in space (adaptive alpha2), the spline reference, and two
     TS schemes with fixed steps at N elements, p = 3 (the dt ladder)."""
-    return ([Method(f"FE p={p}", "fe", p, ladder_fe) for p in (2, 3, 4)]
-            + [Method("spline", "spline", None, ladder_spline)]
+    return (space_methods(ladder_fe, ladder_spline)
             + [Method(f"FE N={N} p=3 {ts} (dt)", "fe", 3, dts[ts], "dt_s", ts, N)
                for ts in ("alpha2", "cn")])

@@ -1,0 +1,107 @@
+"""The commands that run a scene many times: converge (refinement ladders),
+study (a design of scene keys) and calibrate (a least-squares fit)."""
+
+from __future__ import annotations
+
+import logging
+
+from rawehelix.cli.commands.base import Command, overrides, say
+from rawehelix.studies import quantities
+from rawehelix.studies.scene import SceneError
+
+log = logging.getLogger("rawehelix")
+
+
+def _converge_arguments(p):
+    p.add_argument("--quantity", required=True,
+                   help="quantity of interest: tension_s0, eigenvalues, ...")
+
+
+def _converge(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies.converge import study as converge
+    if args.quantity not in quantities.refined():
+        raise SceneError("--quantity", args.quantity,
+                         f"is not one of {', '.join(quantities.refined())}")
+    converge.run(params, args.quantity, outdir, name=params.name,
+                 log=lambda m: say(comm, m), comm=comm)
+    return 0
+
+
+def _fd_step(p):
+    p.add_argument("--fd-step", type=float, default=None, metavar="h",
+                   help="relative finite-difference step (default 1e-2 for the "
+                        "sensitivities, 1e-3 for the Jacobian)")
+
+
+def _study_arguments(p):
+    p.add_argument("--vary", action="append", required=True,
+                   metavar="KEY=START:STOP:COUNT",
+                   help="a dotted scene key and its range (repeatable; COUNT: grid points)")
+    p.add_argument("--sample", choices=("grid", "lhs", "sobol"), default="grid",
+                   help="the design (default grid; lhs, sobol: scipy.stats.qmc, SALib)")
+    p.add_argument("--points", type=int, default=None,
+                   help="lhs: points; sobol: base points N (N (d + 2) scenes)")
+    p.add_argument("--point-timeout", type=float, default=None, metavar="S",
+                   help="a point still running after S seconds (wall) fails with "
+                        "that reason; a rerun with a longer limit computes it again")
+    p.add_argument("--quantity", required=True, metavar="Q[,Q...]",
+                   help="quantities: " + ", ".join(quantities.names()))
+    _fd_step(p)
+
+
+def _calibrate_arguments(p):
+    p.add_argument("--target", required=True, metavar="Q=VALUE[,...]",
+                   help="target values of quantities")
+    _fd_step(p)
+    p.add_argument("--fit", required=True, metavar="KEY[,KEY...]",
+                   help="the dotted scene keys to fit")
+    p.add_argument("--bounds", action="append", default=[], metavar="KEY=LO:HI",
+                   help="bounds of a fitted key (repeatable)")
+    p.add_argument("--uncertainty", type=float, default=0.01, metavar="REL",
+                   help="relative standard uncertainty of the targets, for the "
+                        "linearised confidence (default 0.01)")
+    p.add_argument("--tolerance", type=float, default=None, metavar="REL",
+                   help="a target is met within this relative residual (default "
+                        "1e-3); missed: exit status 3")
+
+
+def _source(args):
+    from rawehelix.studies.study import Source
+    return Source(args.scene, args.elements, args.degree, args.scheme, overrides(args))
+
+
+def _study(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import study
+    variables = [study.parse_vary(v) for v in args.vary]
+    result = study.compute(_source(args), variables, quantities.parse_list(args.quantity),
+                           outdir, sample=args.sample, points=args.points, fd_step=args.fd_step,
+                           comm=comm, log=log.info, point_timeout=args.point_timeout)
+    return _write_and_say(comm, result, study.report(result), outdir)
+
+
+def _calibrate(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import calibrate
+    fit = calibrate.parse_fit(args.fit)
+    result = calibrate.compute(_source(args), fit, calibrate.parse_targets(args.target), outdir,
+                               bounds=calibrate.parse_bounds(args.bounds, fit),
+                               uncertainty=args.uncertainty, fd_step=args.fd_step, comm=comm,
+                               log=log.info, tolerance=args.tolerance)
+    return _write_and_say(comm, result, calibrate.report(result), outdir)
+
+
+def _write_and_say(comm, result, text: str, outdir) -> int:
+    """A study's or a calibration's files (rank 0) and its report; its exit status."""
+    if comm.rank == 0:
+        result.write(outdir)
+    say(comm, text + f"\n  wrote {outdir}/")
+    return result.exit_status
+
+
+COMMANDS = [
+    Command("converge", "refinement study and work-precision figure", _converge_arguments,
+            _converge, kept="runs/*.json"),
+    Command("study", "named quantities over a design of scene keys, on MPI ranks",
+            _study_arguments, _study, kept="points/*.json"),
+    Command("calibrate", "fit scene keys to target quantities (least squares)",
+            _calibrate_arguments, _calibrate, kept="points/*.json"),
+]

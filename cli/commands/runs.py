@@ -1,0 +1,154 @@
+"""The single-run commands: stationary, modes, simulate, sweep, response, orbits."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from rawehelix.cli.commands.base import Command, say
+from rawehelix.studies.scene import SceneError
+
+
+def _written(comm, result, text: str, outdir, before: str = "\n  ") -> int:
+    """A run's files (``result.write``) and its report with where they are."""
+    result.write(outdir)
+    say(comm, text + f"{before}wrote {outdir}/")
+    return 0
+
+
+def _stationary(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import stationary
+    result = rh.stationary(params, comm)
+    return _written(comm, result, stationary.report(result), outdir)
+
+
+def _modes_arguments(p):
+    p.add_argument("--count", type=int, default=None,
+                   help="report the k slowest modes (default: the lowest 3 of each family)")
+
+
+def _modes(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import modes
+    result = rh.modes(params, count=args.count, comm=comm)
+    return _written(comm, result, modes.report(result), outdir, before="\n")
+
+
+def _simulate_arguments(p):
+    p.add_argument("--until", type=float, default=None,
+                   help="end of the simulation [s] (default: the scene's time.until_s)")
+    p.add_argument("--no-gif", action="store_true", help="skip the animated GIF")
+
+
+def _simulate(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import resources, simulate
+    resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
+
+    def checkpoint(partial):  # the last good state and the series so far, every minute
+        partial.write(outdir, pictures=False)
+
+    try:
+        result = simulate.compute(params, until_s=args.until, comm=comm, checkpoint=checkpoint)
+    except simulate.SimulationError as err:
+        err.partial.write(outdir, pictures=False)
+        raise rh.SolverError(f"{err} The series and the last good state are in "
+                             f"{outdir}/ (time_series.csv, state.npz).") from None
+    result.write(outdir, gif=not args.no_gif)
+    say(comm, simulate.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
+def _f1_grid_arguments(p):
+    p.add_argument("--f1", default=None, metavar="START:STOP:STEP",
+                   help="frequencies in Hz (default: the scene's [sweep] section)")
+
+
+def _sweep_arguments(p):
+    _f1_grid_arguments(p)
+    p.add_argument("--series", action="store_true",
+                   help="also write each point's tension time series (CSV)")
+
+
+def _sweep(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import sweep
+    from rawehelix.studies.sweep_store import SweepError
+    try:
+        result = rh.sweep(params, comm=comm, checkpoint=outdir)
+    except SweepError as err:
+        raise SceneError("-o", str(outdir), str(err)) from None
+    result.write(outdir, series=args.series)
+    say(comm, sweep.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
+def _response(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import response
+    result = rh.response(params, comm=comm)
+    return _written(comm, result, response.report(result), outdir)
+
+
+def _orbits_arguments(p):
+    p.add_argument("--f1", required=True, metavar="START:STOP",
+                   help="the f1 window in Hz, traced from START towards STOP")
+    p.add_argument("--sweep", type=Path, default=None, metavar="DIR",
+                   help="a sweep's output directory: its points on the diagram")
+    p.add_argument("--tension-step", type=float, default=None, metavar="FRACTION",
+                   help="largest relative change of T max between two points "
+                        "(default 0.05)")
+    p.add_argument("--max-points", type=int, default=400,
+                   help="stop each rank's window after this many points (a rerun "
+                        "with the same -o resumes)")
+    p.add_argument("--superharmonics", default="2,3", metavar="K[,K...]",
+                   help="orders k of the k:1 resonances f_n / k of the lateral natural "
+                        "frequencies where the step closes in on a multiplier's "
+                        "crossing of +1 ('none': the T max step only)")
+
+
+def _orbits(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import orbits
+    try:
+        start, stop = (float(x) for x in args.f1.split(":"))
+    except ValueError:
+        raise SceneError("--f1", args.f1, "must be START:STOP in Hz") from None
+    if not (start > 0 and stop > 0 and start != stop and math.isfinite(start + stop)):
+        raise SceneError("--f1", args.f1, "must be START:STOP with START != STOP, both > 0 Hz "
+                         "(an empty or negative window)")
+    try:
+        orders = (() if args.superharmonics.strip().lower() == "none"
+                  else tuple(int(k) for k in args.superharmonics.split(",")))
+    except ValueError:
+        raise SceneError("--superharmonics", args.superharmonics,
+                         "must be integers K[,K...] >= 2 or 'none'") from None
+    if args.sweep is not None:
+        orbits.check_sweep_dir(args.sweep)
+    try:
+        result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
+                           tension_step=args.tension_step, max_points=args.max_points,
+                           superharmonics=orders,
+                           progress=lambda o: say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
+                                                  f"{o.tension_max_N:.2f} N, |multiplier| "
+                                                  f"{o.max_multiplier:.5f}"))
+    except orbits.OrbitsStoreError as err:
+        raise SceneError("-o", str(outdir), str(err)) from None
+    if comm.rank == 0:
+        result.write(outdir, sweep_dir=args.sweep)
+    say(comm, orbits.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
+def _none(p):
+    """No options of its own."""
+
+
+COMMANDS = [
+    Command("stationary", "stationary state with fixed ends (Sec. 5.1)", _none, _stationary),
+    Command("modes", "natural modes about the stationary state (Table 3)", _modes_arguments,
+            _modes),
+    Command("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)",
+            _simulate_arguments, _simulate),
+    Command("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)", _sweep_arguments,
+            _sweep, kept="points/f1_*.json", f1_grid=True),
+    Command("response", "linear frequency response to the upper end's circle",
+            _f1_grid_arguments, _response, f1_grid=True),
+    Command("orbits", "periodic orbits over f1 with Floquet stability, through folds",
+            _orbits_arguments, _orbits, kept="window*/p*.json"),
+]
