@@ -54,7 +54,8 @@ from mpi4py import MPI
 from rawehelix.families import VIBRATIONS
 from rawehelix.parameters import (Discretisation, Ends, Environment, Helix, Model, ParameterError,
                                   Parameters)
-from rawehelix.solvers import analytic, shooting
+from rawehelix.references import shooting
+from rawehelix.solvers import analytic
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.pep import create_pep
 from rawehelix.solvers.stationary import StationarySolver
