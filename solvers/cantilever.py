@@ -121,8 +121,9 @@ class CantileverSolver:
 
     def _straight(self, force_N):
         stretch = 1.0 + float(np.dot(force_N, AXIS)) / self.params.helix.EA_N
-        self.rod.w.sub(0).interpolate(lambda x: np.outer(stretch * AXIS, x[0]))
-        self.rod.w.sub(1).interpolate(lambda x: np.zeros(x.shape[1]))
+        w, model = self.rod.w, self.rod.model
+        w.sub(model.index("centre_line")).interpolate(lambda x: np.outer(stretch * AXIS, x[0]))
+        w.sub(model.index("twist")).interpolate(lambda x: np.zeros(x.shape[1]))
         self.rod.w.x.scatter_forward()
 
     def solve(self, force_N, torque_Nm: float = 0.0, halvings: int = 6) -> TipResult:

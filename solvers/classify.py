@@ -22,7 +22,6 @@ import math
 import numpy as np
 from mpi4py import MPI
 
-from rawehelix import compat
 from rawehelix.solvers.linearise import COMPONENTS, Linearisation
 
 
@@ -39,8 +38,7 @@ class Classifier:
         """Boolean mask of the owned alpha dofs in a PETSc vector of W."""
         W = self.lin.rod.W
         n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
-        _, parent = compat.collapse(W.sub(1))
-        parent = np.asarray(parent)
+        parent = self.lin.rod.dofs("twist")  # the model's twist field (models/base.py)
         mask = np.zeros(n_owned, dtype=bool)
         mask[parent[parent < n_owned]] = True
         return mask

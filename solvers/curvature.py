@@ -31,10 +31,10 @@ class CurvatureProjection:
     def __init__(self, rod):
         self.rod = rod
         self.source = dolfinx.fem.Function(rod.W)  # the state whose r is read
-        self.V_k, self.parent = rod.V_k, rod._kappa_dofs
+        self.V_k, self.parent = rod.V_k, rod.dofs("curvature")
         k, eta = ufl.TrialFunction(self.V_k), ufl.TestFunction(self.V_k)
         dx = rod.measures[0]
-        r = ufl.split(self.source)[0]
+        r = rod.model.split(self.source)["centre_line"]
         ends = np.concatenate([compat.locate_boundary_vertices(rod.mesh, lambda x: np.isclose(x[0], v))
                                for v in (0.0, 1.0)]).astype(np.int32)
         self.bcs = [dolfinx.fem.dirichletbc(dolfinx.fem.Function(self.V_k),

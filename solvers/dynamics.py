@@ -21,6 +21,10 @@ TSALPHA2 solves the second-order form; every other type gets the first-order
 form on (U, V) (implicit types: theta, cn, beuler, bdf, alpha, arkimex with
 -ts_arkimex_fully_implicit; explicit types such as rk are not useful here:
 the IP bending term is far too stiff).
+
+This module is the TS driver (options, stepping, failures); the states it takes
+and returns are :mod:`.dynamics_states`, what it reports of them
+:mod:`.dynamics_outputs`.
 """
 
 from __future__ import annotations
@@ -28,7 +32,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import numpy as np
-import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -38,11 +41,12 @@ import dolfinx.fem.petsc
 from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.discrete import RodDiscretisation
+from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
+from rawehelix.solvers.dynamics_states import DynamicsStates
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.probes import Probes
 from rawehelix.solvers.snes import (FloorConvergence, ReusedJacobian, SolverError, default_options,
                                    lu_options, reason_name, temporary_options)
-from rawehelix.solvers.state import RodState
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
 
@@ -79,7 +83,7 @@ def ts_reason_name(reason: int) -> str:
     return reason_name(reason, PETSc.TS.ConvergedReason)
 
 
-class DynamicsSolver:
+class DynamicsSolver(DynamicsStates, DynamicsOutputs):
     """PETSc TS on the FE rod.  It takes a state and integrates it; it solves
     nothing when it is built and writes no files.
 
@@ -138,7 +142,8 @@ class DynamicsSolver:
         self.probes = Probes(self.form)
         rod_ = self.rod
         self._v_top = dolfinx.fem.Function(rod_.V_r)  # the upper end's velocity, Eq. (70)
-        self._bc_v = dolfinx.fem.dirichletbc(self._v_top, rod_.end_dofs["top"], rod_.W.sub(0))
+        self._bc_v = dolfinx.fem.dirichletbc(self._v_top, rod_.end_dofs["top"],
+                                             rod_.sub("centre_line"))
         self._velocity = dolfinx.fem.Function(rod_.W)  # scratch for the first-order form
         self.newton_iterations = 0
         self.steps = 0
@@ -188,7 +193,7 @@ class DynamicsSolver:
         ts.setTimeStep(self.params.time.dt_s / self.q.t_scale)
         ts.setExactFinalTime(PETSc.TS.ExactFinalTime.MATCHSTEP)
         ts.setFromOptions()
-        if self.rod.hysteretic:
+        if self.rod.model.has("internal_twist"):  # z, forms/hysteresis.py
             self._exclude_internal_twist_from_error(ts)
         snes = ts.getSNES()
         snes.setOptionsPrefix(PREFIX + "ts_")
@@ -211,7 +216,7 @@ class DynamicsSolver:
         has a kink) as large errors: with z in the norm the Sec. 5.2 spin-up at
         N = 4 takes 10 x the steps (docs/explanation/model.md).  z follows tau, whose error
         is controlled; tests/test_hysteresis.py measures z's accuracy."""
-        _, z_dofs = compat.collapse(self.rod.W.sub(2))
+        z_dofs = self.rod.dofs("internal_twist")
         U = self.form.initial_vectors()[0]
         owned = U.getLocalSize()
         rtol, atol = ts.getTolerances()
@@ -223,68 +228,6 @@ class DynamicsSolver:
             v.array[local] = 1e300
         ts.setTolerances(rtol=rtol, atol=vatol)
         self._vatol = vatol
-
-    # -- states --------------------------------------------------------------------
-    def set_state(self, state: RodState):
-        """Start from ``state``: its time, configuration and velocity (at rest if
-        it has none) and its controller constant C of Eq. (40) (if it has none,
-        C makes the ground torque of the state zero: the stationary state
-        carries no torque)."""
-        form, rod = self.form, self.rod
-        if form.second_order:
-            rod.set_state(state, w=form.u, w_t=form.v)
-        else:
-            rod.set_state(state, w=rod.w, w_t=self._velocity)
-            form.x.sub(0).interpolate(rod.w.sub(0))
-            form.x.sub(1).interpolate(rod.w.sub(1))
-            form.x.sub(2).interpolate(self._velocity.sub(0))
-            form.x.sub(3).interpolate(self._velocity.sub(1))
-        for f in self._state_functions():
-            f.x.scatter_forward()
-        self.ts.setTime(state.t)
-        form.set_time(state.t)
-        self.convergence.stale = True  # a new start: a fresh Jacobian (if reused)
-        self._push()
-        if state.offset is None:
-            form.offset.value = 0.0
-            form.offset.value = -self.probes.value("m0")  # m0 = 0 in this state
-        else:
-            form.offset.value = state.offset
-        self._remember(state.t)
-        self._fresh = self._has_state = True
-
-    def state(self) -> RodState:
-        """The last accepted state (a copy), with the controller constant C."""
-        if not self._has_state:
-            raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
-        form, rod = self.form, self.rod
-        t = self.t if self._good is None else self._good[0]
-        if form.second_order:
-            w, w_t = form.u, form.v
-        else:
-            w, w_t = dolfinx.fem.Function(rod.W), self._velocity
-            w.sub(0).interpolate(form.x.sub(0))
-            w.sub(1).interpolate(form.x.sub(1))
-            w_t.sub(0).interpolate(form.x.sub(2))
-            w_t.sub(1).interpolate(form.x.sub(3))
-            w.x.scatter_forward()
-            w_t.x.scatter_forward()
-        state = rod.get_state(w, w_t, t)
-        state.offset = float(form.offset.value)
-        return state
-
-    def _push(self):
-        """The TS solution <- the formulation's functions."""
-        form = self.form
-        if form.second_order:  # into the TS's own vectors: no new Vec (see _remember)
-            U, V = self.ts.getSolution2()
-            compat.petsc_vec(form.u).copy(U)
-            compat.petsc_vec(form.v).copy(V)
-            self.ts.setSolution2(U, V)
-        else:
-            X = self.ts.getSolution()
-            compat.petsc_vec(form.x).copy(X)
-            self.ts.setSolution(X)
 
     def set_top_torque(self, top_Nm: float, rise_time_s: float | None = None):
         """The rotor torque at the upper end, Eq. (69): M_N0 = ``top_Nm`` [Nm],
@@ -414,34 +357,6 @@ class DynamicsSolver:
             self.form.set_time(t)
             self._on_output(self)
 
-    def _remember(self, t: float):
-        """The current state is the last good one (restored after a failure).
-
-        Called after every step: it copies into vectors made once.  (A petsc4py
-        3.18 Vec dropped without destroy() goes to PETSc's garbage list and is
-        only freed by PETSc.garbage_cleanup: a new copy per step leaked 9 kB a
-        step, 24 GB in an N = 16 sweep.)"""
-        functions = self._state_functions()
-        if self._good_vecs is None:
-            self._good_vecs = [compat.petsc_vec(f).duplicate() for f in functions]
-        for f, v in zip(functions, self._good_vecs):
-            compat.petsc_vec(f).copy(v)
-        self._good = (t, self._good_vecs)
-
-    def _state_functions(self):
-        return (self.form.u, self.form.v) if self.form.second_order else (self.form.x,)
-
-    def _restore_good(self):
-        """Functions <- the last accepted state (after a failure PETSc may leave a bad one)."""
-        if self._good is None:
-            return
-        t, vecs = self._good
-        for f, v in zip(self._state_functions(), vecs):
-            v.copy(compat.petsc_vec(f))
-            f.x.scatter_forward()
-        self.form.set_time(t)
-        self.good_time = t
-
     def _failure(self, why: str) -> SolverError:
         self._restore_good()
         t_s = self.q.time_s((self._good or (0.0,))[0])
@@ -453,43 +368,6 @@ class DynamicsSolver:
             f"(-{PREFIX}ts_max_snes_failures 20), adaptive steps (-{PREFIX}ts_adapt_type basic), "
             f"more Newton iterations (-{PREFIX}ts_snes_max_it 30) or more elements."
             + law_hint(self.params))
-
-
-    # -- fields ---------------------------------------------------------------------
-    def state_arrays(self) -> dict | None:
-        """The current state along s (normalised), on rank 0 (None elsewhere)."""
-        f = self.probes.fields()
-        if f is None:
-            return None
-        return {"t": self.t if self._good is None else self._good[0],
-                "s": f["s"], "r": f["r"], "alpha": f["alpha"], "r_t": f["r_t"],
-                "alpha_t": f["alpha_t"]}
-
-    def end_moment(self) -> float:
-        """The torsional moment at s = 1 / (GJ / L0) (normalised like the end torques,
-        Eq. 39): tau(1), or the hysteretic moment rho tau + (1 - rho) z of
-        forms/hysteresis.py; collective.  The form is compiled at the first call."""
-        if getattr(self, "_end_moment", None) is None:
-            from rawehelix.forms import hysteresis
-            from rawehelix.forms.kinematics import twist
-            f, c, mesh = self.form.fields, self.rod.c, self.rod.mesh
-            m = twist(f.r, f.alpha, c.gamma_eps, c.gamma_coupling, k=f.kappa)  # (34)
-            if f.z is not None:
-                m = hysteresis.moment(m, f.z, c)
-            s = ufl.SpatialCoordinate(mesh)[0]
-            self._end_moment = dolfinx.fem.form(m * s * ufl.ds(domain=mesh))
-        return self.comm.allreduce(dolfinx.fem.assemble_scalar(self._end_moment), op=MPI.SUM)
-
-    # -- energy (normalised) ----------------------------------------------------------
-    def energy(self) -> dict:
-        """Kinetic, potential, non-variational power and the power dissipated by the
-        structural damping, 2 D (0 without it), of the current state (collective)."""
-        out = {"dissipation": 0.0}
-        for name in ("kinetic", "potential", "power_nv", "dissipation"):
-            form = getattr(self.form, name)
-            if form is not None:
-                out[name] = self.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
-        return out
 
 
 def law_hint(params) -> str:

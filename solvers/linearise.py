@@ -138,7 +138,7 @@ class Linearisation:
         bcs = [bc for bc in self.bcs if all(bc is not k for k in rod.curvature_bcs)]
         n_bc = rod.comm.allreduce(sum(bc.dof_indices()[1] for bc in bcs), op=MPI.SUM)
         n_kappa = 0
-        if rod.mixed:
+        if rod.model.has("curvature"):  # the massless kappa dofs, forms/mixed.py
             im = rod.V_k.dofmap.index_map
             n_kappa = im.size_global * rod.V_k.dofmap.index_map_bs
         return 2 * (rod.dof_count() - n_bc - n_kappa)

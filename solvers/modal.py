@@ -16,30 +16,12 @@ Sec. 5.1 with :class:`StationarySolver` (alpha(0) = 0 pinned, where the Newton
 matrix is regular) and linearises about it on the same rod (the modal bcs
 leave the twist free).
 
-Target and size (the search window).  Only the lowest ``per_family``
-oscillating modes of each family are wanted, never the whole spectrum.
-:func:`estimates` gives every eigenvalue of the classical models (solvers.
-analytic) with their modal damping (the drag of Eq. 28 and the Kelvin-Voigt
-shares of forms/damping.py, tests/test_damping.py): both roots of
-lambda^2 + c lambda + omega^2 = 0.  Structural damping makes every mode above
-omega ~ 2 / tau overdamped, and their slow roots -omega^2 / c crowd at
--1 / tau on the negative real axis (hundreds of them at N = 32: a cluster that
-no Krylov method converges in reasonable time, and need not).  PETSc here is
-real, so the target tau is real; shift-and-invert computes the eigenvalues
-nearest it, i.e. those in a disk |lambda - tau| <= rho.  :meth:`ModalSolver.window`
-takes tau >= omega_min / 4 (off the rigid zero, where K is singular, and away
-from every eigenvalue of a stable state, Re lambda <= 0) where the disk that
-holds every wanted estimate with margin (rho = WINDOW_MARGIN x the farthest,
-clipped half-way to the nearest real root beyond) holds the fewest estimates;
-a positive tau pushes the cluster on the negative real axis back (its distance
-is tau + 1/tau_d) while the lightly damped wanted modes stay near.  Without
-structural damping that is tau = omega_min / 4 and nev = the modes below
-1.2 x the highest wanted one, as before.  nev is the count in the disk.  After
-the solve every family is checked; a missing one widens the search (nev x WIDEN_FACTOR,
-WIDENINGS times, never past the estimated count before the nearest real root),
-then raises an error naming the option to raise (``-rawehelix_pep_nev``).
-A real eigenvalue is reported as ``overdamped`` (families.is_overdamped), not
-as a mode of its family.
+Target and size (the search window): :mod:`.modal_window`.  After the solve
+every family is checked; a missing one widens the search (nev x WIDEN_FACTOR,
+WIDENINGS times, never past the window's ``cap``, the estimated count before the
+nearest real root), then raises an error naming the option to raise
+(``-rawehelix_pep_nev``).  A real eigenvalue is reported as ``overdamped``
+(families.is_overdamped), not as a mode of its family.
 
 The rigid rotation alpha = const is the zero eigenvalue of torque-free ends
 (a Jordan pair: alpha = const and alpha = t), reported once as ``rigid``.
@@ -68,71 +50,15 @@ from rawehelix.solvers import analytic, fields, pep as pep_solve
 from rawehelix.solvers.classify import Classifier
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.linearise import COMPONENTS, Linearisation
+from rawehelix.solvers.modal_window import (  # noqa: F401  (re-exported: the window's names)
+    TARGET_SPAN, TARGET_STEPS, WINDOW_EXTRA, WINDOW_MARGIN, Window, estimates, search_window)
 from rawehelix.solvers.snes import SolverError
 from rawehelix.solvers.state import RodState
 from rawehelix.solvers.stationary import StationarySolver
 
-
-#: the search disk holds the farthest wanted estimate with this margin (unless a
-#: real root lies nearer; then half-way to it)
-WINDOW_MARGIN = 1.2
-#: eigenvalues asked for beyond the estimated count when no real root is near
-WINDOW_EXTRA = 4
 #: widenings of the search (nev x WIDEN_FACTOR) when a family has fewer modes than asked
 WIDENINGS = 3
 WIDEN_FACTOR = 2.0
-#: targets tried between omega_min / 4 and this multiple of the highest wanted |lambda|
-TARGET_SPAN, TARGET_STEPS = 4.0, 33
-
-
-def estimates(q, tension: float, count: int, twist: bool = True,
-              kinematics: str = "paper") -> dict:
-    """Eigenvalue estimates, per family an array (count, 2) for n = 1..count:
-    the roots of lambda^2 + c_n lambda + omega_n^2 = 0 (normalised), omega_n
-    of the classical models (solvers.analytic) and c_n the modal damping:
-
-    * drag (28), linearised: c = nu v_w0 (1 + (e.i_E)^2), e the direction of
-      the motion (chord, j_E x chord, j_E), tests/test_modal.py;
-    * Kelvin-Voigt (forms/damping.py): the retardation time x the mechanism's
-      share of omega_n^2 (tests/test_damping.py): tau_a sigma k^2 + tau_b mu k^4
-      (longitudinal; the bending share with the paper's kinematics only),
-      tau_b mu k^4 (lateral), tau_t delta k^2 (torsional).
-
-    An oscillating pair is (lambda, conj lambda), an overdamped one two real roots."""
-    n = np.arange(1, count + 1)
-    k = n * np.pi
-    mu = q.bending * q.mu
-    chord = q.top_position() / np.linalg.norm(q.top_position())
-    direction = {"longitudinal": chord, "lateral_in_plane": np.cross([0.0, 1.0, 0.0], chord),
-                 "lateral_out_of_plane": np.array([0.0, 1.0, 0.0])}
-    omega = analytic.frequencies(q, tension, count, twist)
-    bending = q.tau_bending * mu * k**4
-    kelvin_voigt = {"longitudinal": q.tau_axial * q.sigma * k**2
-                    + (bending if kinematics == "paper" else 0.0),
-                    "lateral_in_plane": bending, "lateral_out_of_plane": bending,
-                    "torsional": q.tau_torsion * q.delta * k**2}
-    out = {}
-    for family, w in omega.items():
-        e = direction.get(family)
-        c = kelvin_voigt[family] + (0.0 if e is None else q.drag * q.nu * q.v_w0 * (1 + e[0]**2))
-        root = np.sqrt((c / 2) ** 2 - w**2 + 0j)
-        out[family] = np.stack([-c / 2 + root, -c / 2 - root], axis=1)
-    return out
-
-
-@dataclass(frozen=True)
-class Window:
-    """Where and how much to search: shift-and-invert about ``target``, ``nev``
-    eigenvalues; ``cap``: the most nev may be widened to (the estimated count
-    before the nearest real root beyond the wanted ones)."""
-
-    target: float
-    nev: int
-    cap: int
-
-    def __post_init__(self):
-        if not (self.target > 0 and 1 <= self.nev <= self.cap):
-            raise ValueError(f"bad search window {self}")
 
 
 @dataclass
@@ -240,36 +166,12 @@ class ModalSolver:
 
     def window(self, per_family: int = 3) -> Window:
         """The target and nev that hold the lowest ``per_family`` oscillating
-        modes of each family with the fewest others (module docstring)."""
+        modes of each family with the fewest others (:mod:`.modal_window`)."""
         finite = self.finite_eigenvalue_count()
         per_component = finite // (2 * len(COMPONENTS)) + 1  # modes of one family
         est = estimates(self.q, max(self.mean_tension_value, 0.0), per_component, self.twist,
                         self.params.model.kinematics)
-        wanted, every = [], [0.0, 0.0]  # the rigid rotation's Jordan pair
-        for roots in est.values():
-            upper = roots[:, 0]
-            wanted += list(upper[upper.imag > 0][:per_family])
-            every += list(roots.ravel())
-        wanted, every = np.array(wanted), np.array(every)
-        real = every[np.abs(every.imag) == 0]
-        base = self.default_target()
-        top = max(np.abs(wanted).max(), base) if wanted.size else base
-        best = None
-        for tau in base * np.geomspace(1.0, max(TARGET_SPAN * top / base, 1.0), TARGET_STEPS):
-            far = np.abs(wanted - tau).max() if wanted.size else tau
-            beyond = np.abs(real - tau)
-            beyond = beyond[beyond > far]
-            nearest = beyond.min() if beyond.size else math.inf
-            rho = min(WINDOW_MARGIN * far, 0.5 * (far + nearest))
-            inside = int(np.sum(np.abs(every - tau) <= rho))
-            key = (inside, -rho / far)  # fewest eigenvalues, then the widest margin
-            if best is None or key < best[0]:
-                extra = WINDOW_EXTRA if rho == WINDOW_MARGIN * far else 0
-                cap = int(np.sum(np.abs(every - tau) < nearest)) if beyond.size else finite - 2
-                best = (key, tau, inside + extra, cap)
-        _, tau, nev, cap = best
-        cap = min(max(cap, nev), finite - 2)
-        return Window(target=float(tau), nev=min(nev, cap), cap=cap)
+        return search_window(est, finite, self.default_target(), per_family)
 
     # -- the eigenproblem ---------------------------------------------------------------
     def solve(self, nev: int | None = None, per_family: int = 3, target: float | None = None,
@@ -385,8 +287,8 @@ class ModalSolver:
             f = dolfinx.fem.Function(self.rod.W)
             x.copy(compat.petsc_vec(f))
             f.x.scatter_forward()
-            ur = f.sub(0).collapse()
-            ua = f.sub(1).collapse()
+            ur = f.sub(self.rod.model.index("centre_line")).collapse()
+            ua = f.sub(self.rod.model.index("twist")).collapse()
             ur = ur[0] if isinstance(ur, tuple) else ur
             ua = ua[0] if isinstance(ua, tuple) else ua
             s, u = fields.gather(ur)

@@ -15,7 +15,6 @@ from mpi4py import MPI
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.forms import kinematics
 from rawehelix.solvers import fields as fe_fields
 
 
@@ -34,36 +33,36 @@ class Probes:
 
     def __init__(self, formulation):
         rod = formulation.rod
-        mesh, c = rod.mesh, rod.c
-        f = formulation.fields
+        mesh, c, model = rod.mesh, rod.c, rod.model
+        by_role, rates = formulation.fields.roles()  # the model's fields and observables by role
+        r, alpha = by_role["centre_line"], by_role["twist"]
+        r_t, alpha_t = rates["centre_line"], rates["twist"]
         self.comm = mesh.comm
         s = ufl.SpatialCoordinate(mesh)[0]
         ds = ufl.ds(domain=mesh)
         self.s_mid, vertices = middle_vertex(mesh)
         dS_mid = ufl.dS(domain=mesh, subdomain_data=compat.vertex_tags(mesh, vertices), subdomain_id=1)
-        T = kinematics.tension(f.r, c.sigma)  # (29)
+        T = model.tension(by_role, c)  # (29)
         at0 = lambda e: e * (1 - s) * ds  # noqa: E731  value at s = 0
         at1 = lambda e: e * s * ds  # noqa: E731  value at s = 1
         atm = lambda e: ufl.avg(e) * dS_mid  # noqa: E731  value at the middle vertex
         forms = {
-            "spin0": at0(f.alpha_t), "spin_mid": atm(f.alpha_t), "spin1": at1(f.alpha_t),
-            "alpha0": at0(f.alpha), "m0": at0(formulation.m0),
+            "spin0": at0(alpha_t), "spin_mid": atm(alpha_t), "spin1": at1(alpha_t),
+            "alpha0": at0(alpha), "m0": at0(formulation.m0),
             "tension0": at0(T), "tension1": at1(T),
-            "x_mid": atm(f.r[0]), "y_mid": atm(f.r[1]), "z_mid": atm(f.r[2]),
+            "x_mid": atm(r[0]), "y_mid": atm(r[1]), "z_mid": atm(r[2]),
         }
         self.forms = {k: dolfinx.fem.form(v) for k, v in forms.items()}
         # fields along s, interpolated at the Lagrange nodes
         V_r, V_s = rod.V_r, rod.V_a
         self.field_exprs = {
-            "r": (compat.expression(f.r, V_r), dolfinx.fem.Function(V_r)),
-            "alpha": (compat.expression(f.alpha, V_s), dolfinx.fem.Function(V_s)),
-            "alpha_t": (compat.expression(f.alpha_t, V_s), dolfinx.fem.Function(V_s)),
-            "r_t": (compat.expression(f.r_t, V_r), dolfinx.fem.Function(V_r)),
+            "r": (compat.expression(r, V_r), dolfinx.fem.Function(V_r)),
+            "alpha": (compat.expression(alpha, V_s), dolfinx.fem.Function(V_s)),
+            "alpha_t": (compat.expression(alpha_t, V_s), dolfinx.fem.Function(V_s)),
+            "r_t": (compat.expression(r_t, V_r), dolfinx.fem.Function(V_r)),
             "tension": (compat.expression(T, V_s), dolfinx.fem.Function(V_s)),
-            "twist": (compat.expression(
-                kinematics.twist(f.r, f.alpha, c.gamma_eps, c.gamma_coupling,
-                                 k=getattr(f, "kappa", None)), V_s),
-                dolfinx.fem.Function(V_s)),
+            "twist": (compat.expression(model.twist(by_role, c), V_s),  # (34)
+                      dolfinx.fem.Function(V_s)),
         }
 
     def values(self) -> dict:

@@ -176,7 +176,7 @@ class HarmonicResponse:
         for part in (Xb.real, Xb.imag):
             u = dolfinx.fem.Function(rod.V_r)
             set_constant(u, part)
-            bc = dolfinx.fem.dirichletbc(u, rod.end_dofs["top"], rod.W.sub(0))
+            bc = dolfinx.fem.dirichletbc(u, rod.end_dofs["top"], rod.sub("centre_line"))
             x = self.modal.K.createVecRight()
             x.set(0.0)
             dolfinx.fem.petsc.set_bc(x, [bc])
@@ -201,7 +201,7 @@ class HarmonicResponse:
         ds = ufl.ds(domain=mesh)
         s = ufl.SpatialCoordinate(mesh)[0]
         r0 = rod.centre_line()  # the stationary state: the rod holds it after linearise
-        v = ufl.split(rod.test)[0]
+        v = rod.model.split(rod.test)["centre_line"]
         t0 = d(r0) / ufl.sqrt(ufl.dot(d(r0), d(r0)))
         forms = [ufl.avg(v[k]) * dS_mid for k in range(3)]
         forms.append(rod.c.sigma * ufl.dot(t0, d(v)) * (1 - s) * ds)  # dT at s = 0, (29)

@@ -164,7 +164,7 @@ class RodOperator:
         rows assembled once, checked against the probe's point form."""
         rod, u = self.solver.rod, self.form.u
         s = ufl.SpatialCoordinate(rod.mesh)[0]
-        r = ufl.split(u)[0]
+        r = rod.model.split(u)["centre_line"]
         rows = [dolfinx.fem.form(ufl.derivative(kinematics.d(r)[i] * (1 - s) * ufl.ds(domain=rod.mesh),
                                                 u, rod.test)) for i in range(3)]
         self._D = np.array([compat.assemble_vector_array(np.zeros(self.n), f) for f in rows])
