@@ -49,6 +49,11 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$PKGS" ]; then
   chroot "$ROOT" env "${cert[@]}" pip install -q --break-system-packages --no-deps "SALib==1.5.1"
   echo "$PKGS" > "$stamp"
 fi
+# import-linter (the import contracts, tests/test_architecture.py): pip, with its deps
+if ! chroot "$ROOT" python3 -c "import importlinter, grimp" 2>/dev/null; then
+  cert=(); [ -f "$ROOT/etc/rawehelix-host-ca.crt" ] && cert=(SSL_CERT_FILE=/etc/rawehelix-host-ca.crt)
+  chroot "$ROOT" env "${cert[@]}" pip install -q --break-system-packages "import-linter==2.1"
+fi
 
 # The package is this folder mapped to the name rawehelix (as pyproject does).
 rm -rf "$ROOT/src" && mkdir -p "$ROOT/src/pkgs"

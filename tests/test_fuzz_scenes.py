@@ -44,6 +44,7 @@ from hypothesis import strategies as st
 import rawehelix
 from rawehelix import parameters
 from rawehelix.cli import main as cli
+from rawehelix.cli.commands import base as cli_base
 from rawehelix.studies import scene
 
 SHIPPED = sorted(p.stem for p in scene.SCENE_DIR.glob("*.toml"))
@@ -262,7 +263,7 @@ def check_set(scene_name: str, key: str, value):
     # --set=ITEM: an ITEM that starts with "-" would be an option to argparse
     args = cli._parser().parse_args(["modes", scene_name, f"--set={item}"])
     typed = item.partition("=")[0]  # what --set takes for the key (a key may hold "=")
-    return check("--set", lambda: rawehelix.load_scene(args.scene, overrides=cli._overrides(args)),
+    return check("--set", lambda: rawehelix.load_scene(args.scene, overrides=cli_base.overrides(args)),
                  [typed, typed.strip()])
 
 

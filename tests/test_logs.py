@@ -63,7 +63,7 @@ def test_stationary_on_a_cold_cache_prints_nothing_on_stderr(tmp_path):
     code = f"""
     import sys
     from rawehelix.cli import main as cli
-from rawehelix.studies import logs
+    from rawehelix.studies import logs
     logs.configure(0)
     sys.exit(cli.main(["stationary", "stationary_table2", "--elements", "4",
                        "-o", {str(tmp_path / "out")!r}]))
