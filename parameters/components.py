@@ -5,7 +5,8 @@ in __post_init__) that also gives:
 
 * ``HOLDER, KEY``: where the section lives in a scene (``Parameters.model.damping``:
   ("model", "damping"));
-* ``SECTION``: its dataclass when it is a table of its own (the scene's ``[damping]``):
+* ``SECTION``: its dataclass (with ``active`` and ``describe()``, for Model.describe)
+  when it is a table of its own (the scene's ``[damping]``):
   :func:`holds` makes it a field of its holder and studies/scene.py a scene section;
   None for a value its holder declares itself (``helix.EI_law``);
 * ``GROUP_KEYS``: its normalised groups (merged into parameters/scene.py's);
