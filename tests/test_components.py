@@ -24,8 +24,9 @@ def test_each_table_is_a_scene_section_held_by_its_holder():
 
 
 def test_model_keeps_its_fields_in_their_order():
-    """The fingerprints hash Model as a dict in this order (tests/test_checkpoints.py)."""
-    assert [f.name for f in dataclasses.fields(Model)] == [
+    """The fingerprints hash Model as a dict in this order (tests/test_checkpoints.py);
+    a new component's table comes after them."""
+    assert [f.name for f in dataclasses.fields(Model)][:10] == [
         "gravity", "drag", "bending", "twist", "gamma", "reduction", "gamma_eps",
         "kinematics", "damping", "torsion_hysteresis"]
 
