@@ -5,12 +5,22 @@ in __post_init__) that also gives:
 
 * ``HOLDER, KEY``: where the section lives in a scene (``Parameters.model.damping``:
   ("model", "damping"));
+* ``SECTION``: its dataclass (with ``active`` and ``describe()``, for Model.describe)
+  when it is a table of its own (the scene's ``[damping]``):
+  :func:`holds` makes it a field of its holder and studies/scene.py a scene section;
+  None for a value its holder declares itself (``helix.EI_law``);
 * ``GROUP_KEYS``: its normalised groups (merged into parameters/scene.py's);
-* ``normalise(p, scales)``: its fields of :class:`~rawehelix.parameters.Normalised`;
+* ``NORMALISED``: its fields of :class:`~rawehelix.parameters.Normalised` and their
+  values when it is off (:func:`normalised_fields` declares them);
+* ``normalise(p, scales)``: those fields' values for a scene;
 * ``check(p)``: what it cannot run with, a :class:`ParameterError` (Parameters calls it).
 
 Its UFL half, the component itself with its null object, is in forms/ (forms/damping.py,
 forms/eilaw.py, forms/hysteresis.py), and the rod model (models/unshearable.py) asks it.
+
+A new component is its module here, appended to :data:`SECTIONS`, and its forms/
+module appended to forms/coefficients.py; nothing else in parameters/ or studies/
+names it (docs/explanation/model.md, "Adding a component").
 """
 
 from __future__ import annotations
@@ -37,6 +47,39 @@ def check(p) -> None:
     """Every section's refusals."""
     for section in SECTIONS:
         section.check(p)
+
+
+def scene_sections() -> dict:
+    """The components' tables of a scene, ``[KEY]`` -> its dataclass (studies/scene.py)."""
+    return {s.KEY: s.SECTION for s in SECTIONS if s.SECTION is not None}
+
+
+def scene_holders() -> dict:
+    """The section whose dataclass holds each component table: {"damping": "model", ...}."""
+    return {s.KEY: s.HOLDER for s in SECTIONS if s.SECTION is not None}
+
+
+def holds(holder: str):
+    """A class decorator, under ``@dataclass``: the component tables held by ``holder``
+    become fields of the class, ``KEY: SECTION = field(default_factory=SECTION)``,
+    in the order of :data:`SECTIONS` (Model: damping, torsion_hysteresis)."""
+    def add(cls):
+        for s in SECTIONS:
+            if s.HOLDER == holder and s.SECTION is not None:
+                cls.__annotations__[s.KEY] = s.SECTION.__name__
+                setattr(cls, s.KEY, dataclasses.field(default_factory=s.SECTION))
+        return cls
+    return add
+
+
+def normalised_fields(cls):
+    """A class decorator, under ``@dataclass``: every component's ``NORMALISED``
+    groups become fields of :class:`Normalised`, defaulting to their value when off."""
+    for s in SECTIONS:
+        for name, default in s.NORMALISED.items():
+            cls.__annotations__[name] = type(default).__name__
+            setattr(cls, name, default)
+    return cls
 
 
 def nested(holder: str) -> tuple[str, ...]:

@@ -39,7 +39,10 @@ GROUP_KEYS = {
 
 
 #: where the section lives in a scene: Parameters.model.damping (the file's [damping])
-HOLDER, KEY = "model", "damping"
+HOLDER, KEY, SECTION = "model", "damping", Damping
+
+#: its fields of Normalised, off: the retardation times / t_scale (0: off), forms/damping.py
+NORMALISED = {"tau_axial": 0.0, "tau_bending": 0.0, "tau_torsion": 0.0}
 
 
 def normalise(p, scales: dict) -> dict:

@@ -54,8 +54,13 @@ GROUP_KEYS = {
 }
 
 
-#: where the law lives in a scene: Parameters.helix.EI_law
-HOLDER, KEY = "helix", "EI_law"
+#: where the law lives in a scene: Parameters.helix.EI_law, a value Helix declares
+#: itself (an inline table, or None), not a table of its own
+HOLDER, KEY, SECTION = "helix", "EI_law", None
+
+#: its fields of Normalised, off: mu = mu_per_tension T~ + mu_at_zero_tension at the
+#: local normalised tension T~ = sigma eps, i.e. a / L0^2 and b / (M g L0^2)
+NORMALISED = {"bending_law": False, "mu_per_tension": 0.0, "mu_at_zero_tension": 0.0}
 
 
 def normalise(p, scales: dict) -> dict:

@@ -63,7 +63,11 @@ GROUP_KEYS = {
 
 
 #: where the section lives in a scene: Parameters.model.torsion_hysteresis
-HOLDER, KEY = "model", "torsion_hysteresis"
+HOLDER, KEY, SECTION = "model", "torsion_hysteresis", TorsionHysteresis
+
+#: its fields of Normalised, off (forms/hysteresis.py): tau~ = tau L0 and z~ = z L0,
+#: so beta~ = beta / L0^n and gamma~ = gamma / L0^n; rho = 1: off
+NORMALISED = {"bw_rho": 1.0, "bw_A": 1.0, "bw_beta": 0.0, "bw_gamma": 0.0, "bw_n": 1.0}
 
 
 def normalise(p, scales: dict) -> dict:

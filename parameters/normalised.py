@@ -15,6 +15,7 @@ RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
 
 
 @dataclass(frozen=True)
+@components.normalised_fields
 class Normalised(EndForcing):
     """The dimensionless groups of Eqs. (25)-(29) and the scales to undo them."""
 
@@ -46,22 +47,9 @@ class Normalised(EndForcing):
     gravity: float
     drag: float
     bending: float
-    # structural damping: the retardation times / t_scale (0: off), forms/damping.py
-    tau_axial: float = 0.0
-    tau_bending: float = 0.0
-    tau_torsion: float = 0.0
-    # the EI law (helix.EI_law): mu = mu_per_tension T~ + mu_at_zero_tension at the
-    # local normalised tension T~ = sigma eps, i.e. a / L0^2 and b / (M g L0^2)
-    bending_law: bool = False
-    mu_per_tension: float = 0.0
-    mu_at_zero_tension: float = 0.0
-    # hysteretic torsion (forms/hysteresis.py): tau~ = tau L0 and z~ = z L0, so
-    # beta~ = beta / L0^n and gamma~ = gamma / L0^n; rho = 1: off
-    bw_rho: float = 1.0
-    bw_A: float = 1.0
-    bw_beta: float = 0.0
-    bw_gamma: float = 0.0
-    bw_n: float = 1.0
+    # then the components' groups, each module's NORMALISED (parameters/components.py):
+    # tau_axial, tau_bending, tau_torsion (damping.py), bending_law, mu_per_tension,
+    # mu_at_zero_tension (eilaw.py), bw_rho, bw_A, bw_beta, bw_gamma, bw_n (hysteresis.py)
 
     @property
     def damped(self) -> bool:

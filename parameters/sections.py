@@ -6,13 +6,11 @@ from __future__ import annotations
 import dataclasses
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from rawehelix.parameters import components
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
-from rawehelix.parameters.damping import Damping
 from rawehelix.parameters.eilaw import EILaw
-from rawehelix.parameters.hysteresis import TorsionHysteresis
 
 
 @dataclass(frozen=True)
@@ -145,6 +143,7 @@ def check_kinematics(params) -> None:
 
 
 @dataclass(frozen=True)
+@components.holds("model")
 class Model:
     """Which physics terms a scene switches on."""
 
@@ -169,10 +168,9 @@ class Model:
     # tension force is T r'); "extensible": stretch and bending from the stored
     # energy 1/2 EA eps^2 + 1/2 EI |t'|^2, t = r'/|r'| (forms/extensible.py)
     kinematics: str = "paper"
-    # structural damping: the scene's [damping] section (studies/scene.py puts it here)
-    damping: Damping = field(default_factory=Damping)
-    # hysteretic torsion: the scene's [torsion_hysteresis] section (studies/scene.py)
-    torsion_hysteresis: TorsionHysteresis = field(default_factory=TorsionHysteresis)
+    # then the components' tables it holds (parameters/components.py::holds), which
+    # studies/scene.py fills from the scene's sections: damping (the [damping]
+    # section, Damping), torsion_hysteresis ([torsion_hysteresis], TorsionHysteresis)
 
     def describe(self, planar: bool = False) -> str:
         """The model that runs, for summary.json: reduction and the terms switched on."""

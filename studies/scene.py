@@ -2,8 +2,9 @@
 
 A scene has the sections of :class:`rawehelix.parameters.Parameters`
 (``[helix]``, ``[ends]``, ``[environment]``, ``[torque]``, ``[controller]``,
-``[model]``, ``[damping]``, ``[torsion_hysteresis]``, ``[discretisation]``, ``[time]``) and an optional top-level
-``title``.  ``studies/scenes/example.toml`` documents every key.
+``[model]``, ``[discretisation]``, ``[time]``, ``[sweep]``), the physics components'
+sections (``[damping]``, ``[torsion_hysteresis]``: parameters/components.py, which
+names them and the section that holds them) and an optional top-level ``title``.  ``studies/scenes/example.toml`` documents every key.
 
 Any problem raises :class:`SceneError`, whose message names the file, the key
 and what is allowed; the command line turns it into exit status 2 before any
@@ -19,17 +20,16 @@ import tomllib
 from pathlib import Path
 
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
-from rawehelix.parameters import (Controller, Damping, Discretisation, Ends, Environment,
-                                        Helix, Model, ParameterError, Parameters, Sweep,
-                                        Time, Torque, TorsionHysteresis)
+from rawehelix.parameters import (Controller, Discretisation, Ends, Environment, Helix, Model,
+                                  ParameterError, Parameters, Sweep, Time, Torque, components)
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
     "controller": Controller, "model": Model, "discretisation": Discretisation,
-    "time": Time, "sweep": Sweep, "damping": Damping,
-    "torsion_hysteresis": TorsionHysteresis,
+    "time": Time, "sweep": Sweep,
+    **components.scene_sections(),  # [damping], [torsion_hysteresis]
 }
-NESTED = {"damping": "model", "torsion_hysteresis": "model"}  # sections held by another section's dataclass
+NESTED = components.scene_holders()  # sections held by another section's dataclass
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"

@@ -58,13 +58,13 @@ def test_example_documents_every_key_with_its_default():
     data = tomllib.loads(path.read_text())
     required = set()
     # the sections of Parameters, and those held by another section ([damping] in the model)
-    sections = [(s.name, s.type) for s in dataclasses.fields(parameters.Parameters)
-                if s.name in scene.SECTIONS] + [(n, scene.SECTIONS[n].__name__) for n in scene.NESTED]
-    assert {name for name, _ in sections} == set(scene.SECTIONS)
-    for name, type_name in sections:  # (not the labels name and title: file name, title line)
+    sections = [s.name for s in dataclasses.fields(parameters.Parameters)
+                if s.name in scene.SECTIONS] + list(scene.NESTED)
+    assert set(sections) == set(scene.SECTIONS)
+    for name in sections:  # (not the labels name and title: file name, title line)
         table = data.get(name)
         assert isinstance(table, dict), f"[{name}] is missing"
-        fields = [f for f in dataclasses.fields(getattr(parameters, type_name))  # annotations
+        fields = [f for f in dataclasses.fields(scene.SECTIONS[name])
                   if f.name not in scene.NESTED]
         # a key whose default is None (absent: TOML has no null) is shown commented out
         absent = {f.name for f in fields if f.default is None}
