@@ -15,6 +15,13 @@ from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 PENALTY_MAX = 1.0e4
 
 SCHEMES = ("fe", "spline")
+
+
+def check_scheme(name: str) -> None:
+    """Refuse a scheme name that is none of :data:`SCHEMES` (the scene's
+    ``discretisation.scheme``, the scheme registry studies/schemes.py)."""
+    if name not in SCHEMES:
+        raise ParameterError("discretisation.scheme", name, f"must be one of {SCHEMES}")
 MESHES = ("uniform", "graded")
 BENDINGS = ("ip", "mixed")  # the FE bending operator: forms/rod.py, forms/mixed.py
 
@@ -33,8 +40,7 @@ class Discretisation:
     quadrature_degree: int = 0  # cell quadrature: 0 the rule 3p, -1 UFL's estimate, > 0 that degree
 
     def __post_init__(self):
-        if self.scheme not in SCHEMES:
-            raise ParameterError("discretisation.scheme", self.scheme, f"must be one of {SCHEMES}")
+        check_scheme(self.scheme)
         if self.bending not in BENDINGS:
             raise ParameterError("discretisation.bending", self.bending, f"must be one of {BENDINGS}")
         if self.mesh not in MESHES:

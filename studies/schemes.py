@@ -25,7 +25,8 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.families import LATERAL
-from rawehelix.parameters import SCHEMES, ParameterError, Parameters
+from rawehelix.parameters import SCHEMES, Parameters
+from rawehelix.parameters.numerics import check_scheme
 
 
 @dataclass
@@ -213,8 +214,7 @@ assert tuple(SCHEME_REGISTRY) == SCHEMES, "the registry names the schemes of par
 
 def get(name: str) -> Scheme:
     """The scheme of a name; any other name is refused as a scene's is."""
-    if name not in SCHEME_REGISTRY:
-        raise ParameterError("discretisation.scheme", name, f"must be one of {SCHEMES}")
+    check_scheme(name)
     return SCHEME_REGISTRY[name]
 
 
