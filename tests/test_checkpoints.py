@@ -26,6 +26,7 @@ import pytest
 from mpi4py import MPI
 
 from rawehelix.studies import checkpoints, outdir_lock, pool, quantities, writers
+from tests_util import world_folder
 
 SELF = MPI.COMM_SELF
 BROKEN = "rawehelix_test_broken_option"  # a PETSc option the fake evaluation fails under
@@ -100,10 +101,7 @@ def test_taking_the_lock_removes_a_killed_runs_temporary_files(tmp_path):
 
 @pytest.mark.mpi
 def test_under_mpi_rank_0_holds_the_lock_and_every_rank_gets_the_verdict(tmp_path_factory):
-    comm = MPI.COMM_WORLD
-    if comm.size == 1:
-        pytest.skip("run under mpirun -n 2")
-    folder = Path(comm.bcast(str(tmp_path_factory.mktemp("lock")) if comm.rank == 0 else None))
+    comm, folder = world_folder(tmp_path_factory, "lock", "run under mpirun -n 2")
     proc = start_holder(folder / "out") if comm.rank == 0 else None
     comm.Barrier()
     try:

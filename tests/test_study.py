@@ -8,6 +8,7 @@ from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.studies import quantities
+from tests_util import world_folder
 
 N = 4  # elements: small and fast
 
@@ -267,10 +268,7 @@ def test_sampled_designs_and_salib_indices(tmp_path):
 @pytest.mark.mpi
 def test_one_and_two_ranks_give_the_same_csv(tmp_path_factory):
     """The same study on COMM_WORLD (2 ranks, dynamic) and on one rank: the same bytes."""
-    comm = MPI.COMM_WORLD
-    if comm.size == 1:
-        pytest.skip("compares 1 and 2 ranks: run under mpirun -n 2")
-    base = Path(comm.bcast(str(tmp_path_factory.mktemp("study")) if comm.rank == 0 else None))
+    comm, base = world_folder(tmp_path_factory, "study")
     source = study.Source("mobile_end", elements=N)
     v = [study.parse_vary("helix.EI_Nm2=3000:6000:3"), study.parse_vary("helix.GJ_Nm2=100:200:2")]
     wanted = ["lateral_frequency_Hz", "torsional_frequency_Hz"]
@@ -343,10 +341,7 @@ def test_calibration_says_when_targets_do_not_identify_the_keys(tmp_path):
 def test_calibration_on_two_ranks_is_the_one_rank_fit(tmp_path_factory):
     """The Jacobian's columns on 2 ranks (both compute) give the one-rank fit
     to the last bit: fitted, residuals, Jacobian."""
-    comm = MPI.COMM_WORLD
-    if comm.size == 1:
-        pytest.skip("compares 1 and 2 ranks: run under mpirun -n 2")
-    base = Path(comm.bcast(str(tmp_path_factory.mktemp("cal")) if comm.rank == 0 else None))
+    comm, base = world_folder(tmp_path_factory, "cal")
     source = study.Source("nominal_operation", elements=N)
     args = (source, ["ends.elongation", "helix.mass_kg"], {"tension_s0_N": 210.0, "sag_m": 0.04})
     world = calibrate.compute(*args, base / "world", comm=comm).summary

@@ -17,7 +17,7 @@ from mpi4py import MPI
 
 from rawehelix.cli import main as cli
 from rawehelix.studies import scene, sweep
-from tests_util import write_scene
+from tests_util import world_folder, write_scene
 
 # periodic to 0.1 of the oscillation: about 2e-3 of T max at 8-10 Hz
 FAST = {"sweep": {"lead_in_s": 1.0, "min_periods": 3, "periodic_tolerance": 0.1}}
@@ -173,10 +173,7 @@ def test_two_ranks_match_one(tmp_path_factory):
     """Chunks on 2 ranks give the points of 1 rank to the periodicity tolerance
     (the second chunk starts from the stationary state with a lead-in instead of
     continuing).  Low f1, where the response is single-valued."""
-    comm = MPI.COMM_WORLD
-    if comm.size == 1:
-        pytest.skip("compares 1 and 2 ranks: run under mpirun -n 2")
-    base = comm.bcast(str(tmp_path_factory.mktemp("sweep")) if comm.rank == 0 else None, root=0)
+    comm, base = world_folder(tmp_path_factory, "sweep")
     # the default lead-in (10 s) covers the spin-up under the torque ramp (t0 = 1.8 s)
     params = scene.load("mobile_end", scheme="spline", elements=2)
     freqs = [3.0, 4.0, 5.0, 6.0]

@@ -1,6 +1,9 @@
 """Helpers for the tests (not a test module)."""
 
 import tomllib
+from pathlib import Path
+
+import pytest
 
 from rawehelix.studies import scene
 
@@ -80,3 +83,14 @@ def residual_and_energy_derivative(params, extra=None):
         values.append(dolfinx.fem.assemble_scalar(U))
     rod.w.x.array[:] = w0
     return dolfinx.fem.assemble_scalar(F), (values[0] - values[1]) / (2 * h), more
+
+
+def world_folder(tmp_path_factory, name: str,
+                 why: str = "compares 1 and 2 ranks: run under mpirun -n 2"):
+    """(COMM_WORLD, a fresh folder of rank 0's that every rank is given): for the
+    tests marked ``mpi`` that need two ranks; skipped (``why``) on one."""
+    from mpi4py import MPI
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        pytest.skip(why)
+    return comm, Path(comm.bcast(str(tmp_path_factory.mktemp(name)) if comm.rank == 0 else None))
