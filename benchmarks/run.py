@@ -312,14 +312,15 @@ def chord_profile(backend, sim_s: float = 1.0) -> dict:
     simulated from the stationary state), by wrapping them with process_time
     (its own cost, ~0.6 us a pair, is in each part); ``other`` is the rest:
     numpy glue of the chord iteration and the step loop in Python."""
-    from rawehelix.solvers import chord
-    s = backend.stepper
-    form, acc, clock = s.form, {}, time.process_time
+    from rawehelix.solvers import rod_operator
+    s = backend.stepper  # a ChordAlpha: the rod operator s.op and the stepper s.alpha
+    form, acc, clock = s.op.form, {}, time.process_time
     parts = {"set_time (constants, end position)": (form, "set_time"),
              "bc_values (Dirichlet data)": (form, "bc_values"),
-             "residual assembly": (chord.compat, "assemble_vector_array"),
-             "LU solve (getrs)": (s, "_getrs"), "Jacobian assembly + LU factor": (s, "_factor"),
-             "newmark (stage vectors)": (s, "newmark"), "tension0": (s, "tension0")}
+             "residual assembly": (rod_operator.compat, "assemble_vector_array"),
+             "LU solve (getrs)": (s.alpha, "_getrs"),
+             "Jacobian assembly + LU factor": (s.alpha, "_factor"),
+             "newmark (stage vectors)": (s.alpha, "newmark"), "tension0": (s, "tension0")}
     saved = {}
     for label, (obj, name) in parts.items():
         f = saved[label] = getattr(obj, name)
