@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import dataclasses
 
-from rawehelix.parameters import damping, eilaw, hysteresis
+from rawehelix.parameters import damping, eilaw, hysteresis, section
 
 #: the sections, in the order of their checks
-SECTIONS = (eilaw, damping, hysteresis)
+SECTIONS = (eilaw, damping, hysteresis, section)
 
 
 def group_keys() -> dict:

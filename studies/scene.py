@@ -40,6 +40,8 @@ _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "boo
 
 
 def _check_type(path, key: str, value, type_name: str):
+    if type_name == "float | None":  # an optional number: absent is None (TOML has no null)
+        type_name = "float"
     ok = {
         "float": isinstance(value, (int, float)) and not isinstance(value, bool),
         "int": isinstance(value, int) and not isinstance(value, bool),

@@ -118,7 +118,7 @@ def _without_unit(comment: str) -> str:
 
 def _probes(type_name: str):
     """Values to offer a field to learn, from its validation, what it refuses."""
-    if type_name == "float":
+    if type_name in ("float", "float | None"):
         return [0.5, 2.0, 1.0, 0.0, -1.0, 1e-300, 1e300, -1e300, math.nan, math.inf, -math.inf]
     if type_name == "int":
         return [-10**6, -1, 0, 1, 2, 10**6]

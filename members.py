@@ -1,0 +1,252 @@
+"""The tensegrity's members: their strains from the rod's strains, their forces, the
+section's resultants and the structure's limits.  Pure numpy: the one definition of
+the member law and of every limit criterion (issue 29).
+
+The section (a scene's ``[section]``, parameters/section.py) is a ring of ``n``
+tethers at radius R, evenly spaced, each laid at the angle beta to the axis (the
+same hand: a TRPT's rings are turned by delta_0 = l tan(beta) / R against each
+other), with axial stiffness k = EA of one tether [N], a self-stress P0 [N] (the
+tethers' tension at zero rod strain, balanced by bars on the axis of stiffness
+EA_b) and, optionally, a breaking force F_b.
+
+**Kinematics.**  The rod's strains are the stretch eps = |r'| - 1, the curvature
+kappa >= 0 (per unstretched length, in the bending plane) and the twist tau
+[rad/m].  A tether at the angle phi from the bending plane's inner side follows,
+per unit rod length, the axial stretch 1 + eps - R kappa cos(phi) and the
+tangential advance R tau + tan(beta); its strain against its length at zero rod
+strain, 1 / cos(beta) per unit rod length, is
+
+    e(phi) = cos(beta) sqrt((1 + eps - R kappa cos phi)^2 + (R tau + tan beta)^2) - 1 + e0,
+
+e0 = P0 / k.  The members are taken at phi_m = 2 pi m / n: a member lies on the
+bending plane (the phase at which the first member slackens soonest, and the
+largest member force is largest; :func:`phase_spread` measures the other phases).
+
+**The law.**  A tether carries tension only: its force is k <e>_w, the smooth
+positive part <e>_w = (e + sqrt(e^2 + w^2)) / 2 of width w (the slack width, a
+strain; <e>_0 = max(e, 0)).  Its energy per unit rod length is
+(k / cos beta) Phi_w(e), Phi_w' = <.>_w (:func:`ramp_energy`), convex and
+nondecreasing; e is convex in (eps, kappa, tau) (a norm of an affine map, less a
+constant) where the axial stretch is positive, so the section's stored energy
+
+    W(eps, kappa, tau) = sum_m (k / cos beta) Phi_w(e_m) + EA_b / 2 (eps + e_b0)^2 + Q_b0 tau
+
+is convex, unlike EI = a T + b (parameters/eilaw.py).  The bars' prestrain e_b0
+and torque Q_b0 balance the self-stress: N = Q = 0 at zero strain.  The resultants are its derivatives:
+N = dW/d eps, M = dW/d kappa, Q = dW/d tau (:meth:`Members.resultants`).
+
+**Closed forms** (:meth:`Members.taut_moduli`), all members taut, at zero strain
+(w = 0, n >= 3): with K = n (k cos^3 beta + P0 cos beta sin^2 beta),
+EA = K + EA_b, EI = K R^2 / 2, GJ = n cos(beta) R^2 (k sin^2 beta + P0 cos^2 beta):
+the lay's elastic part and the tethers' tension's geometric part (at beta = 0,
+GJ = N_t R^2 at the tethers' tension N_t: the torsional stiffness of Tulloch's
+(2021) TRPT).  :meth:`Members.tangent` measures them at any state.
+
+**Limits** (:data:`CRITERIA`, checked by :func:`limits`):
+
+* ``slack``: a member's strain e <= 0 (its unregularised force is zero);
+* ``breaking``: a member's force >= F_b;
+* ``moment_saturation``: |M| >= N R c, c = max_m(-cos phi_m) the members'
+  tension-limited moment (all tension on the outermost member);
+* ``torsional_collapse``: the twist between adjacent rings, l (tau + tan(beta)/R),
+  past the TRPT's critical deformation angle delta_crit (Tulloch 2021, Eq. 4.34,
+  for tethers of length l_t between rings of radius R at spacing l; the anchor
+  KiteTurbineDynamics.jl uses): the transmitted torque peaks there, and the
+  segment runs away past it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: the limit criteria, in the order of :func:`first_limit`'s ties
+CRITERIA = ("slack", "breaking", "moment_saturation", "torsional_collapse")
+
+
+def smooth_ramp(e, w):
+    """<e>_w = (e + sqrt(e^2 + w^2)) / 2: max(e, 0) for w = 0, smooth for w > 0."""
+    e = np.asarray(e, dtype=float)
+    return 0.5 * (e + np.sqrt(e * e + w * w))
+
+
+def ramp_energy(e, w):
+    """Phi_w(e) = int_0^e <x>_w dx = (e^2 + e sqrt(e^2 + w^2) + w^2 ln((e + sqrt(e^2 + w^2)) / w)) / 4;
+    for w = 0, max(e, 0)^2 / 2.  (<x>_w ~ w^2 / (4 |x|) in the slack, so Phi_w falls like
+    w^2 ln|e| / 4 there: convex and nondecreasing, its offset from 0 below w^2.)"""
+    e = np.asarray(e, dtype=float)
+    if w == 0:
+        return 0.5 * np.maximum(e, 0.0) ** 2
+    root = np.sqrt(e * e + w * w)
+    # e + root loses digits for e << -w: there it is w^2 / (root - e)
+    plus = np.where(e >= 0, e + root, w * w / np.maximum(root - e, 1e-300))
+    return 0.25 * (e * e + e * root + w * w * np.log(plus / w))
+
+
+def critical_twist(R: float, l_t: float) -> float:
+    """Tulloch's (2021) critical deformation angle delta_crit [rad] of a TRPT segment
+    of equal rings of radius R and tethers of length l_t (Eq. 4.34): cos delta_crit =
+    (2 R^2 - l_t^2 + l_t sqrt(l_t^2 - 4 R^2)) / (2 R^2).  inf when l_t < 2 R: the
+    lines cannot reach the axis, and no twist limit exists (the rings meet first)."""
+    if l_t < 2 * R:
+        return math.inf
+    c = (2 * R * R - l_t * l_t + l_t * math.sqrt(l_t * l_t - 4 * R * R)) / (2 * R * R)
+    return math.acos(max(-1.0, min(1.0, c)))
+
+
+@dataclass(frozen=True)
+class Members:
+    """A ring of ``n`` tethers (SI); see the module docstring for each symbol."""
+
+    n: int  # tethers around the section [-]
+    R: float  # their radius [m]
+    beta: float  # their lay angle to the axis [rad]
+    k: float  # the axial stiffness EA of one tether [N]
+    P0: float = 0.0  # self-stress: each tether's tension at zero rod strain [N]
+    EA_b: float = 0.0  # the bars' axial stiffness, on the axis [N]
+    breaking_N: float | None = None  # F_b, a tether's breaking force [N]; None: not set
+    ring_spacing_m: float | None = None  # l, between adjacent rings [m]; None: not set
+    width: float = 0.0  # w, the slack width (a strain) [-]
+
+    def __post_init__(self):
+        if self.n < 3:
+            raise ValueError(f"n = {self.n}: a ring needs at least 3 tethers")
+        if self.P0 > 0 and self.EA_b <= 0:
+            raise ValueError("a self-stress P0 > 0 needs bars (EA_b > 0) to balance it")
+
+    # -- geometry -------------------------------------------------------------------
+    @property
+    def phi(self) -> np.ndarray:
+        """phi_m = 2 pi m / n from the bending plane's inner side."""
+        return 2 * np.pi * np.arange(self.n) / self.n
+
+    @property
+    def e0(self) -> float:
+        """The tethers' prestrain P0 / k."""
+        return self.P0 / self.k
+
+    @property
+    def e_b0(self) -> float:
+        """The bars' prestrain: EA_b e_b0 = -n P0 cos(beta) (N = 0 at zero strain)."""
+        return -self.n * self.P0 * math.cos(self.beta) / self.EA_b if self.EA_b > 0 else 0.0
+
+    @property
+    def Q_b0(self) -> float:
+        """The bars' (rings') torque at zero strain, -n P0 R sin(beta): it balances the
+        self-stressed tethers' torque (Q = 0 at zero strain)."""
+        return -self.n * self.P0 * self.R * math.sin(self.beta)
+
+    @property
+    def saturation(self) -> float:
+        """c = max_m(-cos phi_m): the tension-limited moment is c N R."""
+        return float(np.max(-np.cos(self.phi)))
+
+    # -- the law ----------------------------------------------------------------------
+    def _stretch(self, eps, kappa, tau):
+        """(a, b, l): the axial and tangential advance per unit rod length, and
+        l = sqrt(a^2 + b^2), each of shape (..., n)."""
+        eps, kappa, tau = (np.asarray(x, dtype=float)[..., None] for x in (eps, kappa, tau))
+        a = 1 + eps - self.R * kappa * np.cos(self.phi)
+        b = self.R * tau + math.tan(self.beta) + 0 * a
+        return a, b, np.sqrt(a * a + b * b)
+
+    def strains(self, eps, kappa, tau=0.0):
+        """e_m (..., n): each member's strain, slack where <= 0."""
+        _, _, l = self._stretch(eps, kappa, tau)
+        return math.cos(self.beta) * l - 1 + self.e0
+
+    def forces(self, eps, kappa, tau=0.0):
+        """k <e_m>_w [N], (..., n)."""
+        return self.k * smooth_ramp(self.strains(eps, kappa, tau), self.width)
+
+    def energy(self, eps, kappa, tau=0.0):
+        """W [N = J/m]: the members' and the bars' stored energy per unit rod length."""
+        e = self.strains(eps, kappa, tau)
+        tethers = self.k / math.cos(self.beta) * ramp_energy(e, self.width).sum(axis=-1)
+        eps, tau = np.asarray(eps, dtype=float), np.asarray(tau, dtype=float)
+        return tethers + 0.5 * self.EA_b * (eps + self.e_b0) ** 2 + self.Q_b0 * tau
+
+    def resultants(self, eps, kappa, tau=0.0) -> dict:
+        """N [N], M [N m] (>= 0 for kappa >= 0), Q [N m]: dW/d(eps, kappa, tau)."""
+        a, b, l = self._stretch(eps, kappa, tau)
+        f = self.forces(eps, kappa, tau)  # de/d(.) = cos(beta) (a da + b db) / l; x 1/cos(beta)
+        N = (f * a / l).sum(axis=-1) + self.EA_b * (np.asarray(eps, dtype=float) + self.e_b0)
+        M = (f * a / l * (-self.R * np.cos(self.phi))).sum(axis=-1)
+        Q = (f * b / l * self.R).sum(axis=-1) + self.Q_b0
+        return {"N": N, "M": M, "Q": Q}
+
+    def tangent(self, eps=0.0, kappa=0.0, tau=0.0, h: float = 1e-7) -> dict:
+        """The tangent moduli EA = dN/d eps, EI = dM/d kappa, GJ = dQ/d tau at a state
+        (central differences of :meth:`resultants`, step h in each strain; kappa's
+        step one-sided at kappa = 0, where M is odd in kappa)."""
+        def d(i):
+            x = [eps, kappa, tau]
+            lo, hi = list(x), list(x)
+            lo[i] -= h
+            hi[i] += h
+            key = "NMQ"[i]
+            return (self.resultants(*hi)[key] - self.resultants(*lo)[key]) / (2 * h)
+        return {"EA": float(d(0)), "EI": float(d(1)), "GJ": float(d(2))}
+
+    def taut_moduli(self) -> dict:
+        """The closed forms at zero strain, all taut, w = 0 (module docstring)."""
+        cb, sb = math.cos(self.beta), math.sin(self.beta)
+        K = self.n * (self.k * cb**3 + self.P0 * cb * sb**2)
+        return {"EA": K + self.EA_b, "EI": K * self.R**2 / 2,
+                "GJ": self.n * cb * self.R**2 * (self.k * sb**2 + self.P0 * cb**2)}
+
+    def first_slack_curvature(self, eps: float, tau: float = 0.0) -> float:
+        """kappa at which the member on the inner side (phi = 0) slackens: e = 0,
+        (1 + eps - R kappa)^2 = ((1 - e0) / cos beta)^2 - (R tau + tan beta)^2."""
+        b = self.R * tau + math.tan(self.beta)
+        a0 = math.sqrt(((1 - self.e0) / math.cos(self.beta)) ** 2 - b * b)
+        return (1 + eps - a0) / self.R
+
+    # -- for a solid section: the members' forces under given resultants ------------
+    def linear_forces(self, N, M, Q=0.0):
+        """The tethers' forces [N] (..., n) that carry N, M, Q in the taut, linear
+        law (the diagnostic of a solid section: what a tensegrity would feel):
+        P0 + k de_m, with de_m the linearised strain of the strains N / EA, M / EI,
+        Q / GJ_el (the lay's share of the torque; 0 at beta = 0)."""
+        taut = self.taut_moduli()
+        cb, sb = math.cos(self.beta), math.sin(self.beta)
+        N, M, Q = (np.asarray(x, dtype=float)[..., None] for x in (N, M, Q))
+        eps, kappa = N / taut["EA"], M / taut["EI"]
+        GJ_el = self.n * self.k * sb * sb * cb * self.R**2
+        tau = Q / GJ_el if GJ_el > 0 else 0 * Q
+        de = cb * cb * (eps - self.R * kappa * np.cos(self.phi)) + sb * cb * self.R * tau
+        return self.P0 + self.k * de
+
+    # -- limits ---------------------------------------------------------------------
+    def critical_twist(self) -> float:
+        """delta_crit [rad] between adjacent rings (:func:`critical_twist`), with the
+        tethers' length l / cos(beta); inf without a ring spacing."""
+        if self.ring_spacing_m is None:
+            return math.inf
+        return critical_twist(self.R, self.ring_spacing_m / math.cos(self.beta))
+
+    def ring_twist(self, tau):
+        """The twist between adjacent rings, l (tau + tan(beta) / R) [rad]; nan without l."""
+        if self.ring_spacing_m is None:
+            return np.full(np.shape(tau), np.nan)
+        return self.ring_spacing_m * (np.asarray(tau, dtype=float) + math.tan(self.beta) / self.R)
+
+
+def phase_spread(members: Members, eps: float, kappa: float, tau: float = 0.0,
+                 phases: int = 64) -> dict:
+    """How much the fixed phase (a member on the bending plane) matters: the range of
+    the moment and of the smallest member force over the bending plane's phase
+    relative to the ring, psi in [0, 2 pi / n)."""
+    out = {"M": [], "f_min": []}
+    for psi in np.linspace(0, 2 * np.pi / members.n, phases, endpoint=False):
+        e = (math.cos(members.beta) * np.sqrt(
+            (1 + eps - members.R * kappa * np.cos(members.phi + psi)) ** 2
+            + (members.R * tau + math.tan(members.beta)) ** 2) - 1 + members.e0)
+        f = members.k * smooth_ramp(e, members.width)
+        a = 1 + eps - members.R * kappa * np.cos(members.phi + psi)
+        l = np.sqrt(a * a + (members.R * tau + math.tan(members.beta)) ** 2)
+        out["M"].append(float((f * a / l * (-members.R * np.cos(members.phi + psi))).sum()))
+        out["f_min"].append(float(f.min()))
+    return {k: (min(v), max(v)) for k, v in out.items()}

@@ -1,0 +1,113 @@
+"""The scene's ``[section]`` section: the section law, a solid or the tensegrity's
+members (members.py; forms/ holds its UFL energy).
+
+``law = "solid"`` (the default) is the paper's section, EA, EI and GJ of ``[helix]``;
+its members' keys still describe the tensegrity that the ``limits`` block of every
+result measures the solid's resultants against (members.py: what a tensegrity
+would feel).  ``law = "tensegrity"`` makes the section's resultants those of the
+members.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rawehelix.members import Members
+from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
+
+LAWS = ("solid", "tensegrity")
+
+
+@dataclass(frozen=True)
+class Section:
+    """The cross-section of the helix: a ring of ``tethers`` evenly spaced tension-only
+    members at radius R laid at the angle beta to the axis, with bars on the axis that
+    carry the self-stress (members.py has the law and every symbol)."""
+
+    law: str = "solid"  # "solid": the helix's EA, EI, GJ; "tensegrity": the members' energy
+    tethers: int = 6  # n, tethers around the section [-] (an assumption: the paper gives none)
+    radius_m: float | None = None  # R, the tethers' radius [m]; None: helix.radius_m (Table 1)
+    lay_angle_deg: float = 0.0  # beta, the tethers' angle to the axis, one hand [deg]
+    tether_EA_N: float | None = None  # k, one tether's axial stiffness; None: taut EA = helix.EA_N [N]
+    self_stress_N: float = 0.0  # P0, each tether's tension at zero rod strain [N]
+    bar_EA_N: float = 0.0  # EA_b, the bars' axial stiffness, on the axis [N]; > 0 with P0 > 0
+    breaking_force_N: float | None = None  # F_b, a tether's breaking force [N]; None: not set
+    ring_spacing_m: float | None = None  # l, between adjacent rings (torsional collapse); None: off [m]
+    slack_width: float = 1.0e-4  # w, the strain over which a tether goes slack (regularisation) [-]
+
+    def __post_init__(self):
+        if self.law not in LAWS:
+            raise ParameterError("section.law", self.law, f"must be one of {list(LAWS)}")
+        if isinstance(self.tethers, bool) or not isinstance(self.tethers, int) or self.tethers < 3:
+            raise ParameterError("section.tethers", self.tethers,
+                                 "must be an integer >= 3 (a ring of tethers)")
+        if not (0 <= self.lay_angle_deg < 60):
+            raise ParameterError("section.lay_angle_deg", self.lay_angle_deg,
+                                 "must lie in [0, 60) degrees")
+        _non_negative("section", self, "self_stress_N", "bar_EA_N")
+        _positive("section", self, "slack_width")
+        for name in ("radius_m", "tether_EA_N", "breaking_force_N", "ring_spacing_m"):
+            if getattr(self, name) is not None:
+                _positive("section", self, name)
+        if self.self_stress_N > 0 and self.bar_EA_N <= 0:
+            raise ParameterError("section.self_stress_N", self.self_stress_N,
+                                 "a self-stress needs bars to balance it: set section.bar_EA_N > 0")
+        if self.slack_width >= 1e-2:
+            raise ParameterError("section.slack_width", self.slack_width,
+                                 "must be below 1e-2 (a strain; the tethers' strains are ~1e-3)")
+
+    @property
+    def active(self) -> bool:
+        """The tensegrity law is on (the solid section is the paper's model)."""
+        return self.law == "tensegrity"
+
+    def members(self, helix, width: float | None = None) -> Members:
+        """The :class:`~rawehelix.members.Members` of this section on ``helix`` (SI);
+        ``width`` overrides the slack width (0: the unregularised law)."""
+        beta = math.radians(self.lay_angle_deg)
+        n, P0, EA_b = self.tethers, self.self_stress_N, self.bar_EA_N
+        k = self.tether_EA_N
+        if k is None:  # n (k cos^3 beta + P0 cos beta sin^2 beta) + EA_b = helix.EA_N
+            k = ((helix.EA_N - EA_b) / n - P0 * math.cos(beta) * math.sin(beta) ** 2) \
+                / math.cos(beta) ** 3
+            if k <= 0:
+                raise ParameterError("section.bar_EA_N", EA_b,
+                                     f"leaves the tethers no stiffness: it must be below "
+                                     f"helix.EA_N = {helix.EA_N:g} N, or set section.tether_EA_N")
+        return Members(n=n, R=self.radius_m or helix.radius_m, beta=beta, k=k, P0=P0, EA_b=EA_b,
+                       breaking_N=self.breaking_force_N, ring_spacing_m=self.ring_spacing_m,
+                       width=self.slack_width if width is None else width)
+
+    def describe(self) -> str:
+        return (f"section: tensegrity, {self.tethers} tethers, lay {self.lay_angle_deg:g} deg, "
+                f"self-stress {self.self_stress_N:g} N, slack width {self.slack_width:g}")
+
+
+#: no normalised groups of its own yet (the tensegrity's forms read the members)
+GROUP_KEYS: dict = {}
+
+#: where the section lives in a scene: Parameters.model.section (the file's [section])
+HOLDER, KEY, SECTION = "model", "section", Section
+
+#: its fields of Normalised, off
+NORMALISED = {"section_tensegrity": False}
+
+
+def normalise(p, scales: dict) -> dict:
+    """Normalised's section_tensegrity."""
+    return {"section_tensegrity": p.model.section.active}
+
+
+def check(params) -> None:
+    """What the tensegrity law cannot run with (``params`` a whole scene): its resultants
+    are the variation of the members' energy, so it needs the extensible kinematics
+    (model.kinematics = "extensible") of the FE scheme with the IP bending form."""
+    section, disc = params.model.section, params.discretisation
+    if section.active and (params.model.kinematics != "extensible" or disc.scheme != "fe"
+                           or disc.bending != "ip"):
+        raise ParameterError("section.law", section.law,
+                             "'tensegrity' needs model.kinematics = 'extensible' on the FE "
+                             "scheme with discretisation.bending = 'ip' (its forces are the "
+                             "variation of the members' energy)")
+    section.members(params.helix)  # the derived tether stiffness is positive
