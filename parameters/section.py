@@ -16,7 +16,9 @@ from dataclasses import dataclass
 from rawehelix.members import Members
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 
-LAWS = ("solid", "tensegrity")
+#: "saturating" is the fallback law of issue 29 (members.py::ConeSection): the solid's
+#: EA and EI inside the cone |M| <= c N R of a tension-only section, convex
+LAWS = ("solid", "tensegrity", "saturating")
 
 
 @dataclass(frozen=True)
@@ -25,7 +27,7 @@ class Section:
     members at radius R laid at the angle beta to the axis, with bars on the axis that
     carry the self-stress (members.py has the law and every symbol)."""
 
-    law: str = "solid"  # "solid": the helix's EA, EI, GJ; "tensegrity": the members' energy
+    law: str = "solid"  # "solid": the helix's EA, EI, GJ; "tensegrity": the members; "saturating": |M| <= c N R
     tethers: int = 6  # n, tethers around the section [-] (an assumption: the paper gives none)
     radius_m: float | None = None  # R, the tethers' radius [m]; None: helix.radius_m (Table 1)
     lay_angle_deg: float = 0.0  # beta, the tethers' angle to the axis, one hand [deg]
@@ -59,8 +61,8 @@ class Section:
 
     @property
     def active(self) -> bool:
-        """The tensegrity law is on (the solid section is the paper's model)."""
-        return self.law == "tensegrity"
+        """A law other than the solid (the paper's model) is on."""
+        return self.law != "solid"
 
     def members(self, helix, width: float | None = None) -> Members:
         """The :class:`~rawehelix.members.Members` of this section on ``helix`` (SI);
