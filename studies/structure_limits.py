@@ -1,0 +1,129 @@
+"""The structure's limits in a result: the ``limits`` block of every summary.json
+(issue 29).  The numerical limits of a discretisation are studies/limits.py's.
+
+A :class:`Tracker` takes the section's state along s at each time it is given
+(:meth:`Tracker.add`: SI arrays of the axial force N, the bending moment M, the
+torque Q, the twist tau and, for a member law, the strains eps and kappa) and keeps
+the extremes and the first limit reached; :meth:`Tracker.block` is the block:
+
+* ``min_member_force_N``, ``max_member_force_N``: value, with where (s) and when (t);
+* ``slack_fraction_max``: the largest fraction of slack members in a section;
+* ``moment_ratio_max``: the largest |M| / (N R) (None where N <= 0 carries a moment:
+  ``moment_without_tension`` then says where);
+* ``twist_per_length_max``: the largest |tau| [rad/m];
+* ``first_limit``: the first criterion reached (members.py::CRITERIA), its kind, s and
+  t, or None; ``criteria`` gives each criterion's threshold, None where a scene key
+  leaves it off (section.breaking_force_N, section.ring_spacing_m).
+
+The members' forces: with the solid section, the forces of a tensegrity of the
+scene's ``[section]`` members carrying the solid's resultants (members.py::
+Members.linear_forces: what a tensegrity would feel); with a member law, the members'
+own forces at the rod's strains (Members.forces).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rawehelix.members import CRITERIA, Members
+
+
+def _at(value, s, t) -> dict:
+    return {"value": float(value), "s_m": float(s), "t_s": None if t is None else float(t)}
+
+
+class Tracker:
+    """The extremes of the members' state over the sections and times it is given."""
+
+    def __init__(self, members: Members, law: str = "solid"):
+        self.members, self.law = members, law
+        self._min = self._max = self._ratio = self._twist = None
+        self._slack = 0.0
+        self._no_tension = None
+        self._first = None
+
+    def thresholds(self) -> dict:
+        """Each criterion's threshold, None when off (members.py)."""
+        m = self.members
+        dcrit = m.critical_twist()
+        return {"slack": "a member's strain <= 0 (solid: its force <= 0)",
+                "breaking": m.breaking_N,
+                "moment_saturation": m.saturation,
+                "torsional_collapse": None if not np.isfinite(dcrit) else dcrit}
+
+    def forces(self, N, M, Q, eps=None, kappa=None, tau=None):
+        """The members' forces (..., n) [N] and their slack mask."""
+        m = self.members
+        if self.law == "tensegrity":
+            e = m.strains(eps, kappa, tau)
+            return m.forces(eps, kappa, tau), e <= 0
+        f = m.linear_forces(N, M, Q)
+        return f, f <= 0
+
+    def add(self, s_m, N, M, Q, tau, t_s=None, eps=None, kappa=None):
+        """The sections at ``s_m`` (ns,) at the time ``t_s`` (None: a stationary
+        state): N [N], M [N m] (magnitude), Q [N m], tau [rad/m] of shape (ns,); eps and
+        kappa [1/m] for a member law."""
+        s_m, N, M, Q, tau = (np.asarray(x, dtype=float) for x in (s_m, N, M, Q, tau))
+        f, slack = self.forces(N, M, Q, eps, np.abs(kappa) if kappa is not None else None, tau)
+        m = self.members
+        i = int(np.argmin(f.min(axis=-1)))
+        if self._min is None or f[i].min() < self._min["value"]:
+            self._min = _at(f[i].min(), s_m[i], t_s)
+        i = int(np.argmax(f.max(axis=-1)))
+        if self._max is None or f[i].max() > self._max["value"]:
+            self._max = _at(f[i].max(), s_m[i], t_s)
+        fraction = slack.mean(axis=-1)
+        self._slack = max(self._slack, float(fraction.max()))
+        tension = N > 0
+        ratio = np.where(tension, np.abs(M) / np.where(tension, N * m.R, 1.0), 0.0)
+        i = int(np.argmax(ratio))
+        if self._ratio is None or ratio[i] > self._ratio["value"]:
+            self._ratio = _at(ratio[i], s_m[i], t_s)
+        bad = ~tension & (np.abs(M) > 0)
+        if bad.any() and self._no_tension is None:
+            self._no_tension = _at(0.0, s_m[np.argmax(bad)], t_s)
+        i = int(np.argmax(np.abs(tau)))
+        if self._twist is None or abs(tau[i]) > self._twist["value"]:
+            self._twist = _at(abs(tau[i]), s_m[i], t_s)
+        if self._first is None:
+            self._first = self._first_of(s_m, t_s, f, fraction, ratio, ~tension & (np.abs(M) > 0),
+                                         tau)
+
+    def _first_of(self, s_m, t_s, f, fraction, ratio, no_tension, tau):
+        """The first criterion reached at this time (smallest s; CRITERIA's order on a tie)."""
+        m = self.members
+        reached = {"slack": fraction > 0,
+                   "breaking": (f.max(axis=-1) >= m.breaking_N) if m.breaking_N is not None
+                   else np.zeros_like(fraction, dtype=bool),
+                   "moment_saturation": (ratio >= m.saturation) | no_tension,
+                   "torsional_collapse": np.abs(m.ring_twist(tau)) >= m.critical_twist()}
+        hits = [(float(s_m[np.argmax(mask)]), CRITERIA.index(kind), kind)
+                for kind, mask in reached.items() if mask.any()]
+        if not hits:
+            return None
+        s, _, kind = min(hits)
+        return {"kind": kind, "s_m": s, "t_s": None if t_s is None else float(t_s)}
+
+    def block(self) -> dict:
+        """The ``limits`` block (module docstring); None values where nothing was added."""
+        m = self.members
+        return {
+            "law": self.law,
+            "members": {"tethers": m.n, "radius_m": m.R, "lay_angle_deg": float(np.degrees(m.beta)),
+                        "tether_EA_N": m.k, "self_stress_N": m.P0},
+            "min_member_force_N": self._min,
+            "max_member_force_N": self._max,
+            "slack_fraction_max": self._slack,
+            "moment_ratio_max": self._ratio,
+            "moment_without_tension": self._no_tension,
+            "twist_per_length_max": self._twist,
+            "first_limit": self._first,
+            "criteria": self.thresholds(),
+        }
+
+
+def of_params(params) -> Tracker:
+    """A tracker of a scene's ``[section]`` members and law."""
+    section = params.model.section
+    return Tracker(section.members(params.helix), section.law)
