@@ -8,7 +8,7 @@ A solver asks the model instead of naming r, alpha, kappa or z:
 * the forms: the residual (inertia + elastic + dissipative - loads), the
   stored energy, the kinetic energy, the dissipation potential and the power
   of the non-variational terms;
-* the observables: tension and twist;
+* the observables: tension, twist, curvature and the moments;
 * the end conditions, :meth:`RodModel.end_conditions`;
 * the capabilities: :meth:`RodModel.refuse` raises the one refusal of a
   component (or of the discretisation) for a solver that cannot run it.
@@ -102,6 +102,14 @@ class RodModel(abc.ABC):
     @abc.abstractmethod
     def twist(self, fields: dict, c):
         """The total twist field (an observable)."""
+
+    @abc.abstractmethod
+    def curvature(self, fields: dict, c):
+        """The bending curvature field |kappa| (an observable, 1/L0 units)."""
+
+    @abc.abstractmethod
+    def bending_moment(self, fields: dict, c):
+        """The bending moment's magnitude (an observable, M g L0 units)."""
 
     @abc.abstractmethod
     def end_conditions(self, pin_twist: bool) -> list[EndCondition]:

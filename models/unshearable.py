@@ -124,6 +124,21 @@ class UnshearableRod(RodModel):
         return kinematics.twist(fields["centre_line"], fields["twist"], c.gamma_eps,
                                 c.gamma_coupling, k=fields["curvature"])
 
+    def curvature(self, fields: dict, c):
+        """The bending curvature |kappa| of the kinematics' bending measure: |r''| (the
+        paper's, Eq. 34) or |t'| (the extensible kinematics, per unstretched length)."""
+        r = fields["centre_line"]
+        if c.kinematics.name == "extensible":
+            k = kinematics.d(kinematics.unit_tangent(r))
+        else:
+            k = kinematics.curvature(r, fields["curvature"])
+        return ufl.sqrt(ufl.dot(k, k))
+
+    def bending_moment(self, fields: dict, c):
+        """|m| / (M g L0): the bending modulus (mu, or the EI law's) x :meth:`curvature`
+        (Eq. 17: m = EI kappa b)."""
+        return c.kinematics.bending_modulus(fields["centre_line"], c) * self.curvature(fields, c)
+
     def moment(self, fields: dict, c):
         """The torsional moment / GJ: tau, or the hysteresis component's
         rho tau + (1 - rho) z (forms/hysteresis.py)."""

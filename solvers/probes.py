@@ -15,6 +15,7 @@ from mpi4py import MPI
 import dolfinx.fem
 
 from rawehelix import compat
+from rawehelix.forms import kinematics
 from rawehelix.solvers import fields as fe_fields
 
 
@@ -64,6 +65,14 @@ class Probes:
             "twist": (compat.expression(model.twist(by_role, c), V_s),  # (34)
                       dolfinx.fem.Function(V_s)),
         }
+        # the section's state for the limits block (studies/structure_limits.py)
+        self.section_exprs = {
+            "strain": compat.expression(kinematics.stretch(r) - 1, V_s),  # eps = |r'| - 1
+            "curvature": compat.expression(model.curvature(by_role, c), V_s),
+            "bending_moment": compat.expression(model.bending_moment(by_role, c), V_s),
+            "torque": compat.expression(model.moment(by_role, c), V_s),  # / (GJ / L0)
+        }
+        self._section_u = dolfinx.fem.Function(V_s)
 
     def values(self) -> dict:
         """Normalised point values (collective; every rank gets them)."""
@@ -74,6 +83,20 @@ class Probes:
     def value(self, name: str) -> float:
         """One normalised point value (collective): the sweep reads T(0) every step."""
         return self.comm.allreduce(dolfinx.fem.assemble_scalar(self.forms[name]), op=MPI.SUM)
+
+    def section(self) -> dict | None:
+        """The section's state along s (normalised, at the Lagrange nodes of alpha's
+        space, sorted by s): s, tension, twist and :attr:`section_exprs`; rank 0 (None
+        elsewhere).  Collective."""
+        out = {}
+        exprs = dict(self.section_exprs, tension=self.field_exprs["tension"][0],
+                     twist=self.field_exprs["twist"][0])
+        for name, expr in exprs.items():
+            self._section_u.interpolate(expr)
+            s, vals = fe_fields.gather(self._section_u)
+            if s is not None:
+                out["s"], out[name] = s, vals[:, 0]
+        return out if self.comm.rank == 0 else None
 
     def fields(self) -> dict | None:
         """Normalised fields at the Lagrange nodes, sorted by s, on rank 0 (None elsewhere)."""

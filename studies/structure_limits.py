@@ -123,6 +123,17 @@ class Tracker:
         }
 
 
+def add_normalised(tracker: Tracker, q, section: dict, t=None):
+    """:meth:`Tracker.add` of a section state along s in the model's normalised units
+    (solvers/probes.py::Probes.section: s, tension, twist, strain, curvature,
+    bending_moment, torque); ``q`` the scene's Normalised, ``t`` normalised or None."""
+    L0 = q.L0
+    tracker.add(q.length_m(section["s"]), q.tension_N(section["tension"]),
+                section["bending_moment"] * q.force_scale * L0, q.torque_Nm(section["torque"]),
+                section["twist"] / L0, t_s=None if t is None else float(q.time_s(t)),
+                eps=section["strain"], kappa=section["curvature"] / L0)
+
+
 def of_params(params) -> Tracker:
     """A tracker of a scene's ``[section]`` members and law."""
     section = params.model.section
