@@ -166,7 +166,7 @@ def test_command_line(tmp_path, capsys):
                      "--elements", "2", "-o", str(tmp_path)]) == 0
     assert "apparent GJ (Eq. 65) = 140" in capsys.readouterr().out
     assert json.loads((tmp_path / "summary.json").read_text())["torque_Nm"] == [5.0, 10.0]
-    assert cli.main(["labtest", "axial", "--fit", "-o", str(tmp_path / "x")]) == 2
+    assert cli.main(["labtest", "bending", "--fit", "--EI", "5000", "-o", str(tmp_path / "x")]) == 2
     assert cli.main(["labtest", "bending", "--tension", "90,abc"]) == 2
     assert "--tension" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
