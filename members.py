@@ -53,6 +53,9 @@ GJ = N_t R^2 at the tethers' tension N_t: the torsional stiffness of Tulloch's
   for tethers of length l_t between rings of radius R at spacing l; the anchor
   KiteTurbineDynamics.jl uses): the transmitted torque peaks there, and the
   segment runs away past it.
+
+**The fallback** (:class:`ConeSection`, scene ``law = "saturating"``): the solid's EA
+and EI inside the cone |M| <= c R N that the members' own resultants never leave.
 """
 
 from __future__ import annotations

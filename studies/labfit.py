@@ -5,6 +5,11 @@ docs/explanation/labtest.md): per tension a 1-D root find of a constant EI
 the roots, then Gauss-Newton on (a, b) with the law in the rod.  The test itself
 (``bending_test``: solver, T_e, loads -> its reading) is the caller's
 (:mod:`rawehelix.studies.labtest`).
+
+Below it, the tensegrity's members fitted to the three tests at the section level
+(:func:`section_fit`, issue 29, docs/explanation/section.md): k from Eq. (62), the lay
+angle or the self-stress from GJ = 140 N m^2 at 200 N, the layout's EI against
+Eq. (64), and the fallback cone law (members.py::ConeSection).
 """
 
 from __future__ import annotations
@@ -151,7 +156,7 @@ def section_axial(members, tensions) -> dict:
     clamp), the apparent EA through the origin."""
     strain = [section_state(members, N=T)[0] for T in tensions]
     return {"tension_N": list(tensions), "strain": strain,
-            "apparent_EA_N": _slope(strain, tensions)}
+            "apparent_EA_N": slope(strain, tensions)}
 
 
 def section_torsion(members, tension_N: float, torques, L0: float) -> dict:
@@ -168,40 +173,36 @@ def section_torsion(members, tension_N: float, torques, L0: float) -> dict:
             for sign in (1, -1)}
     return {"tension_N": tension_N, "torque_Nm": list(torques), "reference_torque_Nm": Q_ref,
             "twist_per_length_dead_load": load, "twist_per_length_held": held,
-            "apparent_GJ_dead_load_Nm2": _slope(load, torques),
-            "apparent_GJ_held_Nm2": _slope(held, torques),
+            "apparent_GJ_dead_load_Nm2": slope(load, torques),
+            "apparent_GJ_held_Nm2": slope(held, torques),
             "tension_held_N": held_N,
             "tension_change_at_fixed_length_N": {"+50deg": rise[1], "-50deg": rise[-1]}}
 
 
-def _slope(x, y) -> float:
-    """The least-squares line through the origin, y = slope x."""
-    return float(np.dot(x, y) / np.dot(x, x))
+def slope(x, y) -> float:
+    """The least-squares line through the origin, y = slope x (the lab's formulas have
+    no intercept)."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    return float(x @ y / (x @ x))
 
 
-def section_bending(members, tensions, L0: float) -> dict:
+def section_bending(members, tensions, targets, L0: float) -> dict:
     """The members' EI = dM/d kappa at N = T_e (kappa = 0+), Eq. (63)'s reading of it
     (the tensioned cantilever, extensible kinematics) against Eq. (64), and the radius
     R' = sqrt(2 EI_int / K) at which the same tethers (K = EA - EA_b) would give the
     intrinsic EI that Eq. (64) needs at each T_e."""
     EI, apparent, intrinsic = [], [], []
     K = members.taut_moduli()["EA"] - members.EA_b
-    for T, target in zip(tensions, eq64_targets(tensions)):
+    targets = np.asarray(targets, dtype=float)
+    for T, target in zip(tensions, targets):
         eps, tau = section_state(members, N=T)
         EI.append(members.tangent(eps, 0.0, tau)["EI"])
         apparent.append(_apparent(EI[-1], T, K + members.EA_b, L0))
         intrinsic.append(_intrinsic(target, T, K + members.EA_b, L0))
     return {"tension_N": list(tensions), "members_EI_Nm2": EI, "apparent_EI_Nm2": apparent,
-            "eq64_EI_Nm2": eq64_targets(tensions).tolist(), "intrinsic_EI_Nm2": intrinsic,
-            "relative_error": (np.array(apparent) / eq64_targets(tensions) - 1).tolist(),
+            "eq64_EI_Nm2": targets.tolist(), "intrinsic_EI_Nm2": intrinsic,
+            "relative_error": (np.array(apparent) / targets - 1).tolist(),
             "radius_needed_m": [float(np.sqrt(2 * e / K)) for e in intrinsic]}
-
-
-def eq64_targets(tensions):
-    """Eq. (64) at the tensions (the labtest module's constant; imported late: labtest
-    imports this module)."""
-    from rawehelix.studies.labtest import eq64
-    return eq64(tensions)
 
 
 def _apparent(EI, T_e, EA, L0):
@@ -272,7 +273,8 @@ def fit_self_stress(members, tensions, EA_target: float, L0: float, torques,
     return fitted(brentq(misfit, 0.0, hi, xtol=1e-10 * hi))
 
 
-def cone_fit(EA: float, R: float, c: float, tensions, L0: float, loads, width: float = 0.0):
+def cone_fit(EA: float, R: float, c: float, tensions, targets, L0: float, loads,
+             width: float = 0.0):
     """The fallback (members.py::ConeSection): per T_e the intrinsic EI that Eq. (64)
     needs, its slope dM/d kappa measured on the law at N = T_e (not the input restated:
     it is the law's, at the lab's curvatures), Eq. (63)'s reading of it, the smallest
@@ -280,7 +282,7 @@ def cone_fit(EA: float, R: float, c: float, tensions, L0: float, loads, width: f
     the wall moment F tanh(lambda L0) / lambda reaches c T_e R (the cone's edge)."""
     from rawehelix.members import ConeSection
     rows = []
-    for T, target in zip(tensions, eq64_targets(tensions)):
+    for T, target in zip(tensions, targets):
         EI = _intrinsic(target, T, EA, L0)
         law = ConeSection(EA=EA, EI=EI, R=R, c=c, width=width)
         eps = T / EA
@@ -316,15 +318,15 @@ def _min_hessian(law, eps, kappa, points: int = 15) -> float:
     return float(worst)
 
 
-def section_fit(test: str, members, EA_target: float, L0: float, tensions, loads) -> dict:
+def section_fit(test: str, members, EA_target: float, L0: float, lab: dict) -> dict:
     """``labtest <test> --fit``'s members block (the module doc's section level):
     axial: k from Eq. (62); torsion: k and beta (and, at the scene's beta, P0 with bars)
     from Eq. (62) and GJ = 140 N m^2 at 200 N; bending: that layout's EI against
-    Eq. (64), the radius it would need, the verdict and the fallback cone law."""
+    Eq. (64), the radius it would need, the verdict and the fallback cone law.
+    ``lab``: the tests' inputs, {"axial": tensions, "torsion": torques, "bending":
+    tensions, "bending_loads": F_N, "eq64": Eq. (64) at the bending tensions}."""
     from dataclasses import replace
-    from rawehelix.studies.labtest import DEFAULT_TENSIONS_N
-    axial_T = DEFAULT_TENSIONS_N["axial"] if test != "axial" else tensions
-    torques = loads if test == "torsion" else DEFAULT_LOADS_TORSION
+    axial_T, torques = lab["axial"], lab["torsion"]
     base = fit_tether_EA(members, axial_T, EA_target)
     out = {"level": SECTION_LEVEL, "tethers": members.n, "radius_m": members.R,
            "EA_target_N": EA_target, "axial_tensions_N": list(axial_T),
@@ -356,15 +358,13 @@ def section_fit(test: str, members, EA_target: float, L0: float, tensions, loads
     if test == "torsion":
         return out
     layout = lay or base
-    bend = section_bending(layout, tensions, L0)
-    cone = cone_fit(EA_target, layout.R, layout.saturation, tensions, L0, loads)
+    bend = section_bending(layout, lab["bending"], lab["eq64"], L0)
+    cone = cone_fit(EA_target, layout.R, layout.saturation, lab["bending"], lab["eq64"], L0,
+                    lab["bending_loads"])
     worst = max(abs(e) for e in bend["relative_error"])
     out.update(bending=bend, cone=cone, consistent=bool(worst <= FIT_TARGET),
                verdict=_verdict(layout, bend, worst))
     return out
-
-
-DEFAULT_LOADS_TORSION = (5.0, 10.0, 15.0, 20.0, 25.0)  # M_t [N m], as labtest's torsion
 
 
 def _layout(m) -> dict:

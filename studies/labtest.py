@@ -23,7 +23,9 @@ EI (secant, from the closed-form inverse of solvers/analytic.py), the line
 through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
 small loads (the law's energy couples the axial force to kappa^2, so its
 test softens with the load: docs/explanation/labtest.md); the fit is
-:mod:`rawehelix.studies.labfit`.
+:mod:`rawehelix.studies.labfit`.  Any test with ``fit`` also fits the scene's
+``[section]`` members at the section level (``summary["section_fit"]``,
+labfit.section_fit; docs/explanation/section.md).
 
 :func:`compute` returns a :class:`LabTest`; :meth:`LabTest.write` writes
 summary.json and labtest.png.  Computing writes nothing.
@@ -89,10 +91,7 @@ def lab_parameters(helix_scene: Parameters, elements: int | None = None,
                          f"{err.value!r} {err.allowed}") from None
 
 
-def slope(x, y) -> float:
-    """The least-squares line through the origin, y = slope x."""
-    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-    return float(x @ y / (x @ x))
+slope = labfit.slope  # the least-squares line through the origin, y = slope x
 
 
 # -- the three tests on one solver ------------------------------------------------------
@@ -234,11 +233,25 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
     if fit:  # the members (issue 29), at the section level until the FE section law lands
         members = helix_scene.model.section.members(helix_scene.helix, width=0.0)
         summary["section_fit"] = labfit.section_fit(
-            test, members, helix_scene.helix.EA_N, LAB_LENGTH_M, tensions,
-            loads if test != "axial" else ())
+            test, members, helix_scene.helix.EA_N, LAB_LENGTH_M, section_lab(test, tensions, loads))
     summary["wall_s"] = time.perf_counter() - start
     log.debug("labtest %s: %.2f s", test, summary["wall_s"])
     return LabTest(params, test, rows, summary, comm.rank)
+
+
+def section_lab(test: str, tensions, loads) -> dict:
+    """The members' fit's inputs (labfit.section_fit): this test's tensions and loads,
+    the defaults for the other two."""
+    lab = {"axial": DEFAULT_TENSIONS_N["axial"], "torsion": DEFAULT_LOADS["torsion"],
+           "bending": PAPER_BENDING_TENSIONS_N, "bending_loads": DEFAULT_LOADS["fit"]}
+    if test == "axial":
+        lab["axial"] = tensions
+    elif test == "torsion":
+        lab["torsion"] = loads
+    else:
+        lab.update(bending=tensions, bending_loads=loads)
+    lab["eq64"] = eq64(lab["bending"]).tolist()
+    return lab
 
 
 def _describe(params) -> str:

@@ -206,7 +206,7 @@ def test_section_fit_reproduces_eq62(table2, section):
     scene = table2.replace(section=section)
     m = scene.model.section.members(scene.helix, width=0.0)
     out = labfit.section_fit("axial", m, scene.helix.EA_N, L0,
-                             labtest.DEFAULT_TENSIONS_N["axial"], ())
+                             labtest.section_lab("axial", labtest.DEFAULT_TENSIONS_N["axial"], ()))
     assert "section" in out["level"]
     fitted = replace(m, k=out["axial"]["tether_EA_N"])
     T = np.array(labtest.DEFAULT_TENSIONS_N["axial"])
@@ -220,8 +220,9 @@ def test_section_fit_reproduces_eq62(table2, section):
 def bending_fit(table2):
     from rawehelix.studies import labfit
     m = table2.model.section.members(table2.helix, width=0.0)
-    return labfit.section_fit("bending", m, table2.helix.EA_N, L0,
-                              labtest.PAPER_BENDING_TENSIONS_N, labtest.DEFAULT_LOADS["fit"])
+    lab = labtest.section_lab("bending", labtest.PAPER_BENDING_TENSIONS_N,
+                              labtest.DEFAULT_LOADS["fit"])
+    return labfit.section_fit("bending", m, table2.helix.EA_N, L0, lab)
 
 
 def test_section_fit_reproduces_gj_at_200_N(bending_fit):
