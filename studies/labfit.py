@@ -376,9 +376,10 @@ def _verdict(layout, bend, worst) -> str:
     if worst <= FIT_TARGET:
         return "one member layout fits Eq. (62), GJ at 200 N and Eq. (64) within 1 %"
     R_need = bend["radius_needed_m"]
+    EA_R2 = layout.taut_moduli()["EA"] * layout.R**2 / 2
     return (f"no member layout fits all three: the tethers' taut EI = K R^2 / 2 <= EA R^2 / 2 "
-            f"= {max(bend['members_EI_Nm2']):.0f} N m^2 (at most, any n, beta, P0, bars on the "
-            f"axis) reads {min(bend['relative_error']) * 100:+.0f} % against Eq. (64); it would "
+            f"= {EA_R2:.0f} N m^2 (any n, beta, P0, bars on the axis; "
+            f"{max(bend['members_EI_Nm2']):.0f} under the tension) reads {min(bend['relative_error']) * 100:+.0f} % against Eq. (64); it would "
             f"need R = {R_need[0]:.2f}-{R_need[-1]:.2f} m ({R_need[0] / layout.R:.1f}-"
             f"{R_need[-1] / layout.R:.1f} x {layout.R:g} m) and an EI rising with T_e, which "
             f"the members' taut EI does not: the assumption that fails is that the bending "
