@@ -53,6 +53,9 @@ GJ = N_t R^2 at the tethers' tension N_t: the torsional stiffness of Tulloch's
   for tethers of length l_t between rings of radius R at spacing l; the anchor
   KiteTurbineDynamics.jl uses): the transmitted torque peaks there, and the
   segment runs away past it.
+
+**The fallback** (:class:`ConeSection`, scene ``law = "saturating"``): the solid's EA
+and EI inside the cone |M| <= c R N that the members' own resultants never leave.
 """
 
 from __future__ import annotations
@@ -250,3 +253,65 @@ def phase_spread(members: Members, eps: float, kappa: float, tau: float = 0.0,
         out["M"].append(float((f * a / l * (-members.R * np.cos(members.phi + psi))).sum()))
         out["f_min"].append(float(f.min()))
     return {k: (min(v), max(v)) for k, v in out.items()}
+
+
+@dataclass(frozen=True)
+class ConeSection:
+    """The fallback law of issue 29 (scene ``law = "saturating"``): the solid's EA and
+    EI inside the cone |M| <= c R N, N >= 0 of a tension-only section (c, R from the
+    members: :attr:`Members.saturation`, whose own (N, M) lie in that cone).
+
+    W(eps, kappa) is the conjugate of the complementary energy N^2/(2 EA) + M^2/(2 EI)
+    restricted to the cone, hence convex; with x = eps + c R |kappa| (the outermost
+    member's strain) and v = eps - EI |kappa| / (c R EA) (v >= 0: inside the cone),
+    D = 1/EA + c^2 R^2/EI and S = EI + c^2 R^2 EA, it is
+
+        W = x^2 / (2 D) + (c R EA)^2 v^2 / (2 S)      where v >= 0 (= EA eps^2/2 + EI kappa^2/2),
+        W = x^2 / (2 D)                               where v < 0 < x (M = c R N: saturated),
+        W = 0                                         where x <= 0 (all slack),
+
+    i.e. W = Phi_0(x) / D + (c R EA)^2 Phi_0(v) / S with Phi_0(e) = max(e, 0)^2 / 2.  The
+    regularised law takes Phi_w (:func:`ramp_energy`, the members' slack width w, both
+    arguments strains): at kappa = 0 the two |kappa| terms' slopes cancel exactly
+    (1/D = EA EI / S), so W_w is smooth there; W_w -> W as w -> 0."""
+
+    EA: float  # [N]
+    EI: float  # [N m^2]
+    R: float  # the members' radius [m]
+    c: float = 1.0  # the tension-limited moment is c N R [-]
+    width: float = 0.0  # w, the regularisation width (a strain) [-]
+
+    def __post_init__(self):
+        for name in ("EA", "EI", "R", "c"):
+            if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
+                raise ValueError(f"ConeSection.{name} = {getattr(self, name)!r}: must be > 0")
+        if self.width < 0:
+            raise ValueError(f"ConeSection.width = {self.width!r}: must be >= 0")
+
+    @property
+    def _DS(self):
+        cR = self.c * self.R
+        return 1 / self.EA + cR * cR / self.EI, self.EI + cR * cR * self.EA
+
+    def _xv(self, eps, kappa):
+        eps, kappa = np.asarray(eps, dtype=float), np.abs(np.asarray(kappa, dtype=float))
+        cR = self.c * self.R
+        return eps + cR * kappa, eps - self.EI * kappa / (cR * self.EA)
+
+    def energy(self, eps, kappa):
+        """W [N = J/m] per unit length (above)."""
+        D, S = self._DS
+        x, v = self._xv(eps, kappa)
+        cRA = self.c * self.R * self.EA
+        return ramp_energy(x, self.width) / D + cRA * cRA * ramp_energy(v, self.width) / S
+
+    def resultants(self, eps, kappa) -> dict:
+        """N = dW/d eps [N], M = dW/d kappa [N m] (the sign of kappa)."""
+        D, S = self._DS
+        x, v = self._xv(eps, kappa)
+        cR = self.c * self.R
+        cRA = cR * self.EA
+        px, pv = smooth_ramp(x, self.width), smooth_ramp(v, self.width)
+        N = px / D + cRA * cRA * pv / S
+        M = np.sign(np.asarray(kappa, dtype=float)) * (cR * px / D - cRA * self.EI * pv / S)
+        return {"N": N, "M": M}

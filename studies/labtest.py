@@ -23,7 +23,9 @@ EI (secant, from the closed-form inverse of solvers/analytic.py), the line
 through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
 small loads (the law's energy couples the axial force to kappa^2, so its
 test softens with the load: docs/explanation/labtest.md); the fit is
-:mod:`rawehelix.studies.labfit`.
+:mod:`rawehelix.studies.labfit`.  Any test with ``fit`` also fits the scene's
+``[section]`` members at the section level (``summary["section_fit"]``,
+labfit.section_fit; docs/explanation/section.md).
 
 :func:`compute` returns a :class:`LabTest`; :meth:`LabTest.write` writes
 summary.json and labtest.png.  Computing writes nothing.
@@ -89,10 +91,7 @@ def lab_parameters(helix_scene: Parameters, elements: int | None = None,
                          f"{err.value!r} {err.allowed}") from None
 
 
-def slope(x, y) -> float:
-    """The least-squares line through the origin, y = slope x."""
-    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-    return float(x @ y / (x @ x))
+slope = labfit.slope  # the least-squares line through the origin, y = slope x
 
 
 # -- the three tests on one solver ------------------------------------------------------
@@ -186,7 +185,7 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
                          "rh.torsion_loop (studies/torsion_loop.py)")
     _check(test, tensions_N, loads, fit, rod_EI_Nm2)
     tensions = tuple(float(t) for t in (tensions_N or DEFAULT_TENSIONS_N[test]))
-    loads = tuple(float(x) for x in (loads or DEFAULT_LOADS.get("fit" if fit else test, ())))
+    loads = tuple(float(x) for x in (loads or DEFAULT_LOADS.get("fit" if fit and test == "bending" else test, ())))
     scene_law = helix_scene.helix.EI_law if rod_EI_Nm2 is None else None
     params = lab_parameters(helix_scene, elements, degree, gravity,
                             law=fit or scene_law is not None)
@@ -231,9 +230,28 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
                        tension_N=list(tensions), load_N=list(loads), rod_EI_Nm2=rod_EI,
                        apparent_EI_Nm2=apparent, eq64_EI_Nm2=eq64(tensions).tolist(),
                        closed_form_apparent_EI_Nm2=closed_form_apparent_EI(params, rod_EI, tensions))
+    if fit:  # the members (issue 29), at the section level until the FE section law lands
+        members = helix_scene.model.section.members(helix_scene.helix, width=0.0)
+        summary["section_fit"] = labfit.section_fit(
+            test, members, helix_scene.helix.EA_N, LAB_LENGTH_M, section_lab(test, tensions, loads))
     summary["wall_s"] = time.perf_counter() - start
     log.debug("labtest %s: %.2f s", test, summary["wall_s"])
     return LabTest(params, test, rows, summary, comm.rank)
+
+
+def section_lab(test: str, tensions, loads) -> dict:
+    """The members' fit's inputs (labfit.section_fit): this test's tensions and loads,
+    the defaults for the other two."""
+    lab = {"axial": DEFAULT_TENSIONS_N["axial"], "torsion": DEFAULT_LOADS["torsion"],
+           "bending": PAPER_BENDING_TENSIONS_N, "bending_loads": DEFAULT_LOADS["fit"]}
+    if test == "axial":
+        lab["axial"] = tensions
+    elif test == "torsion":
+        lab["torsion"] = loads
+    else:
+        lab.update(bending=tensions, bending_loads=loads)
+    lab["eq64"] = eq64(lab["bending"]).tolist()
+    return lab
 
 
 def _describe(params) -> str:
@@ -255,8 +273,6 @@ def closed_form_apparent_EI(params, rod_EI, tensions) -> list:
 def _check(test, tensions, loads, fit, rod_EI):
     if test not in TESTS:
         raise SceneError("labtest", test, f"must be one of {', '.join(TESTS)}")
-    if fit and test != "bending":
-        raise SceneError("labtest --fit", test, "fits the bending law: use 'labtest bending --fit'")
     if fit and rod_EI is not None:
         raise SceneError("labtest --EI", rod_EI, "cannot be given with --fit (the fit finds EI)")
     for name, values, low in (("--tension", tensions, 0.0 if test == "bending" else 1e-300),
@@ -272,7 +288,48 @@ def _check(test, tensions, loads, fit, rod_EI):
 
 
 def report(result: LabTest) -> str:
-    """The short table a user reads after a lab test."""
+    """The short table a user reads after a lab test (and the members' fit, --fit)."""
+    text = _report(result)
+    block = result.summary.get("section_fit")
+    return text if block is None else "\n".join([text, *section_report(block)])
+
+
+def section_report(b: dict) -> list:
+    """The members' fit (labfit.section_fit) in a few lines, its level first."""
+    lay = b["layout"]
+    lines = [f"members' fit at the {b['level']}",
+             f"  Eq. (62): {lay['tethers']} tethers at R = {lay['radius_m']:g} m, lay "
+             f"{lay['lay_angle_deg']:g} deg: k = {b['axial']['tether_EA_N']:.5g} N per tether "
+             f"reads EA = {b['axial']['apparent_EA_N']:.5g} N ({100 * b['axial']['relative_error']:+.3f} %)"]
+    for key in ("lay_angle_fit_held", "lay_angle_fit_dead_load", "self_stress_fit_dead_load"):
+        if key not in b:
+            continue
+        f = b[key]
+        if f is None:
+            lines.append(f"  GJ = 140 N m^2 at 200 N, {key}: no solution in range")
+            continue
+        m, rise = f["layout"], f["tension_change_at_fixed_length_N"]
+        lines.append(f"  GJ = 140 N m^2 at 200 N, {key}: lay {m['lay_angle_deg']:.3f} deg, P0 "
+                     f"{m['self_stress_N']:.4g} N, k {m['tether_EA_N']:.5g} N, bars {m['bar_EA_N']:.4g} N: "
+                     f"GJ dead load "
+                     f"{f['apparent_GJ_dead_load_Nm2']:.4g}, held {f['apparent_GJ_held_Nm2']:.4g} "
+                     f"N m^2; T change at fixed length +50 deg {rise['+50deg']:+.1f} N, -50 deg "
+                     f"{rise['-50deg']:+.1f} N")
+    if "bending" in b:
+        for T, EI, app, e64, R in zip(*(b["bending"][k] for k in (
+                "tension_N", "members_EI_Nm2", "apparent_EI_Nm2", "eq64_EI_Nm2", "radius_needed_m"))):
+            lines.append(f"  Eq. (64) at {T:g} N: members' EI {EI:.0f} reads {app:.0f} N m^2 against "
+                         f"{e64:.0f} ({100 * (app / e64 - 1):+.1f} %); needs R = {R:.3f} m")
+        c = b["cone"]
+        lines.append(f"  fallback (saturating, c = {c['c']:.3f}): reproduces Eq. (64) within "
+                     f"{100 * max(abs(e) for e in c['relative_error']):.2g} %, convex "
+                     f"{c['convex']}; moment saturates at F_N = " + ", ".join(
+                         f"{r['saturation_load_N']:.2f}" for r in c["rows"]) + " N")
+        lines.append(f"  verdict: {b['verdict']}")
+    return lines
+
+
+def _report(result: LabTest) -> str:
     s = result.summary
     head = (f"labtest {s['test']}: {s['length_m']} m segment of {s['scene']}, N = {s['elements']}, "
             f"p = {s['degree']}, gravity {'on' if s['gravity'] else 'off'}")

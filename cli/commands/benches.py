@@ -37,7 +37,8 @@ def _labtest_arguments(p):
     p.add_argument("--loads", default=None, metavar="X1,X2,...",
                    help="bending: F_N in N (default 2.5,5,7.5,10); torsion: M_t in Nm (default 5-25)")
     p.add_argument("--fit", action="store_true",
-                   help="bending: identify the intrinsic law EI = a T + b that reproduces Eq. (64)")
+                   help="bending: identify the intrinsic law EI = a T + b that reproduces Eq. (64); "
+                        "every test: fit the [section] members (section level, members.py)")
     p.add_argument("--EI", type=float, default=None, dest="rod_EI", metavar="NM2",
                    help="the rod's constant EI in N m^2 (default: Eq. (64) at each T_e for bending, "
                         "the scene's EI otherwise)")
