@@ -124,10 +124,12 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
 
 
 def rod_energy(r, c, alpha_ip, dx, dS):
-    """:func:`stored_energy` with the coefficients ``c`` (forms/coefficients.py::Coefficients):
-    the bending modulus of :func:`bending_modulus`, built from ``r`` itself, so
-    that its variation carries 1/2 mu'(eps) kappa^2."""
-    return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS, field=c.bending_law.field)
+    """The section law's stored energy, cells and nodes (``c.section``,
+    forms/section_law.py): for the solid, :func:`stored_energy` with the coefficients
+    ``c`` (forms/coefficients.py::Coefficients) and the bending modulus of
+    :func:`bending_modulus`, built from ``r`` itself, so that its variation carries
+    1/2 mu'(eps) kappa^2."""
+    return c.section.energy(r, c, alpha_ip, dx, dS)
 
 
 def variation(energy, r, v, domain):
