@@ -5,7 +5,9 @@ members (members.py; forms/ holds its UFL energy).
 its members' keys still describe the tensegrity that the ``limits`` block of every
 result measures the solid's resultants against (members.py: what a tensegrity
 would feel).  ``law = "tensegrity"`` makes the section's resultants those of the
-members.
+members, ``law = "saturating"`` the solid's EA and EI inside the cone |M| <= c N R
+(forms/section_law.py: their stored energies in the extensible rod; the twist
+keeps helix.GJ_Nm2).
 """
 
 from __future__ import annotations
@@ -126,9 +128,9 @@ def check(params) -> None:
     if section.active and (params.model.kinematics != "extensible" or disc.scheme != "fe"
                            or disc.bending != "ip"):
         raise ParameterError("section.law", section.law,
-                             "'tensegrity' needs model.kinematics = 'extensible' on the FE "
+                             f"'{section.law}' needs model.kinematics = 'extensible' on the FE "
                              "scheme with discretisation.bending = 'ip' (its forces are the "
-                             "variation of the members' energy)")
+                             "variation of the section's energy, forms/section_law.py)")
     if section.active and params.helix.EI_law is not None:
         raise ParameterError("section.law", section.law,
                              f"'{section.law}' sets EI itself: remove helix.EI_law "
