@@ -84,7 +84,7 @@ class Section:
                        width=self.slack_width if width is None else width)
 
     def describe(self) -> str:
-        return (f"section: tensegrity, {self.tethers} tethers, lay {self.lay_angle_deg:g} deg, "
+        return (f"section: {self.law}, {self.tethers} tethers, lay {self.lay_angle_deg:g} deg, "
                 f"self-stress {self.self_stress_N:g} N, slack width {self.slack_width:g}")
 
 
