@@ -10,7 +10,9 @@ sections and keeps the others' last results.
 1. The Fig. 8 sweep (0.5-15 Hz, 30 points): FE at the converged resolution
    against the spline reference at N = 2 (the paper's method), same points,
    same session, each the whole ``rawehelix sweep`` command.
-2. Cost of one time step against N (10 to 10^4) and the fitted exponent.
+2. Cost of one time step against N (10 to 10^4) and the fitted exponent;
+   ``section_law``: the same with the section laws against the solid (extensible
+   kinematics both), ratios of medians at N = 100 and 1000 (issue 29).
 3. The same FE sweep on 2 MPI ranks against 1 (mpirun, same command).
 4. The modal solve (20 eigenpairs) at N = 2000, p = 3.
 5. Real-time factor of the Sec. 5.2 and 5.3 scenes at converged resolution.
@@ -121,9 +123,10 @@ def bench_sweep(f1: list[float], repeats: int):
     return out
 
 
-def newton_iteration_cost(N: int, repeats: int) -> float:
+def newton_iteration_cost(N: int, repeats: int, **changes) -> float:
     """One Newton iteration of a time step (residual, Jacobian, LU solve with the
-    solvers' own choice, ``lu_options``) at the chord state; a step costs ~1-2 of these."""
+    solvers' own choice, ``lu_options``) at the chord state; a step costs ~1-2 of these.
+    ``changes``: Parameters.replace's sections (a variant of the scene)."""
     from mpi4py import MPI
     from rawehelix import compat
     from rawehelix.solvers.discrete import RodDiscretisation
@@ -131,6 +134,8 @@ def newton_iteration_cost(N: int, repeats: int) -> float:
     from rawehelix.solvers.ts_forms import SecondOrder
     from rawehelix.studies import scene
     params = scene.load("nominal_operation", elements=N, degree=3)
+    if changes:
+        params = params.replace(**changes)
     rod = RodDiscretisation(params, MPI.COMM_SELF, pin_twist=False)
     rod.set_chord()
     form = SecondOrder(rod, rod.bcs[:2])
@@ -157,6 +162,24 @@ def bench_step_cost(repeats: int, ladder):
     big = Ns >= 100
     slope = float(np.polyfit(np.log(Ns[big]), np.log(t[big]), 1)[0])
     return {"per_N": {str(N): rows[N] for N in ladder}, "fitted_exponent_N>=100": slope}
+
+
+SECTION_LAW_N = (100, 1000)  # the section laws' step cost at these N
+
+
+def bench_section_law(repeats: int, ladder=SECTION_LAW_N):
+    """Issue 29: one Newton iteration of a time step (:func:`newton_iteration_cost`)
+    with each section law against the solid, extensible kinematics both, same scene
+    and N, as ratios of medians (target: tensegrity / solid <= 1.5)."""
+    extensible = {"kinematics": "extensible"}
+    out = {}
+    for N in ladder:
+        row = {"solid": newton_iteration_cost(N, repeats, model=extensible)}
+        for law in ("tensegrity", "saturating"):
+            row[law] = newton_iteration_cost(N, repeats, model=extensible, section={"law": law})
+            row[f"{law}_ratio"] = row[law]["median"] / row["solid"]["median"]
+        out[str(N)] = row
+    return out
 
 
 def bench_modal(repeats: int):
@@ -390,6 +413,7 @@ def bench_chord(repeats: int, sim_s: float = 1.0):
 TARGETS = {
     "sweep": "FE at converged N: as fast as or faster than the paper's N = 2 reference (ratio <= 1)",
     "step_cost": "linear in N (exponent 1)",
+    "section_law": "tensegrity / solid <= 1.5 per step (issue 29)",
     "mpi": "2 ranks: speed-up near 2 (2 cores)",
     "modal": "seconds (the paper: N = 2 only)",
     "rtf": {"sec5.2": "real-time factor >= 5 (Sec. 5.2)",
@@ -510,7 +534,7 @@ def markdown(r: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-SECTIONS = ("step_cost", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
+SECTIONS = ("step_cost", "section_law", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
             "orbits", "curve")
 
 
@@ -535,6 +559,7 @@ def main():
     only = set(args.only.split(","))
     steps = (10, 30, 100, 300, 1000, 3000, 10000)
     for name, fn in (("step_cost", lambda: bench_step_cost(repeats, steps)),
+                     ("section_law", lambda: bench_section_law(repeats)),
                      ("modal", lambda: bench_modal(repeats)),
                      ("rtf", lambda: bench_rtf(repeats)),
                      ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats)),

@@ -10,6 +10,7 @@ from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
 from rawehelix.forms.extensible import ExtensibleKinematics
 from rawehelix.forms.hysteresis import BoucWen, NoneHysteresis
 from rawehelix.forms.paper import PaperKinematics
+from rawehelix.forms import section_law
 
 #: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py)
 KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics}
@@ -53,6 +54,9 @@ class Coefficients:
     # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
     # object NoneHysteresis (no z field, the elastic moment)
     hysteresis: Any = field(default_factory=NoneHysteresis)
+    # the section law, a component (forms/section_law.py): TensegritySection,
+    # SaturatingSection, or the null object SolidSection (sigma, mu and the EI law)
+    section: Any = field(default_factory=section_law.SolidSection)
     # the ENERGY_COMPONENTS of the scene
     extra: tuple = ()
 
@@ -70,5 +74,6 @@ class Coefficients:
             damping=KelvinVoigt.from_normalised(q, make),
             bending_law=TensionDependentBending.from_normalised(q, make),
             hysteresis=BoucWen.from_normalised(q, make),
+            section=section_law.from_normalised(q, make),
             extra=tuple(cls.from_normalised(q, make) for cls in ENERGY_COMPONENTS),
         )

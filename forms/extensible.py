@@ -76,6 +76,11 @@ kinematics (parameters/eilaw.py::check): its forces are not the variation of an 
 (the -mu kappa^2 r' of Eq. 32) and its bending acts on axial motion, so
 "the consistent axial term" has no meaning there.
 
+The section law (``[section] law``, ``c.section``, forms/section_law.py) owns the
+cell and node energies: the solid (the default) is U above with the EI law; the
+tensegrity's members and the saturating cone replace sigma/2 eps^2 + mu/2 |t'|^2 by
+their W(eps, |t'|) and the node terms by -{{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2.
+
 The residual is the Gateaux derivative d/de U(r + e v) at e = 0, taken by UFL
 (:func:`variation`), so it is the exact variation of U on the discrete space
 and its Jacobian (ufl.derivative of the residual, as everywhere) the exact
@@ -124,10 +129,12 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
 
 
 def rod_energy(r, c, alpha_ip, dx, dS):
-    """:func:`stored_energy` with the coefficients ``c`` (forms/coefficients.py::Coefficients):
-    the bending modulus of :func:`bending_modulus`, built from ``r`` itself, so
-    that its variation carries 1/2 mu'(eps) kappa^2."""
-    return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS, field=c.bending_law.field)
+    """The section law's stored energy, cells and nodes (``c.section``,
+    forms/section_law.py): for the solid, :func:`stored_energy` with the coefficients
+    ``c`` (forms/coefficients.py::Coefficients) and the bending modulus of
+    :func:`bending_modulus`, built from ``r`` itself, so that its variation carries
+    1/2 mu'(eps) kappa^2."""
+    return c.section.energy(r, c, alpha_ip, dx, dS)
 
 
 def variation(energy, r, v, domain):

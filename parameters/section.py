@@ -5,7 +5,9 @@ members (members.py; forms/ holds its UFL energy).
 its members' keys still describe the tensegrity that the ``limits`` block of every
 result measures the solid's resultants against (members.py: what a tensegrity
 would feel).  ``law = "tensegrity"`` makes the section's resultants those of the
-members.
+members, ``law = "saturating"`` the solid's EA and EI inside the cone |M| <= c N R
+(forms/section_law.py: their stored energies in the extensible rod; the twist
+keeps helix.GJ_Nm2).
 """
 
 from __future__ import annotations
@@ -82,23 +84,40 @@ class Section:
                        width=self.slack_width if width is None else width)
 
     def describe(self) -> str:
-        return (f"section: tensegrity, {self.tethers} tethers, lay {self.lay_angle_deg:g} deg, "
+        return (f"section: {self.law}, {self.tethers} tethers, lay {self.lay_angle_deg:g} deg, "
                 f"self-stress {self.self_stress_N:g} N, slack width {self.slack_width:g}")
 
 
-#: no normalised groups of its own yet (the tensegrity's forms read the members)
+#: no groups for parameters/scene.py's range check: the members' groups are 0 while the
+#: law is the solid whatever the keys say (normalise), which that check would refuse
 GROUP_KEYS: dict = {}
 
 #: where the section lives in a scene: Parameters.model.section (the file's [section])
 HOLDER, KEY, SECTION = "model", "section", Section
 
-#: its fields of Normalised, off
-NORMALISED = {"section_tensegrity": False}
+#: its fields of Normalised, off (the solid: forms/section_law.py::SolidSection).  The
+#: members normalised: R~ = R / L0, k~ = k / (M g), EA_b~ = EA_b / (M g); the
+#: prestrains e0 = P0 / k and e_b0, the lay angle [rad], the slack width w and the
+#: saturation c = max(-cos phi_m) (members.py) as they are
+NORMALISED = {"section_tensegrity": False, "section_law": "solid", "section_tethers": 0,
+              "section_radius": 0.0, "section_lay_angle": 0.0, "section_stiffness": 0.0,
+              "section_prestrain": 0.0, "section_bar_stiffness": 0.0,
+              "section_bar_prestrain": 0.0, "section_width": 0.0, "section_saturation": 0.0}
 
 
 def normalise(p, scales: dict) -> dict:
-    """Normalised's section_tensegrity."""
-    return {"section_tensegrity": p.model.section.active}
+    """Normalised's section fields: the members of :meth:`Section.members` in the
+    units of Eqs. (25)-(27) (their values when off for the solid)."""
+    section = p.model.section
+    if not section.active:
+        return {**NORMALISED}
+    m = section.members(p.helix)
+    force = scales["M"] * scales["g"]  # [N]
+    return {"section_tensegrity": True, "section_law": section.law, "section_tethers": m.n,
+            "section_radius": m.R / scales["L0"], "section_lay_angle": m.beta,
+            "section_stiffness": m.k / force, "section_prestrain": m.e0,
+            "section_bar_stiffness": m.EA_b / force, "section_bar_prestrain": m.e_b0,
+            "section_width": m.width, "section_saturation": m.saturation}
 
 
 def check(params) -> None:
@@ -109,7 +128,11 @@ def check(params) -> None:
     if section.active and (params.model.kinematics != "extensible" or disc.scheme != "fe"
                            or disc.bending != "ip"):
         raise ParameterError("section.law", section.law,
-                             "'tensegrity' needs model.kinematics = 'extensible' on the FE "
+                             f"'{section.law}' needs model.kinematics = 'extensible' on the FE "
                              "scheme with discretisation.bending = 'ip' (its forces are the "
-                             "variation of the members' energy)")
+                             "variation of the section's energy, forms/section_law.py)")
+    if section.active and params.helix.EI_law is not None:
+        raise ParameterError("section.law", section.law,
+                             f"'{section.law}' sets EI itself: remove helix.EI_law "
+                             "(one bending law at a time)")
     section.members(params.helix)  # the derived tether stiffness is positive
