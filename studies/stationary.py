@@ -69,6 +69,19 @@ def sag_m(params: Parameters, result) -> float:
     return q.L0 * sag(result.centre_line, q.top_position())
 
 
+def limits_block(params: Parameters, solver) -> dict | None:
+    """The ``limits`` block (studies/structure_limits.py) of the stationary solver's
+    state (t = None), on rank 0 (None elsewhere).  Collective."""
+    from rawehelix.solvers.probes import SectionProbe
+    from rawehelix.studies import structure_limits
+    section = SectionProbe.of_rod(solver.rod).section()
+    if section is None:
+        return None
+    tracker = structure_limits.of_params(params)
+    structure_limits.add_normalised(tracker, params.normalised(), section)
+    return tracker.block()
+
+
 def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
     allows it), compared with the shooting solution of Sys. (67) (of the extensible
@@ -85,6 +98,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     q = params.normalised()
     disc = params.discretisation
     solver, result, planar = solve(params, comm)
+    block = limits_block(params, solver)  # collective; before residual_at moves the state
     # the independent reference: Sys. (67), or the extensible elastica (with the EI law);
     # planar only: a scene off the x-z plane is reported without it
     not_applicable = shooting.not_applicable(q)
@@ -114,6 +128,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
                           "min": float(T.min()), "max": float(T.max())},
             "sag_m": sag_m(params, result),
             "shooting": "compared" if reference else f"not applicable: {not_applicable}",
+            "limits": block,
         }
         if reference:
             x_ref = q.length_m(reference.centre_line(result.s))
