@@ -114,7 +114,8 @@ class Probes:
                       dolfinx.fem.Function(V_s)),
         }
         # the section's state for the limits block (studies/structure_limits.py)
-        self.section_probe = SectionProbe(model, by_role, c, V_s, T, self.field_exprs["twist"][0])
+        self.section_probe = SectionProbe(model, by_role, c, V_s, self.field_exprs["tension"][0],
+                                          self.field_exprs["twist"][0])
 
     def values(self) -> dict:
         """Normalised point values (collective; every rank gets them)."""
