@@ -34,22 +34,27 @@ def middle_vertex(mesh) -> tuple[float, np.ndarray]:
 class SectionProbe:
     """The section's state along s for the limits block (studies/structure_limits.py):
     the one list of its fields, as UFL of a model's fields by role (models/), at the
-    Lagrange nodes of the scalar space ``V_s``.  A DynamicsSolver's :class:`Probes`
-    and the stationary solver (:meth:`of_rod`) both read it."""
+    Lagrange nodes of the scalar space ``V_s``; the fields are one vector-valued
+    expression (one interpolation and one gather per call: simulate calls it at every
+    output step).  A DynamicsSolver's :class:`Probes` and the stationary solver
+    (:meth:`of_rod`) both read it."""
 
-    def __init__(self, model, by_role: dict, c, V_s, tension=None, twist=None):
+    def __init__(self, model, by_role: dict, c, V_s):
         r = by_role["centre_line"]
-        self.comm = V_s.mesh.comm
-        expr = lambda e: compat.expression(e, V_s)  # noqa: E731
-        self.exprs = {
-            "strain": expr(kinematics.stretch(r) - 1),  # eps = |r'| - 1
-            "curvature": expr(model.curvature(by_role, c)),
-            "bending_moment": expr(model.bending_moment(by_role, c)),
-            "torque": expr(model.moment(by_role, c)),  # / (GJ / L0)
-            "tension": tension if tension is not None else expr(model.tension(by_role, c)),  # (29)
-            "twist": twist if twist is not None else expr(model.twist(by_role, c)),  # (34)
+        mesh = V_s.mesh
+        self.comm = mesh.comm
+        fields = {
+            "strain": kinematics.stretch(r) - 1,  # eps = |r'| - 1
+            "curvature": model.curvature(by_role, c),
+            "bending_moment": model.bending_moment(by_role, c),
+            "torque": model.moment(by_role, c),  # / (GJ / L0)
+            "tension": model.tension(by_role, c),  # (29)
+            "twist": model.twist(by_role, c),  # (34)
         }
-        self._u = dolfinx.fem.Function(V_s)
+        self.names = tuple(fields)
+        V = compat.vector_space(mesh, "Lagrange", V_s.ufl_element().degree(), len(fields))
+        self._expr = compat.expression(ufl.as_vector(list(fields.values())), V)
+        self._u = dolfinx.fem.Function(V)
 
     @classmethod
     def of_rod(cls, rod):
@@ -67,14 +72,12 @@ class SectionProbe:
 
     def section(self) -> dict | None:
         """The section's state along s (normalised, at the Lagrange nodes of ``V_s``,
-        sorted by s): s and :attr:`exprs`; rank 0 (None elsewhere).  Collective."""
-        out = {}
-        for name, expr in self.exprs.items():
-            self._u.interpolate(expr)
-            s, vals = fe_fields.gather(self._u)
-            if s is not None:
-                out["s"], out[name] = s, vals[:, 0]
-        return out if self.comm.rank == 0 else None
+        sorted by s): s and the fields by name; rank 0 (None elsewhere).  Collective."""
+        self._u.interpolate(self._expr)
+        s, vals = fe_fields.gather(self._u)
+        if s is None:
+            return None
+        return {"s": s, **{name: vals[:, k] for k, name in enumerate(self.names)}}
 
 
 class Probes:
@@ -114,8 +117,7 @@ class Probes:
                       dolfinx.fem.Function(V_s)),
         }
         # the section's state for the limits block (studies/structure_limits.py)
-        self.section_probe = SectionProbe(model, by_role, c, V_s, self.field_exprs["tension"][0],
-                                          self.field_exprs["twist"][0])
+        self.section_probe = SectionProbe(model, by_role, c, V_s)
 
     def values(self) -> dict:
         """Normalised point values (collective; every rank gets them)."""
