@@ -334,4 +334,5 @@ def report(result: TimeSeries) -> str:
                      f"{f['spin_rpm']['L0']:.3f} rpm (s = 0, L0/2, L0), ground torque "
                      f"{f['ground_torque_Nm']:.3f} Nm, T(0) = {f['tension_s0_N']:.2f} N"
                      + (f"; settled (2 %) at {settle:.3f} s" if settle is not None else ""))
+    lines[-1] += structure_limits.line(s.get("limits"))
     return "\n".join(lines)

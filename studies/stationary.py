@@ -13,7 +13,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import writers
+from rawehelix.studies import structure_limits, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -73,7 +73,6 @@ def limits_block(params: Parameters, solver) -> dict | None:
     """The ``limits`` block (studies/structure_limits.py) of the stationary solver's
     state (t = None), on rank 0 (None elsewhere).  Collective."""
     from rawehelix.solvers.probes import SectionProbe
-    from rawehelix.studies import structure_limits
     section = SectionProbe.of_rod(solver.rod).section()
     if section is None:
         return None
@@ -154,8 +153,10 @@ def report(result: Stationary) -> str:
             f"{s['wall_s']:.2f} s\n")
     if "shooting_tension_s0_N" not in s:
         return (head + f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N\n"
-                f"  sag {s['sag_m']:.5f} m; shooting reference {s['shooting']}")
+                f"  sag {s['sag_m']:.5f} m; shooting reference {s['shooting']}"
+                + structure_limits.line(s.get("limits")))
     return (head + f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N "
             f"(shooting T(0) = {s['shooting_tension_s0_N']:.3f} N)\n"
             f"  sag {s['sag_m']:.5f} m; FE vs shooting max |dr| = {s['shooting_max_diff_m']:.3e} m; "
-            f"FE residual at shooting = {s['residual_at_shooting']:.3e}")
+            f"FE residual at shooting = {s['residual_at_shooting']:.3e}"
+            + structure_limits.line(s.get("limits")))

@@ -160,3 +160,15 @@ def of_params(params) -> Tracker:
     """A tracker of a scene's ``[section]`` members and law."""
     section = params.model.section
     return Tracker(section.members(params.helix), section.law)
+
+
+def line(block: dict | None) -> str:
+    """The block as a report's last line ("\n  members ..."), "" without one."""
+    if not block or not block.get("min_member_force_N"):
+        return ""
+    first, ratio = block["first_limit"], block["moment_ratio_max"]
+    at = lambda x: f"s = {x['s_m']:.3f} m" + ("" if x["t_s"] is None else f", t = {x['t_s']:.4f} s")  # noqa: E731
+    return (f"\n  members ({block['law']}): force {block['min_member_force_N']['value']:.1f} .. "
+            f"{block['max_member_force_N']['value']:.1f} N; moment ratio |M|/(N R) max "
+            f"{ratio['value']:.3f} at {at(ratio)}; first limit: "
+            + (f"{first['kind']} at {at(first)}" if first else "none"))
