@@ -197,10 +197,11 @@ class _Recorder:
     def track(self, solver, t_s: float):
         """The limits block's section state at ``t_s`` (collective; rank 0 keeps it)."""
         section = solver.probes.section()
+        state = None
         if section is not None:
             state = structure_limits.si(self.q, section)
             self.tracker.add(**state, t_s=t_s)
-            self._section = (t_s, state)
+        self._section = (t_s, state)  # on every rank: frame() calls section() on all or none
 
     def frame(self, solver, t_s: float):
         f = solver.probes.fields()  # collective
