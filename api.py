@@ -58,7 +58,8 @@ def load_scene(name_or_path, elements: int | None = None, degree: int | None = N
 def stationary(scene: Parameters, comm=None):
     """The stationary state with fixed ends (Sec. 5.1), checked against the
     shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
-    with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``."""
+    with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``
+    (``summary["limits"]``: the structure's limits in that state, issue 29)."""
     _resources(scene, "stationary")
     from rawehelix.studies import stationary as study
     return study.compute(scene, _world(comm))
@@ -100,8 +101,10 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
     """The dynamics from the stationary state (Secs. 5.2, 5.3) to ``until_s``
     [s] (default ``time.until_s``): a :class:`~rawehelix.studies.simulate.TimeSeries`
     with ``t_s``, ``spin_rpm`` (n x 3: s = 0, ~L0/2, L0), ``ground_torque_Nm``,
-    ``tension_s0_N``, ``tension_s1_N``, ``lateral_mid_m``, ``final_state`` and
-    ``summary``.  ``options``: PETSc options of the integrator without the
+    ``tension_s0_N``, ``tension_s1_N``, ``lateral_mid_m``, ``final_state``,
+    ``limits_history`` (t, smallest and largest member force) and ``summary``
+    (``summary["limits"]``: the structure's limits over the run, issue 29; also in a
+    failed run's ``SimulationError.partial``).  ``options``: PETSc options of the integrator without the
     prefix, e.g. ``{"ts_type": "cn"}``."""
     _resources(scene, "simulate")
     from rawehelix.studies import simulate as study

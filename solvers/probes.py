@@ -13,9 +13,11 @@ import ufl
 from mpi4py import MPI
 
 import dolfinx.fem
+from petsc4py import PETSc
 
 from rawehelix import compat
 from rawehelix.forms import kinematics
+from rawehelix.models.unshearable import UnshearableRod
 from rawehelix.solvers import fields as fe_fields
 
 
@@ -27,6 +29,55 @@ def middle_vertex(mesh) -> tuple[float, np.ndarray]:
     s_mid = float(min(candidates, key=lambda v: abs(v - 0.5)))
     vertices = dolfinx.mesh.locate_entities(mesh, 0, lambda y: np.isclose(y[0], s_mid))
     return s_mid, vertices
+
+
+class SectionProbe:
+    """The section's state along s for the limits block (studies/structure_limits.py):
+    the one list of its fields, as UFL of a model's fields by role (models/), at the
+    Lagrange nodes of the scalar space ``V_s``; the fields are one vector-valued
+    expression (one interpolation and one gather per call: simulate calls it at every
+    output step).  A DynamicsSolver's :class:`Probes` and the stationary solver
+    (:meth:`of_rod`) both read it."""
+
+    def __init__(self, model, by_role: dict, c, V_s):
+        r = by_role["centre_line"]
+        mesh = V_s.mesh
+        self.comm = mesh.comm
+        fields = {
+            "strain": kinematics.stretch(r) - 1,  # eps = |r'| - 1
+            "curvature": model.curvature(by_role, c),
+            "bending_moment": model.bending_moment(by_role, c),
+            "torque": model.moment(by_role, c),  # / (GJ / L0)
+            "tension": model.tension(by_role, c),  # (29)
+            "twist": model.twist(by_role, c),  # (34)
+        }
+        self.names = tuple(fields)
+        V = compat.vector_space(mesh, "Lagrange", V_s.ufl_element().degree(), len(fields))
+        self._expr = compat.expression(ufl.as_vector(list(fields.values())), V)
+        self._u = dolfinx.fem.Function(V)
+
+    @classmethod
+    def of_rod(cls, rod):
+        """The probe of a stationary solver's rod (solvers/stationary.py): the full
+        rod's fields, or the planar rod's (x, z) with alpha = 0 (solvers/planar.py)."""
+        if hasattr(rod, "model"):
+            return cls(rod.model, rod.model.split(rod.w), rod.c, rod.V_a)
+        from rawehelix.solvers.planar import embed
+        mesh = rod.mesh
+        zero = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
+        by_role = {"centre_line": embed(rod.w), "twist": zero, "curvature": None,
+                   "internal_twist": None}
+        return cls(UnshearableRod(rod.params), by_role, rod.c,
+                   compat.scalar_space(mesh, "Lagrange", rod.degree))
+
+    def section(self) -> dict | None:
+        """The section's state along s (normalised, at the Lagrange nodes of ``V_s``,
+        sorted by s): s and the fields by name; rank 0 (None elsewhere).  Collective."""
+        self._u.interpolate(self._expr)
+        s, vals = fe_fields.gather(self._u)
+        if s is None:
+            return None
+        return {"s": s, **{name: vals[:, k] for k, name in enumerate(self.names)}}
 
 
 class Probes:
@@ -66,13 +117,7 @@ class Probes:
                       dolfinx.fem.Function(V_s)),
         }
         # the section's state for the limits block (studies/structure_limits.py)
-        self.section_exprs = {
-            "strain": compat.expression(kinematics.stretch(r) - 1, V_s),  # eps = |r'| - 1
-            "curvature": compat.expression(model.curvature(by_role, c), V_s),
-            "bending_moment": compat.expression(model.bending_moment(by_role, c), V_s),
-            "torque": compat.expression(model.moment(by_role, c), V_s),  # / (GJ / L0)
-        }
-        self._section_u = dolfinx.fem.Function(V_s)
+        self.section_probe = SectionProbe(model, by_role, c, V_s)
 
     def values(self) -> dict:
         """Normalised point values (collective; every rank gets them)."""
@@ -85,18 +130,8 @@ class Probes:
         return self.comm.allreduce(dolfinx.fem.assemble_scalar(self.forms[name]), op=MPI.SUM)
 
     def section(self) -> dict | None:
-        """The section's state along s (normalised, at the Lagrange nodes of alpha's
-        space, sorted by s): s, tension, twist and :attr:`section_exprs`; rank 0 (None
-        elsewhere).  Collective."""
-        out = {}
-        exprs = dict(self.section_exprs, tension=self.field_exprs["tension"][0],
-                     twist=self.field_exprs["twist"][0])
-        for name, expr in exprs.items():
-            self._section_u.interpolate(expr)
-            s, vals = fe_fields.gather(self._section_u)
-            if s is not None:
-                out["s"], out[name] = s, vals[:, 0]
-        return out if self.comm.rank == 0 else None
+        """The section's state along s (:meth:`SectionProbe.section`).  Collective."""
+        return self.section_probe.section()
 
     def fields(self) -> dict | None:
         """Normalised fields at the Lagrange nodes, sorted by s, on rank 0 (None elsewhere)."""

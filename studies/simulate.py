@@ -7,9 +7,12 @@ Computing writes nothing.  ``TimeSeries.write(outdir)`` writes:
                       tension [N] at s = 0 and L0, lateral displacement of the middle [m]
     summary.json      key figures; ``solve_s`` is the time loop, ``wall_s`` the whole job
     state.npz         the final (or last good) state (normalised, with SI scales)
-    centre_line.xdmf  (+ .h5) the moving centre line with tension, twist and spin,
+    centre_line.xdmf  (+ .h5) the moving centre line with tension, twist, spin and
+                      the members' smallest and largest force and the moment ratio,
                       every ``time.fields_every_s``
     dynamics.png      Fig. 6: spins against the target, ground torque, tensions
+    members.png       the [section] members' forces: smallest and largest against t
+                      (slack and breaking lines), the smallest over (s, t) from the frames
     helix_<t>s.png, helix.gif   pyvista pictures (if pyvista is installed)
 
 A run that fails raises :class:`SimulationError`, which carries the time
@@ -34,10 +37,15 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, metrics, schemes, writers
+from rawehelix.studies import limits, metrics, schemes, structure_limits, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
+
+#: the limits block takes every k-th output step (its ``sampled_every_s``): at every
+#: step it cost 13.5 % of a mobile_end run at N = 8, every 2nd keeps it under 10 %
+#: (docs/explanation/structure_limits.md)
+LIMITS_EVERY = 2
 
 COLUMNS = ("time_s", "spin_s0_rpm", "spin_mid_rpm", "spin_L0_rpm", "ground_torque_Nm",
            "tension_s0_N", "tension_L0_N", "lateral_mid_m")
@@ -62,6 +70,10 @@ class Frame:
     tension_N: np.ndarray
     twist_rad_per_m: np.ndarray
     spin_rpm: np.ndarray
+    # the members along s (studies/structure_limits.py::Tracker.profile)
+    member_force_min_N: np.ndarray | None = None
+    member_force_max_N: np.ndarray | None = None
+    moment_ratio: np.ndarray | None = None
 
 
 @dataclass
@@ -75,6 +87,8 @@ class TimeSeries:
     summary: dict = field(default_factory=dict)
     rank: int = 0
     _start: float = 0.0
+    #: (n, 3): t [s], the smallest and largest member force [N] at each tracked step
+    limits_history: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def t_s(self) -> np.ndarray:
@@ -126,6 +140,9 @@ class TimeSeries:
         title = self.params.title or self.params.name
         writers.dynamics_png(outdir / "dynamics.png", self.rows, self.params.controller.target_rpm,
                              title)
+        if len(self.limits_history):
+            writers.members_png(outdir / "members.png", self.limits_history, self.frames,
+                                self.summary["limits"]["criteria"]["breaking"], title)
         from rawehelix.studies import render
         if not self.frames or not render.available():
             return
@@ -143,13 +160,17 @@ class TimeSeries:
 
 
 class _Recorder:
-    """Rows at every output time, fields at every ``fields_every`` (collective)."""
+    """Rows and the limits block at every output time, fields at every
+    ``fields_every`` (collective).  ``limits_every``: the limits block takes every
+    k-th output step (1: every one)."""
 
-    def __init__(self, solver, fields_every: int):
+    def __init__(self, solver, fields_every: int, tracker, limits_every: int = 1):
         self.q = solver.q
         self.rows: list[tuple] = []
         self.frames: list[Frame] = []
         self.fields_every = max(1, fields_every)
+        self.tracker, self.limits_every = tracker, max(1, limits_every)
+        self._section = (None, None)  # (t [s], SI section state) last tracked
         self.r_mid0 = None
         top = self.q.top_position(0.0)
         self.chord = top / np.linalg.norm(top)
@@ -167,17 +188,33 @@ class _Recorder:
                float(q.torque_Nm(v["m0"])), float(q.tension_N(v["tension0"])),
                float(q.tension_N(v["tension1"])), float(q.length_m(lateral)))
         self.rows.append(row)
-        if (len(self.rows) - 1) % self.fields_every == 0:
+        k = len(self.rows) - 1
+        if k % self.limits_every == 0:
+            self.track(solver, row[0])
+        if k % self.fields_every == 0:
             self.frame(solver, row[0])
+
+    def track(self, solver, t_s: float):
+        """The limits block's section state at ``t_s`` (collective; rank 0 keeps it)."""
+        section = solver.probes.section()
+        state = None
+        if section is not None:
+            state = structure_limits.si(self.q, section)
+            self.tracker.add(**state, t_s=t_s)
+        self._section = (t_s, state)  # on every rank: frame() calls section() on all or none
 
     def frame(self, solver, t_s: float):
         f = solver.probes.fields()  # collective
+        t_last, state = self._section
+        if t_last != t_s:  # a frame off the tracked steps: its section state too
+            state = structure_limits.si(self.q, s) if (s := solver.probes.section()) else None
         if f is None or (self.frames and self.frames[-1].t_s == t_s):
             return
         q = self.q
+        state = {k: v for k, v in state.items() if k != "s_m"}
         self.frames.append(Frame(t_s, q.length_m(f["s"]), q.length_m(f["r"]), np.array(f["alpha"]),
                                  q.tension_N(f["tension"]), f["twist"] / q.L0,
-                                 q.spin_rpm(f["alpha_t"])))
+                                 q.spin_rpm(f["alpha_t"]), **self.tracker.profile(**state)))
 
 
 def _state_file(solver) -> dict | None:
@@ -217,7 +254,11 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s
     solver = DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name)
-    rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)))
+    tracker = structure_limits.of_params(params)
+    rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)),
+                    tracker=tracker, limits_every=LIMITS_EVERY)
+    if LIMITS_EVERY > 1:
+        tracker.sampled_every_s = LIMITS_EVERY * tm.output_every_s
     show = (progress if progress is not None else sys.stdout.isatty()) and comm.rank == 0
     bar = None
     if show:
@@ -233,7 +274,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     def result(complete: bool, error: str | None = None) -> TimeSeries:
         rows = np.array(rec.rows) if rec.rows else np.zeros((0, len(COLUMNS)))
         series = TimeSeries(params, rows, list(rec.frames), _state_file(solver), dict(summary),
-                            comm.rank, start)
+                            comm.rank, start, np.array(tracker.history).reshape(-1, 3))
         s = series.summary
         s.update({"complete": complete, "error": error,
                   "simulated_s": float(rows[-1, 0]) if len(rows) else 0.0,
@@ -241,7 +282,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                   "wall_s": time.perf_counter() - start,
                   "steps": solver.steps, "newton_iterations": solver.newton_iterations,
                   "settling_time_s": metrics.settling_time(rows[:, 0], rows[:, 1:4],
-                                                           params.controller.target_rpm)})
+                                                           params.controller.target_rpm),
+                  "limits": comm.bcast(tracker.block() if comm.rank == 0 else None, root=0)})
         if len(rows):
             s["final"] = {"spin_rpm": {"s0": rows[-1, 1], "mid": rows[-1, 2], "L0": rows[-1, 3]},
                           "ground_torque_Nm": rows[-1, 4], "tension_s0_N": rows[-1, 5],
@@ -293,4 +335,5 @@ def report(result: TimeSeries) -> str:
                      f"{f['spin_rpm']['L0']:.3f} rpm (s = 0, L0/2, L0), ground torque "
                      f"{f['ground_torque_Nm']:.3f} Nm, T(0) = {f['tension_s0_N']:.2f} N"
                      + (f"; settled (2 %) at {settle:.3f} s" if settle is not None else ""))
+    lines[-1] += structure_limits.line(s.get("limits"))
     return "\n".join(lines)

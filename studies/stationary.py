@@ -13,7 +13,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import writers
+from rawehelix.studies import structure_limits, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -69,6 +69,18 @@ def sag_m(params: Parameters, result) -> float:
     return q.L0 * sag(result.centre_line, q.top_position())
 
 
+def limits_block(params: Parameters, solver) -> dict | None:
+    """The ``limits`` block (studies/structure_limits.py) of the stationary solver's
+    state (t = None), on rank 0 (None elsewhere).  Collective."""
+    from rawehelix.solvers.probes import SectionProbe
+    section = SectionProbe.of_rod(solver.rod).section()
+    if section is None:
+        return None
+    tracker = structure_limits.of_params(params)
+    structure_limits.add_normalised(tracker, params.normalised(), section)
+    return tracker.block()
+
+
 def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
     allows it), compared with the shooting solution of Sys. (67) (of the extensible
@@ -85,6 +97,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     q = params.normalised()
     disc = params.discretisation
     solver, result, planar = solve(params, comm)
+    block = limits_block(params, solver)  # collective; before residual_at moves the state
     # the independent reference: Sys. (67), or the extensible elastica (with the EI law);
     # planar only: a scene off the x-z plane is reported without it
     not_applicable = shooting.not_applicable(q)
@@ -114,6 +127,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
                           "min": float(T.min()), "max": float(T.max())},
             "sag_m": sag_m(params, result),
             "shooting": "compared" if reference else f"not applicable: {not_applicable}",
+            "limits": block,
         }
         if reference:
             x_ref = q.length_m(reference.centre_line(result.s))
@@ -139,8 +153,10 @@ def report(result: Stationary) -> str:
             f"{s['wall_s']:.2f} s\n")
     if "shooting_tension_s0_N" not in s:
         return (head + f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N\n"
-                f"  sag {s['sag_m']:.5f} m; shooting reference {s['shooting']}")
+                f"  sag {s['sag_m']:.5f} m; shooting reference {s['shooting']}"
+                + structure_limits.line(s.get("limits")))
     return (head + f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N "
             f"(shooting T(0) = {s['shooting_tension_s0_N']:.3f} N)\n"
             f"  sag {s['sag_m']:.5f} m; FE vs shooting max |dr| = {s['shooting_max_diff_m']:.3e} m; "
-            f"FE residual at shooting = {s['residual_at_shooting']:.3e}")
+            f"FE residual at shooting = {s['residual_at_shooting']:.3e}"
+            + structure_limits.line(s.get("limits")))

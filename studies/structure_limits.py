@@ -41,6 +41,8 @@ class Tracker:
         self._slack = 0.0
         self._no_tension = None
         self._first = None
+        self.history: list[tuple] = []  # (t [s], min, max member force [N]) per add()
+        self.sampled_every_s = None  # set by a caller that adds every k-th output only
 
     def thresholds(self) -> dict:
         """Each criterion's threshold, None when off (members.py)."""
@@ -60,13 +62,27 @@ class Tracker:
         f = m.linear_forces(N, M, Q)
         return f, f <= 0
 
+    def moment_ratio(self, N, M):
+        """|M| / (N R) per section (0 where N <= 0) and the mask of N > 0."""
+        tension = N > 0
+        return np.where(tension, np.abs(M) / np.where(tension, N * self.members.R, 1.0), 0.0), tension
+
+    def profile(self, N, M, Q, tau, eps=None, kappa=None) -> dict:
+        """Along s, one time: ``member_force_min_N``, ``member_force_max_N`` and
+        ``moment_ratio`` per section (the fields of simulate's frames)."""
+        N, M, Q, tau = (np.asarray(x, dtype=float) for x in (N, M, Q, tau))
+        f, _ = self.forces(N, M, Q, eps, np.abs(kappa) if kappa is not None else None, tau)
+        return {"member_force_min_N": f.min(axis=-1), "member_force_max_N": f.max(axis=-1),
+                "moment_ratio": self.moment_ratio(N, M)[0]}
+
     def add(self, s_m, N, M, Q, tau, t_s=None, eps=None, kappa=None):
         """The sections at ``s_m`` (ns,) at the time ``t_s`` (None: a stationary
         state): N [N], M [N m] (magnitude), Q [N m], tau [rad/m] of shape (ns,); eps and
-        kappa [1/m] for a member law."""
+        kappa [1/m] for a member law.  Each time's smallest and largest member force
+        is kept in :attr:`history` (t, min, max)."""
         s_m, N, M, Q, tau = (np.asarray(x, dtype=float) for x in (s_m, N, M, Q, tau))
         f, slack = self.forces(N, M, Q, eps, np.abs(kappa) if kappa is not None else None, tau)
-        m = self.members
+        self.history.append((np.nan if t_s is None else float(t_s), float(f.min()), float(f.max())))
         i = int(np.argmin(f.min(axis=-1)))
         if self._min is None or f[i].min() < self._min["value"]:
             self._min = _at(f[i].min(), s_m[i], t_s)
@@ -75,8 +91,7 @@ class Tracker:
             self._max = _at(f[i].max(), s_m[i], t_s)
         fraction = slack.mean(axis=-1)
         self._slack = max(self._slack, float(fraction.max()))
-        tension = N > 0
-        ratio = np.where(tension, np.abs(M) / np.where(tension, N * m.R, 1.0), 0.0)
+        ratio, tension = self.moment_ratio(N, M)
         i = int(np.argmax(ratio))
         if self._ratio is None or ratio[i] > self._ratio["value"]:
             self._ratio = _at(ratio[i], s_m[i], t_s)
@@ -120,21 +135,40 @@ class Tracker:
             "twist_per_length_max": self._twist,
             "first_limit": self._first,
             "criteria": self.thresholds(),
+            "sampled_every_s": self.sampled_every_s,
         }
 
 
-def add_normalised(tracker: Tracker, q, section: dict, t=None):
-    """:meth:`Tracker.add` of a section state along s in the model's normalised units
-    (solvers/probes.py::Probes.section: s, tension, twist, strain, curvature,
-    bending_moment, torque); ``q`` the scene's Normalised, ``t`` normalised or None."""
+def si(q, section: dict) -> dict:
+    """A section state along s in the model's normalised units (solvers/probes.py::
+    SectionProbe.section: s, tension, twist, strain, curvature, bending_moment, torque)
+    as :meth:`Tracker.add`'s SI arguments; ``q`` the scene's Normalised."""
     L0 = q.L0
-    tracker.add(q.length_m(section["s"]), q.tension_N(section["tension"]),
-                section["bending_moment"] * q.force_scale * L0, q.torque_Nm(section["torque"]),
-                section["twist"] / L0, t_s=None if t is None else float(q.time_s(t)),
-                eps=section["strain"], kappa=section["curvature"] / L0)
+    return {"s_m": q.length_m(section["s"]), "N": q.tension_N(section["tension"]),
+            "M": section["bending_moment"] * q.force_scale * L0,
+            "Q": q.torque_Nm(section["torque"]), "tau": section["twist"] / L0,
+            "eps": section["strain"], "kappa": section["curvature"] / L0}
+
+
+def add_normalised(tracker: Tracker, q, section: dict, t=None):
+    """:meth:`Tracker.add` of a section state in normalised units (:func:`si`), ``t``
+    normalised or None."""
+    tracker.add(**si(q, section), t_s=None if t is None else float(q.time_s(t)))
 
 
 def of_params(params) -> Tracker:
     """A tracker of a scene's ``[section]`` members and law."""
     section = params.model.section
     return Tracker(section.members(params.helix), section.law)
+
+
+def line(block: dict | None) -> str:
+    """The block as a report's last line ("\n  members ..."), "" without one."""
+    if not block or not block.get("min_member_force_N"):
+        return ""
+    first, ratio = block["first_limit"], block["moment_ratio_max"]
+    at = lambda x: f"s = {x['s_m']:.3f} m" + ("" if x["t_s"] is None else f", t = {x['t_s']:.4f} s")  # noqa: E731
+    return (f"\n  members ({block['law']}): force {block['min_member_force_N']['value']:.1f} .. "
+            f"{block['max_member_force_N']['value']:.1f} N; moment ratio |M|/(N R) max "
+            f"{ratio['value']:.3f} at {at(ratio)}; first limit: "
+            + (f"{first['kind']} at {at(first)}" if first else "none"))

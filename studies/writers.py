@@ -283,16 +283,55 @@ def write_npz(path: Path, arrays: dict) -> Path:
     return _atomic(path, lambda f: np.savez(f, **arrays))
 
 
+#: the members' fields of a frame (studies/structure_limits.py::Tracker.profile)
+MEMBER_FIELDS = ("member_force_min_N", "member_force_max_N", "moment_ratio")
+
+
 def frames_xdmf(path: Path, frames) -> Path:
     """The moving centre line with its fields, one XDMF step per frame
-    (``simulate.Frame``: t_s, s_m, x_m, tension_N, twist, alpha, spin)."""
+    (``simulate.Frame``: t_s, s_m, x_m, tension_N, twist, alpha, spin and, where
+    present, :data:`MEMBER_FIELDS`)."""
     from rawehelix.studies.xdmf_series import PolylineSeries
     series = PolylineSeries(path)
     try:
         for f in frames:
-            series.write(f.t_s, f.x_m, {"s_m": f.s_m, "tension_N": f.tension_N,
-                                        "twist_rad_per_m": f.twist_rad_per_m,
-                                        "alpha_rad": f.alpha_rad, "spin_rpm": f.spin_rpm})
+            data = {"s_m": f.s_m, "tension_N": f.tension_N, "twist_rad_per_m": f.twist_rad_per_m,
+                    "alpha_rad": f.alpha_rad, "spin_rpm": f.spin_rpm}
+            data.update({k: getattr(f, k) for k in MEMBER_FIELDS if getattr(f, k) is not None})
+            series.write(f.t_s, f.x_m, data)
     finally:
         series.close()
     return Path(path)
+
+
+def members_png(path: Path, history, frames, breaking_N, title: str) -> Path:
+    """The [section] members' forces (the limits block, studies/structure_limits.py):
+    (a) the smallest and largest member force against t (``history``: rows t [s],
+    min, max [N]) with the slack line (0) and the breaking force (if set); (b) the
+    smallest member force over (s, t) from the frames (``simulate.Frame``)."""
+    plt = _pyplot()
+    history = np.asarray(history, dtype=float)
+    frames = [f for f in frames if f.member_force_min_N is not None]
+    fig, ax = plt.subplots(2, 1, figsize=(7, 7.5))
+    ax[0].plot(history[:, 0], history[:, 2], "-", label="largest member force")
+    ax[0].plot(history[:, 0], history[:, 1], "-", label="smallest member force")
+    ax[0].axhline(0.0, color="k", lw=1.5, ls="--", label="slack (0 N)")
+    if breaking_N is not None:
+        ax[0].axhline(breaking_N, color="r", lw=1.5, ls="--", label="breaking force")
+    ax[0].set_xlabel("t [s]")
+    ax[0].set_ylabel("member force [N]")
+    ax[0].legend(loc="best", fontsize=8)
+    ax[0].grid(True, alpha=0.3)
+    if len(frames) > 1:
+        t = np.array([f.t_s for f in frames])
+        f_min = np.array([f.member_force_min_N for f in frames])
+        bound = max(np.abs(f_min).max(), 1e-12)  # centred on the slack line
+        mesh = ax[1].pcolormesh(frames[0].s_m, t, f_min, shading="nearest", cmap="RdBu",
+                                vmin=-bound, vmax=bound)
+        fig.colorbar(mesh, ax=ax[1], label="smallest member force [N]")
+        ax[1].set_xlabel("s [m]")
+        ax[1].set_ylabel("t [s]")
+        ax[1].set_title("smallest member force over (s, t) (red: slack)", fontsize=10)
+    else:
+        ax[1].axis("off")
+    return _finish(fig, path, title, dpi=110)

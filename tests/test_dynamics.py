@@ -266,7 +266,9 @@ def test_outputs(nominal_run):
         assert reader.num_steps == round(30.0 / 0.5) + 1
         t, point_data, _ = reader.read_data(reader.num_steps - 1)
     assert t == pytest.approx(30.0)
-    assert set(point_data) == {"position_m", "s_m", "tension_N", "twist_rad_per_m", "alpha_rad", "spin_rpm"}
+    assert set(point_data) == {"position_m", "s_m", "tension_N", "twist_rad_per_m", "alpha_rad",
+                               "spin_rpm", "member_force_min_N", "member_force_max_N",
+                               "moment_ratio"}  # the members (issue 29)
     assert point_data["position_m"].shape == points.shape == (3 * 8 + 1, 3)
     assert np.allclose(point_data["spin_rpm"], 120.0, rtol=1e-2)
     for key in ("spin_rpm", "ground_torque_Nm", "tension_s0_N"):
