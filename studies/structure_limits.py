@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rawehelix.members import CRITERIA, Members
+from rawehelix.members import CRITERIA, ConeSection, Members
 
 
 def _at(value, s, t) -> dict:
@@ -35,8 +35,8 @@ def _at(value, s, t) -> dict:
 class Tracker:
     """The extremes of the members' state over the sections and times it is given."""
 
-    def __init__(self, members: Members, law: str = "solid"):
-        self.members, self.law = members, law
+    def __init__(self, members: Members, law: str = "solid", cone=None):
+        self.members, self.law, self.cone = members, law, cone  # cone: the saturating law's
         self._min = self._max = self._ratio = self._twist = None
         self._slack = 0.0
         self._no_tension = None
@@ -62,6 +62,18 @@ class Tracker:
         f = m.linear_forces(N, M, Q)
         return f, f <= 0
 
+    def law_resultants(self, N, M, eps, kappa, tau):
+        """(N, M) of the section law: the members' or the cone's own resultants at the
+        strains (the model's tension and bending-moment observables are the solid's,
+        sigma eps and EI kappa); the solid's given N and M otherwise."""
+        if self.law == "tensegrity":
+            r = self.members.resultants(eps, kappa, tau)
+            return r["N"], np.abs(r["M"])
+        if self.law == "saturating":
+            r = self.cone.resultants(eps, kappa)
+            return r["N"], np.abs(r["M"])
+        return N, M
+
     def moment_ratio(self, N, M):
         """|M| / (N R) per section (0 where N <= 0) and the mask of N > 0."""
         tension = N > 0
@@ -71,7 +83,9 @@ class Tracker:
         """Along s, one time: ``member_force_min_N``, ``member_force_max_N`` and
         ``moment_ratio`` per section (the fields of simulate's frames)."""
         N, M, Q, tau = (np.asarray(x, dtype=float) for x in (N, M, Q, tau))
-        f, _ = self.forces(N, M, Q, eps, np.abs(kappa) if kappa is not None else None, tau)
+        kappa = np.abs(kappa) if kappa is not None else None
+        N, M = self.law_resultants(N, M, eps, kappa, tau)
+        f, _ = self.forces(N, M, Q, eps, kappa, tau)
         return {"member_force_min_N": f.min(axis=-1), "member_force_max_N": f.max(axis=-1),
                 "moment_ratio": self.moment_ratio(N, M)[0]}
 
@@ -81,7 +95,9 @@ class Tracker:
         kappa [1/m] for a member law.  Each time's smallest and largest member force
         is kept in :attr:`history` (t, min, max)."""
         s_m, N, M, Q, tau = (np.asarray(x, dtype=float) for x in (s_m, N, M, Q, tau))
-        f, slack = self.forces(N, M, Q, eps, np.abs(kappa) if kappa is not None else None, tau)
+        kappa = np.abs(kappa) if kappa is not None else None
+        N, M = self.law_resultants(N, M, eps, kappa, tau)
+        f, slack = self.forces(N, M, Q, eps, kappa, tau)
         self.history.append((np.nan if t_s is None else float(t_s), float(f.min()), float(f.max())))
         i = int(np.argmin(f.min(axis=-1)))
         if self._min is None or f[i].min() < self._min["value"]:
@@ -158,8 +174,13 @@ def add_normalised(tracker: Tracker, q, section: dict, t=None):
 
 def of_params(params) -> Tracker:
     """A tracker of a scene's ``[section]`` members and law."""
-    section = params.model.section
-    return Tracker(section.members(params.helix), section.law)
+    section, helix = params.model.section, params.helix
+    members = section.members(helix)
+    cone = None
+    if section.law == "saturating":  # forms/section_law.py::SaturatingSection's constants
+        cone = ConeSection(EA=helix.EA_N, EI=helix.EI_Nm2, R=members.R, c=members.saturation,
+                           width=section.slack_width)
+    return Tracker(members, section.law, cone)
 
 
 def line(block: dict | None) -> str:

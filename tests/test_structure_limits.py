@@ -98,3 +98,24 @@ def test_a_member_law_reads_the_strains():
         tr.add(np.array([0.0]), np.array([0.0]), np.array([0.0]), np.zeros(1), np.zeros(1),
                t_s=0.0, eps=np.array([eps]), kappa=np.array([kappa]))
         assert tr.block()["slack_fraction_max"] == pytest.approx(slack)
+
+
+@pytest.mark.parametrize("law", ["tensegrity", "saturating"])
+def test_a_member_law_reports_its_own_moment_ratio(law):
+    """With a member law the ratio is that of the law's own resultants (not the
+    solid's EI kappa passed in): a tension-only section's (N, M) lie in the cone
+    |M| <= c N R (members.py), so the ratio stays <= c = 1 however large the
+    curvature (for the 6-ring at a fixed strain it tends to 3/4: the members at 180
+    and +-120 degrees all stretch), while the solid's moment would pass it many times."""
+    from rawehelix.members import ConeSection
+    m = ring()
+    cone = ConeSection(EA=36400.0, EI=4381.0, R=R, c=m.saturation, width=0.0)
+    tr = Tracker(m, law, cone)
+    eps = np.full(50, 0.002)
+    kappa = np.linspace(0.0, 1.0, 50)  # up to ~100 x the first slack curvature
+    huge = 4381.0 * kappa  # the solid's EI kappa, passed as M
+    tr.add(np.linspace(0, 7.9, 50), 36400.0 * eps, huge, np.zeros(50), np.zeros(50),
+           t_s=0.0, eps=eps, kappa=kappa)
+    b = tr.block()
+    assert 0.5 < b["moment_ratio_max"]["value"] <= 1.0 + 1e-9
+    assert b["slack_fraction_max"] > 0
