@@ -38,7 +38,7 @@ class Section:
     bar_EA_N: float = 0.0  # EA_b, the bars' axial stiffness, on the axis [N]; > 0 with P0 > 0
     breaking_force_N: float | None = None  # F_b, a tether's breaking force [N]; None: not set
     ring_spacing_m: float | None = None  # l, between adjacent rings (torsional collapse); None: off [m]
-    slack_width: float = 1.0e-4  # w, the strain over which a tether goes slack (regularisation) [-]
+    slack_width: float = 1.0e-5  # w, the strain over which a tether goes slack (regularisation) [-]
 
     def __post_init__(self):
         if self.law not in LAWS:
