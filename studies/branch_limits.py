@@ -113,3 +113,34 @@ def moment_ratio_panel(ax, points: list[dict], label: str = "sweep"):
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left", fontsize=8)
     return bool(have)
+
+
+class OrbitLimits:
+    """The limits of a branch's orbits: each orbit's block over one period from its
+    state (the period map's ``sections``: solvers/orbits.py::AlphaMap.sections; a
+    map without them, the spline reference, gives the absent block), computed once
+    an orbit, and the branch points' observables ``moment_ratio_max`` and
+    ``slack_fraction_max`` (problem.py's Observable, of the orbit alone)."""
+
+    def __init__(self, m, params):
+        from rawehelix.periodic_orbits.problem import Observable
+        self.m, self.params = m, params
+        self._blocks = {}  # id(orbit) -> (orbit, block): the orbit kept while cached
+        self.observables = tuple(
+            Observable(name, None, lambda o, name=name: flat(self.block(o))[name])
+            for name in ("moment_ratio_max", "slack_fraction_max"))
+
+    def block(self, orbit) -> dict:
+        """The orbit's block (t from the period's phase 0)."""
+        key = id(orbit)
+        if key not in self._blocks:
+            sections = (self.m.sections(orbit.X, orbit.f1_Hz, steps=orbit.steps)
+                        if hasattr(self.m, "sections") else None)
+            self._blocks[key] = (orbit, point_block(self.params, sections))
+        return self._blocks[key][1]
+
+    def entry(self, orbit) -> dict:
+        """The orbit's branch entry with its observables, first limit and block."""
+        block = self.block(orbit)
+        return {**orbit.entry(), **{ob.name: ob.of_orbit(orbit) for ob in self.observables},
+                "first_limit": flat(block)["first_limit"], "limits": block}
