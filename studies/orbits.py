@@ -341,6 +341,9 @@ def report(result: OrbitsResult) -> str:
     lines.append(f"  largest Floquet multiplier modulus: "
                  f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
                  f"{len(unstable)}")
+    ratio = s.get("limits", {}).get("moment_ratio_max")
+    if ratio:
+        lines.append(f"  largest |M| / (N R): {ratio['value']:.3f} at f1 = {ratio['f1_Hz']:.4f} Hz")
     for w in s["windows"]:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
