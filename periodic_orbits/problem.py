@@ -106,15 +106,24 @@ class Observable:
     ``record_from_solution``): ``of_samples`` from one period's samples
     (:meth:`PeriodicOrbitProblem.samples`, a corrected point before its
     Floquet period), ``of_orbit`` from a finished :class:`Orbit`; ``name``: its
-    key in the events reported."""
+    key in the events reported.  ``of_samples`` None: an observable of the orbit
+    alone, not of the samples (the section along s over a period, issue 29's
+    moment_ratio_max): no step guard can read it (:meth:`samples_value`)."""
 
     name: str
-    of_samples: Callable[[np.ndarray], float]
+    of_samples: Callable[[np.ndarray], float] | None
     of_orbit: Callable[[Orbit], float]
 
     def __post_init__(self):
         if not self.name:
             raise ValueError("Observable: a name is needed (the events' key)")
+
+    def samples_value(self, samples) -> float:
+        """``of_samples(samples)``; a ValueError for an observable of the orbit alone."""
+        if self.of_samples is None:
+            raise ValueError(f"Observable {self.name!r}: of a finished orbit only, not of "
+                             f"the tension samples")
+        return self.of_samples(samples)
 
 
 class PeriodicOrbitProblem(abc.ABC):

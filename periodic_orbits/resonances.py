@@ -71,7 +71,7 @@ class Peaks(StepGuard):
 
     def admit(self, prev: Orbit, orbit: Orbit | None, samples) -> float | None:
         value = (self.observable.of_orbit(orbit) if orbit is not None
-                 else self.observable.of_samples(samples))
+                 else self.observable.samples_value(samples))
         self.change = change = abs(value / self.observable.of_orbit(prev) - 1.0)
         if change > self.step:  # moved too far: a shorter step, scaled to the change
             return max(0.2, 0.8 * self.step / change)
@@ -113,7 +113,7 @@ class Peaks(StepGuard):
             if got is None:
                 break
             _, f1, _, _, samples, _ = got
-            T = float(self.observable.of_samples(samples))
+            T = float(self.observable.samples_value(samples))
             previous = best
             if T > best[1]:
                 best, located = (sv, T, f1), "refined"

@@ -52,6 +52,8 @@ class FEBackend:
         self._stationary = self.solver.state()
         self._motion = (params.ends.circle_frequency_Hz, 0.0)
         self._last = None  # (the state the last advance returned, the motion it ran)
+        #: an optional step hook with ``expect(t_out)`` (solvers/section_samples.py)
+        self.section_sampler = None
 
     def stationary(self) -> RodState:
         """The state the solver was built with: stationary, top at phase 0, at rest."""
@@ -98,9 +100,14 @@ class FEBackend:
         if restart:
             ts.restartStep()
         samples = [(t0, solver.probes.value("tension0"))]  # (above 31 Hz a step > T/64)
+        sampler = self.section_sampler
+        if sampler is not None:
+            sampler.expect(t_out)
 
         def record(s):
             samples.append((s.t, s.probes.value("tension0")))
+            if sampler is not None:
+                sampler(s)
             s.ts.setTimeStep(step)  # back to the fixed step after a cut (failed Newton)
 
         solver.advance(t1, on_step=record)

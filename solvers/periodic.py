@@ -25,6 +25,9 @@ A *backend* integrates the rod; it works in normalised units and provides
                                              (``Normalised.at_frequency``)
     backend.advance(state, t0, t1, t_out)    -> (state at t1, tension at s = 0 at t_out)
     backend.pack(state) -> dict of arrays;  backend.unpack(dict) -> state
+    backend.section_sampler (optional)       None, or solvers/section_samples.py's
+                                             SectionSampler: the section along s over
+                                             the recorded periods (PointResult.sections)
 
 Backends read and write no files: ``pack`` and ``unpack`` convert a state to
 and from plain arrays, which the caller may keep where it likes.
@@ -58,6 +61,9 @@ class PointResult:
     series_t_s: np.ndarray | None = None  # tension at s = 0 over the recorded periods
     series_tension_N: np.ndarray | None = None
     slack: bool = False  # the tension at s = 0 fell to <= 0 in a judged period
+    #: [(t, Probes.section() dict)] (normalised) over the recorded periods; None: the
+    #: backend has no section sampler (not in the entry: studies/sweep_limits.py)
+    sections: list | None = None
 
     def entry(self) -> dict:
         """The summary.json entry."""
@@ -129,6 +135,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
             state, _ = backend.advance(state, t, t + period, np.array([t + period]))
             t += period
     maxima, minima, means, history = [], [], [], []
+    sampler = getattr(backend, "section_sampler", None)
     periodic = slack = False
     for k in range(1, sweep.max_periods + 1):
         t_out = t + period * np.arange(1, n + 1) / n
@@ -141,7 +148,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         minima.append(float(np.min(tension)))
         means.append(float(np.mean(tension)))
         slack = slack or minima[-1] <= 0
-        history.append((t_out, tension))
+        history.append((t_out, tension, sampler.take() if sampler is not None else None))
         history = history[-sweep.record_periods:]
         if k >= sweep.min_periods and settled(maxima, minima, means, sweep.periodic_tolerance,
                                               sweep.record_periods):
@@ -156,5 +163,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         start="stationary" if lead_in else "continuation", slack=slack,
         period_maxima_N=[float(v) for v in q.tension_N(np.array(maxima))],
         period_minima_N=[float(v) for v in q.tension_N(np.array(minima))],
-        series_t_s=q.time_s(t_rec), series_tension_N=T_rec)
+        series_t_s=q.time_s(t_rec), series_tension_N=T_rec,
+        sections=None if sampler is None else sampler.sections(
+            [kept for h in history for kept in h[2]]))
     return result, state, t

@@ -48,7 +48,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import schemes, writers
+from rawehelix.studies import branch_limits, schemes, writers
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
@@ -88,6 +88,7 @@ class OrbitsResult:
                 "superharmonic_orders": list(self.superharmonics),
                 "branch": self.branch, "folds": self.folds, "bifurcations": self.bifurcations,
                 "peaks": self.peaks, "windows": self.windows, "junctions": self.junctions,
+                "limits": branch_limits.over_points(self.branch, order="f1 along the branch"),
                 "wall_s": self.wall_s}
 
     def write(self, outdir, sweep_dir=None) -> Path:
@@ -232,7 +233,8 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
     traced.trace(None, stop_f1, max_points=max_points, progress=each,
                  on_point=store.save if store else None)
-    entries = [o.entry() for o in traced.points]
+    limits = branch_limits.OrbitLimits(m, params)  # one period more an orbit (AlphaMap.sections)
+    entries = [limits.entry(o) for o in traced.points]
     return entries, traced.folds, traced.bifurcations, traced.peaks, about
 
 
@@ -339,6 +341,9 @@ def report(result: OrbitsResult) -> str:
     lines.append(f"  largest Floquet multiplier modulus: "
                  f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
                  f"{len(unstable)}")
+    ratio = s.get("limits", {}).get("moment_ratio_max")
+    if ratio:
+        lines.append(f"  largest |M| / (N R): {ratio['value']:.3f} at f1 = {ratio['f1_Hz']:.4f} Hz")
     for w in s["windows"]:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")

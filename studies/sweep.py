@@ -39,14 +39,19 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
+from rawehelix.solvers.section_samples import SectionSampler
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, schemes, writers
+from rawehelix.studies import branch_limits, limits, schemes, writers
 from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
 from rawehelix.studies.scene import SceneError
 
-def make_backend(params: Parameters, comm):
-    """The integrator for the scene's scheme."""
-    return schemes.of(params).forced_backend(params, comm)
+def make_backend(params: Parameters, comm, track: bool = True):
+    """The integrator for the scene's scheme; with ``track``, and a backend that has
+    the rod's fields along s (FE), it samples the section for the limits block."""
+    backend = schemes.of(params).forced_backend(params, comm)
+    if track and hasattr(backend, "section_sampler"):
+        backend.section_sampler = SectionSampler(backend.solver)
+    return backend
 
 
 def validate_frequencies(f1_Hz) -> list[float]:
@@ -63,12 +68,14 @@ def validate_frequencies(f1_Hz) -> list[float]:
     return sorted({round(f, 10) for f in values})
 
 
-def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=None) -> int:
-    """Run one rank's contiguous chunk with continuation; return the points computed."""
+def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=None,
+              track: bool = True) -> int:
+    """Run one rank's contiguous chunk with continuation; return the points computed.
+    ``track``: each point's limits block over its recorded periods (branch_limits.py)."""
     log = log or logging.getLogger("rawehelix").info
 
     def backend_factory():
-        return make_backend(params, MPI.COMM_SELF)
+        return make_backend(params, MPI.COMM_SELF, track)
 
     backend = backend or backend_factory()
     q = params.normalised()
@@ -95,11 +102,15 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
                      "tension_mean_N": None, "periods": 0, "periodic": False, "slack": None,
                      "failed": str(err), "wall_s": None, "start": "stationary" if lead_in
                      else "continuation"}
+            entry = branch_limits.with_block(entry, branch_limits.absent(branch_limits.FAILED))
             store.save(f1, {"entry": entry}, None, " failed")
             log(f"  f1 = {f1:6.2f} Hz: FAILED: {err}")
             backend, state, computed = backend_factory(), None, computed + 1
             continue
-        store.save(f1, {"entry": result.entry(), "period_maxima_N": result.period_maxima_N,
+        block = (branch_limits.point_block(params, result.sections) if track
+                 else branch_limits.absent("not recorded (tracking off)"))
+        store.save(f1, {"entry": branch_limits.with_block(result.entry(), block),
+                        "period_maxima_N": result.period_maxima_N,
                         "period_minima_N": result.period_minima_N,
                         "series_t_s": result.series_t_s, "series_tension_N": result.series_tension_N},
                    {**backend.pack(state), "t": t})
@@ -108,7 +119,9 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
             ("  SLACK (T <= 0)" if result.slack else "")
         log(f"  f1 = {f1:6.2f} Hz: T max {result.tension_max_N:8.2f} N, min "
             f"{result.tension_min_N:8.2f} N, {result.periods:3d} periods, "
-            f"{result.wall_s:6.1f} s ({result.start}){flag}")
+            f"{result.wall_s:6.1f} s ({result.start}){flag}"
+            + (f", M/(NR) max {block['moment_ratio_max']['value']:.3f}"
+               if isinstance(block.get("moment_ratio_max"), dict) else ""))
     return computed
 
 
@@ -179,7 +192,7 @@ class SweepResult:
 
 
 def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None,
-            log=None) -> SweepResult:
+            log=None, track: bool = True) -> SweepResult:
     """The periodic response at each f1 [Hz] (default: the scene's [sweep] list).
 
     ``checkpoint``: a directory that keeps finished points, so that the same
@@ -203,7 +216,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
         rank_log = (lambda m, _log=rank_log: _log(f"[rank {comm.rank}]{m}"))
     if mine:
         rank_log(f"  chunk {mine[0]:.2f}-{mine[-1]:.2f} Hz ({len(mine)} points)")
-    computed = run_chunk(params, store, mine, log=rank_log)
+    computed = run_chunk(params, store, mine, log=rank_log, track=track)
     computed = comm.allreduce(computed, op=MPI.SUM)
     records = store.all_records(comm)
     result = SweepResult(params, [], rank=comm.rank)
@@ -212,7 +225,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
         wanted = {round(f, 5) for f in frequencies}
         records = sorted((r for r in records if round(r["entry"]["f1_Hz"], 5) in wanted),
                          key=lambda r: r["entry"]["f1_Hz"])
-        points = [r["entry"] for r in records]
+        points = [branch_limits.loaded(r["entry"]) for r in records]
         result.points = points
         result.series = {r["entry"]["f1_Hz"]: (np.asarray(r["series_t_s"]),
                                                 np.asarray(r["series_tension_N"]))
@@ -226,6 +239,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
                    "not_periodic_Hz": [p["f1_Hz"] for p in points if not p["periodic"]],
                    "slack_Hz": [p["f1_Hz"] for p in points if p.get("slack")],
                    "failed_Hz": [p["f1_Hz"] for p in points if p.get("failed")],
+                   "limits": branch_limits.over_points(points),
                    "ranks": comm.size, "computed_now": computed,
                    "model": params.describe_model(),
                    "wall_s": time.perf_counter() - start}
@@ -253,7 +267,8 @@ def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz
     tmax = np.array([p["tension_max_N"] for p in points])
     tmin = np.array([p["tension_min_N"] for p in points])
     ok = np.array([p["periodic"] for p in points])
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, (ax, ax_m) = plt.subplots(2, 1, figsize=(8, 8), sharex=True,
+                                   gridspec_kw={"height_ratios": [3, 2]})
     ax.fill_between(f, tmin, tmax, color="C0", alpha=0.15, label="min-max over the last periods")
     ax.plot(f, tmax, "-", color="C0")
     ax.plot(f[ok], tmax[ok], "o", color="C0", label="T max (periodic)")
@@ -261,7 +276,6 @@ def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz
         ax.plot(f[~ok], tmax[~ok], "x", color="C3", ms=9, label="T max (not periodic: cap hit)")
     for k, f1 in enumerate(failed):
         ax.axvline(f1, color="C3", ls="--", lw=1, label="failed (see summary)" if k == 0 else None)
-    ax.set_xlabel("forcing frequency f1 [Hz]")
     ax.set_ylabel("tension at s = 0 [N]")
     ax.set_title(f"{title}: maximum tension against f1 (Fig. 8)")
     ax.grid(True, alpha=0.3)
@@ -275,6 +289,9 @@ def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz
         ins.set_xlabel("t [s]", fontsize=8)
         ins.set_ylabel("T [N]", fontsize=8)
         ins.tick_params(labelsize=7)
+    branch_limits.moment_ratio_panel(ax_m, points)
+    ax_m.set_title("the section: max |M| / (N R) over the recorded periods (limits block)",
+                   fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -288,6 +305,9 @@ def report(result: SweepResult) -> str:
              f"{s['scheme']} N = {s['elements']}, {s['ranks']} rank(s), {s['wall_s']:.1f} s"]
     if s["resonance_Hz"] is not None:
         lines.append(f"  largest T max at f1 = {s['resonance_Hz']} Hz: {s['peak_tension_N']:.1f} N")
+    ratio = s.get("limits", {}).get("moment_ratio_max")
+    if ratio:
+        lines.append(f"  largest |M| / (N R): {ratio['value']:.3f} at f1 = {ratio['f1_Hz']:g} Hz")
     for key, what in (("not_periodic_Hz", "not periodic (hit sweep.max_periods)"),
                       ("slack_Hz", "slack (T <= 0)"), ("failed_Hz", "failed (see summary.json)")):
         if s[key]:

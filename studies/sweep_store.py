@@ -148,9 +148,9 @@ class DirectoryStore:
             files[STATE] = writers.file_sha256(npz)
         writers.write_json(self.points / f"{_key(f1)}.json",
                            checkpoints.seal(record, self.fingerprint, self.options, files))
+        self.merge()  # before the log's line: a point logged is in sweep.json, if killed
         writers.append_line(self.outdir / "computed.log",
                             f"{f1} rank {MPI.COMM_WORLD.rank} pid {os.getpid()}{note}")
-        self.merge()
 
     def records(self) -> list[dict]:
         """The checked records of the finished points, by f1 (a bad one set aside)."""
