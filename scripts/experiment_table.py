@@ -10,7 +10,8 @@ or bifurcation and its kind; sweeps: the first point flagged not periodic), wher
 max first reaches three times the quasi-static value, and where the largest member
 force first reaches each breaking force of ``--breaking`` [N].  Every frequency is
 linearly interpolated between the two points that bracket it (a sweep's step, or
-the branch's), and the bracket is printed beside it; "-" where the run never gets
+the branch's), and the bracket is printed beside it (the slack, an indicator, by its
+bracket alone); "-" where the run never gets
 there, "n/r" where the run did not record the quantity.
 """
 
@@ -75,13 +76,16 @@ def stability(summary: dict, pts) -> str:
     return f"{min(bad):.2f} (not periodic)" if bad else "-"
 
 
-def fmt(x) -> str:
+def fmt(x, interpolate: bool = True) -> str:
+    """'f [a, b]' (interpolated in its bracket), or '(a, b]' for an indicator."""
     if x is None:
         return "-"
     if x == "n/r":
         return "n/r"
     f, (a, b) = x
-    return f"{f:.2f} [{a:g}, {b:g}]" if a != b else f"<= {f:g}"
+    if a == b:
+        return f"<= {f:g}"
+    return f"{f:.2f} [{a:g}, {b:g}]" if interpolate else f"({a:g}, {b:g}]"
 
 
 def column(summary: dict, breaking: list[float]) -> dict:
@@ -89,7 +93,8 @@ def column(summary: dict, breaking: list[float]) -> dict:
     T_qs = pts[0]["tension_max_N"]
     out = {"T_qs": f"{T_qs:.1f} N at {pts[0]['f1_Hz']:g} Hz",
            "rise": fmt(first_crossing(pts, lambda p: p["tension_max_N"], 1.1 * T_qs)),
-           "slack": fmt(first_crossing(pts, lambda p: limit(p, "slack_fraction_max"), 1e-12)),
+           "slack": fmt(first_crossing(pts, lambda p: limit(p, "slack_fraction_max"), 1e-12),
+                        interpolate=False),
            "stability": stability(summary, pts),
            "x3": fmt(first_crossing(pts, lambda p: p["tension_max_N"], 3 * T_qs))}
     for F in breaking:
@@ -106,7 +111,7 @@ def main(argv=None):
     breaking = [float(x) for x in args.breaking.split(",")]
     cols = {}
     for run in args.runs:
-        label, _, folder = run.partition("=")
+        label, _, folder = run.rpartition("=")
         cols[label] = column(json.loads((Path(folder) / "summary.json").read_text()), breaking)
     rows = [("quasi-static T max", "T_qs", "80 N nominal"),
             ("T max 10 % above it [Hz]", "rise", EXPERIMENT["rise"]),
