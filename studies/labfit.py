@@ -113,7 +113,7 @@ def _refine_law(solver, tensions, targets, loads, start, bending_test,
 
 SECTION_LEVEL = ("section: members.py's law at one section, the lab segment's Eq. (63) "
                  "through the tensioned cantilever's closed form (no gravity); the rod-level "
-                 "fit with the section law needs the FE section law (not yet on main)")
+                 "fit through the FE section law (forms/section_law.py) is not done yet")
 GJ_TARGET = (140.0, 200.0)  # GJ [N m^2] at T_e [N]: Sec. 4, Fig. 5
 TWIST_RAD = np.radians(50.0)  # the torsion test's largest angle, about 50 deg (Sec. 4)
 
