@@ -116,7 +116,10 @@ class UnshearableRod(RodModel):
 
     # -- observables ---------------------------------------------------------------
     def tension(self, fields: dict, c):
-        """T = sigma (|r'| - 1), Eq. (29)."""
+        """T = sigma (|r'| - 1), Eq. (29); with a member section law (forms/section_law.py)
+        its axial force N = dW/d eps (a slack tether carries nothing; sigma eps would)."""
+        if c.section.name != "solid":
+            return c.section.axial_force(fields["centre_line"], c)
         return kinematics.tension(fields["centre_line"], c.sigma)
 
     def twist(self, fields: dict, c):
