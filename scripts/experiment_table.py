@@ -6,7 +6,8 @@ summary.json of `rawehelix sweep` or `rawehelix orbits` runs of the mobile_end s
 Per run (a column): the quasi-static T max (the lowest f1's), where T max first rises
 10 % above it, where the first member slackens (the limits block's slack fraction >
 0), where the response stops being a stable periodic orbit (orbits: the first fold
-or bifurcation and its kind; sweeps: the first point flagged not periodic), where T
+or bifurcation and its kind; sweeps: the first point flagged not periodic, or the
+first fall of T max by more than JUMP between two points: the followed branch's fold), where T
 max first reaches three times the quasi-static value, and where the largest member
 force first reaches each breaking force of ``--breaking`` [N].  Every frequency is
 linearly interpolated between the two points that bracket it (a sweep's step, or
@@ -21,18 +22,27 @@ import argparse
 import json
 from pathlib import Path
 
+SETTLING = 0.5  # [N]: a not-periodic point oscillating less than this is still settling
+JUMP = 0.2  # a sweep's T max falling by more than this fraction between two points
+
 EXPERIMENT = {"rise": "3.5", "slack": "-", "stability": "irregular near 5 Hz",
               "x3": "~5 (then failure)", "breaking": "~5 (tethers ripped)"}
 
 
 def points(summary: dict) -> list[dict]:
-    """The run's points by increasing f1 (the orbits' branch up to its first fold:
-    the branch the experiment's slowly rising f1 follows)."""
+    """The run's points by increasing f1.  An orbit branch is walked from its
+    lowest-f1 end while f1 rises: the branch the experiment's slowly rising f1
+    follows, up to the fold where it turns (and the response would jump)."""
     if "branch" in summary:
-        pts = sorted(summary["branch"], key=lambda p: p["f1_Hz"])
-        folds = [f["f1_Hz"] for f in summary.get("folds", [])]
-        first = min(folds) if folds else float("inf")
-        return [p for p in pts if p["f1_Hz"] <= first + 1e-9]
+        pts = list(summary["branch"])
+        if pts[0]["f1_Hz"] > pts[-1]["f1_Hz"]:
+            pts.reverse()
+        walk = pts[:1]
+        for p in pts[1:]:
+            if p["f1_Hz"] < walk[-1]["f1_Hz"]:
+                break
+            walk.append(p)
+        return walk
     return sorted((p for p in summary["points"] if "tension_max_N" in p),
                   key=lambda p: p["f1_Hz"])
 
@@ -65,15 +75,28 @@ def limit(p, key):
 
 
 def stability(summary: dict, pts) -> str:
-    if "branch" in summary:
+    if "branch" in summary:  # the fold or bifurcation nearest where the walk turned
+        turn = pts[-1]["f1_Hz"]
         events = [(f["f1_Hz"], "fold") for f in summary.get("folds", [])]
         events += [(b["f1_Hz"], b.get("kind", "bifurcation")) for b in summary.get("bifurcations", [])]
+        events = [e for e in events if e[0] <= turn + 0.05 * turn]
         if not events:
             return "-"
-        f, kind = min(events)
+        f, kind = max(events)
         return f"{f:.2f} ({kind})"
-    bad = [p["f1_Hz"] for p in summary["points"] if not p.get("periodic", True)]
-    return f"{min(bad):.2f} (not periodic)" if bad else "-"
+    events = []
+    # not periodic after max_periods; "*": its oscillation T max - T min is below
+    # SETTLING N, a slow transient near the quasi-static state rather than a response
+    bad = [p for p in pts if not p.get("periodic", True)]
+    if bad:
+        names = ", ".join(f"{p['f1_Hz']:g}" + ("*" if p["tension_max_N"] - p["tension_min_N"]
+                                                < SETTLING else "") for p in bad)
+        events.append((bad[0]["f1_Hz"], f"not periodic at {names}"))
+    for a, b in zip(pts, pts[1:]):  # a jump down: the branch the sweep followed ended in a fold
+        if b["tension_max_N"] < (1 - JUMP) * a["tension_max_N"]:
+            events.append((b["f1_Hz"], f"({a['f1_Hz']:g}, {b['f1_Hz']:g}] (jump down: a fold)"))
+            break
+    return min(events)[1] if events else "-"
 
 
 def fmt(x, interpolate: bool = True) -> str:
@@ -102,6 +125,13 @@ def column(summary: dict, breaking: list[float]) -> dict:
     return out
 
 
+def load(folder: Path) -> dict:
+    """A run's summary.json, or an unfinished sweep's sweep.json (its points so far)."""
+    if (folder / "summary.json").exists():
+        return json.loads((folder / "summary.json").read_text())
+    return json.loads((folder / "sweep.json").read_text())
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", help="LABEL=DIR of a sweep's or orbits' output")
@@ -112,7 +142,7 @@ def main(argv=None):
     cols = {}
     for run in args.runs:
         label, _, folder = run.rpartition("=")
-        cols[label] = column(json.loads((Path(folder) / "summary.json").read_text()), breaking)
+        cols[label] = column(load(Path(folder)), breaking)
     rows = [("quasi-static T max", "T_qs", "80 N nominal"),
             ("T max 10 % above it [Hz]", "rise", EXPERIMENT["rise"]),
             ("first member slack [Hz]", "slack", EXPERIMENT["slack"]),
