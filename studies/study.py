@@ -211,15 +211,15 @@ def scatter_png(path: Path, result: StudyResult):
             if len(X):
                 order = np.argsort(X[:, j], kind="stable")
                 ax.plot(X[order, j], Y[order], "o", ms=3.5, color="C0")
-            if base and base["values"][name] is not None:
-                ax.plot(result.summary["base"][v.key], base["values"][name], "*", ms=10,
-                        color="C3", label="base point")
+            x0 = result.summary["base"][v.key]  # None: a key whose default is another's
+            if base and base["values"][name] is not None and x0 is not None:
+                ax.plot(x0, base["values"][name], "*", ms=10, color="C3", label="base point")
             ax.grid(alpha=0.3)
             if i == nq - 1:
                 ax.set_xlabel(v.key)
             if j == 0:
                 ax.set_ylabel(f"{name}")
-    if base:
+    if base and axes[0, 0].get_legend_handles_labels()[0]:
         axes[0, 0].legend(fontsize=8)
     return writers._finish(fig, path, f"{result.title}: {result.sample} design, "
                            f"{len(X)} points")
