@@ -516,6 +516,11 @@ def markdown(r: dict) -> str:
                      f"{_spread(t['rtf'], '.2f', '')} (x{v['speedup']:.2f}); T max error "
                      f"{c['tension_max_rel_error']:+.2e} (TS {t['tension_max_rel_error']:+.2e}) | "
                      f"{TARGETS['rtf']['sec5.3']} |")
+    for N, row in (r.get("section_law") or {}).items():
+        lines.append(f"| 12. section law, one Newton iteration of a step, N = {N}, extensible "
+                     f"kinematics, wall | solid {_spread(row['solid'], '.4f')}: tensegrity "
+                     f"x{row['tensegrity_ratio']:.2f}, saturating x{row['saturating_ratio']:.2f} "
+                     f"(ratios of medians) | {TARGETS['section_law']} |")
     if r.get("study"):
         lines.append(study_bench.markdown(r["study"]).replace("| ", "| 9. ", 1))
     for key, v in (r.get("orbits") or {}).items():
