@@ -311,6 +311,7 @@ class FakeResponse:
     period_minima_N: tuple = ()
     series_t_s: tuple = (0.0, 1.0)
     series_tension_N: tuple = (1.0, 2.0)
+    sections: object = None  # no fields along s: the point's limits block says so
 
     @property
     def tension_max_N(self):

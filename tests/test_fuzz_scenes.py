@@ -234,7 +234,8 @@ def check(way: str, load, changed: list[str]):
         COUNTS[way, "refused"] += 1
         return "refused"
     q = params.normalised()  # valid: the groups a solve starts from are numbers
-    numbers = {f.name: getattr(q, f.name) for f in dataclasses.fields(q)}
+    numbers = {f.name: getattr(q, f.name) for f in dataclasses.fields(q)
+               if not isinstance(getattr(q, f.name), str)}  # (section_law: a name)
     bad = {k: v for k, v in numbers.items() if not math.isfinite(v)}
     assert not bad, f"loaded with {changed}, but the normalised groups {bad} are not finite"
     assert q.L0 > 0 and q.t_scale > 0 and q.force_scale > 0 and q.sigma > 0 and q.mu > 0
