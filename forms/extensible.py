@@ -128,13 +128,14 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
     return cells + mu * (-ufl.dot(avg_dt, jump_t) + 0.5 * alpha_ip * ufl.dot(jump_t, jump_t)) * dS
 
 
-def rod_energy(r, c, alpha_ip, dx, dS):
+def rod_energy(r, c, alpha_ip, dx, dS, twist=None):
     """The section law's stored energy, cells and nodes (``c.section``,
     forms/section_law.py): for the solid, :func:`stored_energy` with the coefficients
     ``c`` (forms/coefficients.py::Coefficients) and the bending modulus of
     :func:`bending_modulus`, built from ``r`` itself, so that its variation carries
-    1/2 mu'(eps) kappa^2."""
-    return c.section.energy(r, c, alpha_ip, dx, dS)
+    1/2 mu'(eps) kappa^2.  ``twist``: tau, held fixed, for a section whose members
+    carry it (forms/section_law.py)."""
+    return c.section.energy(r, c, alpha_ip, dx, dS, tau=twist)
 
 
 def variation(energy, r, v, domain):
@@ -159,11 +160,12 @@ def twist_coupling(r, tau, beta):
     return beta * tau * ufl.cross(d(r), d(r, 2))
 
 
-def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS):
+def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS, twist=None):
     """delta U(r; v) + int beta tau (r' x r'').v': the elastic forces of the
-    centre-line equation (30) with extensible kinematics."""
+    centre-line equation (30) with extensible kinematics (``tau`` the moment / GJ,
+    ``twist`` the twist that a member section's energy reads, held fixed)."""
     def energy(x):
-        return rod_energy(x, c, alpha_ip, dx, dS)
+        return rod_energy(x, c, alpha_ip, dx, dS, twist=twist)
     return variation(energy, r, v, dx.ufl_domain()) + ufl.inner(twist_coupling(r, tau, c.beta), d(v)) * dx
 
 
@@ -173,12 +175,14 @@ class ExtensibleKinematics:
 
     name = "extensible"
 
-    def centre_line_residual(self, r, v, tau, c, degree: int, penalty, dx, dS, kappa=None, eta=None):
+    def centre_line_residual(self, r, v, tau, c, degree: int, penalty, dx, dS, kappa=None, eta=None,
+                             twist=None):
         """delta U(r; v) + the twist coupling (IP bending only: no ``kappa``)."""
-        return centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS)
+        return centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS,
+                                    twist=twist)
 
-    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None):
-        return rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS)
+    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None, twist=None):
+        return rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS, twist=twist)
 
     def non_variational_force(self, r, tau, c, kappa=None):
         """-beta tau (r' x r''): the twist coupling, the one non-variational part of F_NL."""

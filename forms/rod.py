@@ -95,17 +95,18 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     (IP bending only; the twist terms are the same)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    if z is not None:  # the moment / GJ of the hysteresis component (Fig. 5)
-        tau = c.hysteresis.moment(tau, z)
+    # the moment / GJ: tau, the members' Q / GJ (forms/section_law.py), or the
+    # hysteresis component's (Fig. 5; the two are refused together)
+    moment = c.section.twist_moment(r, tau, c) if z is None else c.hysteresis.moment(tau, z)
     # the kinematics component: the paper's F_NL (32)-(33) (forms/paper.py) or the
     # variation of the extensible rod's stored energy (forms/extensible.py)
-    F = c.kinematics.centre_line_residual(r, v, tau, c, degree, penalty, dx, dS,
-                                          kappa=kappa, eta=eta)
+    F = c.kinematics.centre_line_residual(r, v, moment, c, degree, penalty, dx, dS,
+                                          kappa=kappa, eta=eta, twist=tau)
     for comp in c.extra:  # the energy components (forms/energy_component.py): delta W(r; v)
         F += comp.residual(r, v, c, dx)
     if psi is None:  # the planar model: no twist equation
         return F
-    return (F + c.delta * tau * d(psi) * dx  # (31)
+    return (F + c.delta * moment * d(psi) * dx  # (31)
             # (38)-(39): tau(0) = m0, tau(1) = mN; x = 0 or 1 on the two ends
             - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)
 

@@ -16,10 +16,15 @@ parameters/section.py::normalise gives R~ = R / L0, k~ = k / (M g), EA_b~ = EA_b
       W = sum_m (k / cos beta) Phi_w(e_m) + EA_b / 2 (eps + e_b0)^2,
       e_m = cos(beta) sqrt((1 + eps - R kappa cos phi_m)^2 + tan(beta)^2) - 1 + e0,
 
-  at tau = 0.  **Torsion is not the members'**: the twist equation (31) keeps the
-  scene's GJ; the members' torsional part (the lay's elastic GJ, the tension's
-  geometric GJ, the bars' torque Q_b0 tau) lives in members.py for the limits and the
-  lab fits only.
+  at tau = 0 with ``[section] torsion = "helix"`` (the default): the twist equation
+  (31) keeps the scene's GJ, and the members' torsional part lives in members.py for
+  the limits and the lab fits only.  With ``torsion = "members"`` the members carry
+  the twist too: tau enters their tangential advance R tau + tan(beta), W gains the
+  bars' Q_b0 tau, the twist equation's moment / GJ is Q / GJ with Q = dW/d tau
+  (members.py::Members.resultants: the lay's elastic and the tension's geometric
+  torque) and the twisting moment's shear force of F_NL is Q (r' x r'') (Eq. 32 with
+  beta tau -> Q).  The centre line's variation holds tau fixed, as the solid's does
+  (forms/energy.py: the gamma coupling is one way).
 * :class:`SaturatingSection` (``"saturating"``, the fallback): the conjugate of the
   complementary energy N^2/(2 EA) + M^2/(2 EI) on the cone |M| <= c R N.  With
   rho = c R, A = EA, B = EI, D = 1/A + rho^2/B, g = eps + rho kappa (the cone's ray)
@@ -48,8 +53,9 @@ Node terms (the EI law's, forms/extensible.py, for a nonlinear W):
 the taut bending modulus (K R^2 / 2 of members.py's closed forms; mu for the
 saturating law): consistent because the exact solution has [[t]] = 0.
 
-The tension observable (models/unshearable.py::tension, Eq. 29) stays T = sigma eps,
-the solid's; :meth:`axial_force` gives N = dW/d eps of a law (the members' N).
+The tension observable (models/unshearable.py::tension, Eq. 29) is sigma eps for the
+solid and :meth:`axial_force`, N = dW/d eps, for a member law (a slack tether pulls
+nothing; sigma eps would).
 """
 
 from __future__ import annotations
@@ -83,12 +89,21 @@ class SolidSection:
     """The paper's section (the null object): forms/extensible.py::stored_energy."""
 
     name = "solid"
+    torsion = False
 
-    def energy(self, r, c, alpha_ip, dx, dS):
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None):
         return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS,
                              field=c.bending_law.field)
 
-    def axial_force(self, r, c):
+    def twist_moment(self, r, tau, c):
+        """The twisting moment / GJ of Eq. (31): tau."""
+        return tau
+
+    def twist_energy(self, tau, c):
+        """The twist's stored energy per length, beta/2 tau^2 (forms/energy.py)."""
+        return 0.5 * c.beta * tau**2
+
+    def axial_force(self, r, c, tau=0):
         """N = sigma eps (Eq. 29), without the EI law's 1/2 mu'(eps) kappa^2."""
         return c.sigma * strain(r)
 
@@ -99,12 +114,21 @@ class NonlinearSection:
 
     name = ""
     taut_bending = 0.0
+    torsion = False  # the members carry the twist ([section] torsion = "members")
 
-    def W(self, eps, kappa):
+    def W(self, eps, kappa, tau=0):
         raise NotImplementedError
 
-    def dW(self, eps, kappa):
+    def dW(self, eps, kappa, tau=0):
         raise NotImplementedError
+
+    def twist_moment(self, r, tau, c):
+        """The twisting moment / GJ of Eq. (31): tau (the scene's GJ)."""
+        return tau
+
+    def twist_energy(self, tau, c):
+        """beta/2 tau^2 (the scene's GJ)."""
+        return 0.5 * c.beta * tau**2
 
     @staticmethod
     def curvature(q):
@@ -116,25 +140,27 @@ class NonlinearSection:
         q = c.bending * d(unit_tangent(r))
         return strain(r), q, self.curvature(q)
 
-    def moment(self, r, c):
+    def moment(self, r, c, tau=0):
         """dW/dt' = W_kappa t' / kappa (with the bending switch)."""
         eps, q, kappa = self.strains(r, c)
-        return c.bending * self.dW(eps, kappa)[1] / kappa * q
+        return c.bending * self.dW(eps, kappa, tau)[1] / kappa * q
 
-    def axial_force(self, r, c):
+    def axial_force(self, r, c, tau=0):
         """N = dW/d eps."""
         eps, _, kappa = self.strains(r, c)
-        return self.dW(eps, kappa)[0]
+        return self.dW(eps, kappa, tau)[0]
 
-    def energy(self, r, c, alpha_ip, dx, dS):
-        """int W dx - sum {{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2."""
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None):
+        """int W dx - sum {{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2; ``tau`` the
+        twist (held fixed in the centre line's variation), read if :attr:`torsion`."""
         n = ufl.FacetNormal(dS.ufl_domain())
         eps, _, kappa = self.strains(r, c)
+        tau = tau if self.torsion and tau is not None else 0
         jump_t = jump(unit_tangent(r), n)
-        m = self.moment(r, c)
+        m = self.moment(r, c, tau)
         avg_m = 0.5 * (m("+") + m("-"))  # {{dW/dt'}}
         EI_t = c.bending * self.taut_bending
-        return (self.W(eps, kappa) * dx
+        return (self.W(eps, kappa, tau) * dx
                 + (-ufl.dot(avg_m, jump_t) + 0.5 * alpha_ip * EI_t * ufl.dot(jump_t, jump_t)) * dS)
 
 
@@ -143,38 +169,61 @@ class TensegritySection(NonlinearSection):
 
     name = "tensegrity"
 
-    def __init__(self, n: int, R, beta: float, k, e0, EA_b, e_b0, width):
+    def __init__(self, n: int, R, beta: float, k, e0, EA_b, e_b0, width, torsion: bool = False):
         self.n, self.R, self.beta, self.k, self.e0 = n, R, beta, k, e0
-        self.EA_b, self.e_b0, self.width = EA_b, e_b0, width
+        self.EA_b, self.e_b0, self.width, self.torsion = EA_b, e_b0, width, torsion
+        # the bars' torque at zero strain, -n P0 R sin(beta) (members.py::Members.Q_b0)
+        self.Q_b0 = -n * k * e0 * R * math.sin(beta)
         self.phi = [2 * math.pi * m / n for m in range(n)]
         cb, sb = math.cos(beta), math.sin(beta)
         # K R^2 / 2, K = n (k cos^3 beta + P0 cos beta sin^2 beta), P0 = k e0 (members.py)
         self.taut_bending = n * k * cb * (cb * cb + e0 * sb * sb) * R * R / 2
 
-    def _members(self, eps, kappa):
-        """[(a_m, l_m, e_m)] of members.py::Members._stretch and strains, tau = 0."""
+    def _members(self, eps, kappa, tau=0):
+        """[(a_m, b, l_m, e_m)] of members.py::Members._stretch and strains (tau = 0 unless
+        the members carry the twist)."""
         cb, tb = math.cos(self.beta), math.tan(self.beta)
+        b = self.R * tau + tb if self.torsion else tb
         out = []
         for phi in self.phi:
             a = 1 + eps - self.R * kappa * math.cos(phi)
-            l = ufl.sqrt(a * a + tb * tb) if tb != 0 else a  # a > 0: the stretch
-            out.append((a, l, cb * l - 1 + self.e0))
+            l = ufl.sqrt(a * a + b * b) if self.torsion or tb != 0 else a  # a > 0: the stretch
+            out.append((a, b, l, cb * l - 1 + self.e0))
         return out
 
-    def member_strains(self, eps, kappa):
-        return [e for _, _, e in self._members(eps, kappa)]
+    def member_strains(self, eps, kappa, tau=0):
+        return [e for *_, e in self._members(eps, kappa, tau)]
 
-    def W(self, eps, kappa):
-        tethers = sum(ramp_energy(e, self.width) for _, _, e in self._members(eps, kappa))
-        return self.k / math.cos(self.beta) * tethers + 0.5 * self.EA_b * (eps + self.e_b0)**2
+    def W(self, eps, kappa, tau=0):
+        tethers = sum(ramp_energy(e, self.width) for *_, e in self._members(eps, kappa, tau))
+        W = self.k / math.cos(self.beta) * tethers + 0.5 * self.EA_b * (eps + self.e_b0)**2
+        return W + self.Q_b0 * tau if self.torsion else W
 
-    def dW(self, eps, kappa):
-        """(N, M) of members.py::Members.resultants at tau = 0."""
+    def dW(self, eps, kappa, tau=0):
+        """(N, M) of members.py::Members.resultants."""
         N, M = self.EA_b * (eps + self.e_b0), 0
-        for phi, (a, l, e) in zip(self.phi, self._members(eps, kappa)):
+        for phi, (a, _, l, e) in zip(self.phi, self._members(eps, kappa, tau)):
             f = self.k * ramp(e, self.width) * a / l
             N, M = N + f, M - f * self.R * math.cos(phi)
         return N, M
+
+    def torque(self, eps, kappa, tau):
+        """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
+        Q = self.Q_b0
+        for a, b, l, e in self._members(eps, kappa, tau):
+            Q = Q + self.k * ramp(e, self.width) * self.R * b / l
+        return Q
+
+    def twist_moment(self, r, tau, c):
+        """The twisting moment / GJ of Eq. (31): Q / beta with the members' torque, or tau."""
+        if not self.torsion:
+            return tau
+        eps, _, kappa = self.strains(r, c)
+        return self.torque(eps, kappa, tau) / c.beta
+
+    def twist_energy(self, tau, c):
+        """beta/2 tau^2, or 0: the members' W holds the twist's energy."""
+        return 0 if self.torsion else 0.5 * c.beta * tau**2
 
 
 class SaturatingSection(NonlinearSection):
@@ -189,13 +238,13 @@ class SaturatingSection(NonlinearSection):
     def _gh(self, eps, kappa):
         return eps + self.rho * kappa, eps - self.B * kappa / (self.rho * self.A)
 
-    def W(self, eps, kappa):
+    def W(self, eps, kappa, tau=0):
         A, B, rho = self.A, self.B, self.rho
         g, h = self._gh(eps, kappa)
         return (A * B * ramp_energy(g, self.width)
                 + (rho * A)**2 * ramp_energy(h, self.width)) / (B + rho * rho * A)
 
-    def dW(self, eps, kappa):
+    def dW(self, eps, kappa, tau=0):
         A, B, rho = self.A, self.B, self.rho
         g, h = self._gh(eps, kappa)
         G, H = ramp(g, self.width), ramp(h, self.width)
@@ -211,7 +260,7 @@ def from_normalised(q, make=float):
         return TensegritySection(q.section_tethers, make(q.section_radius), q.section_lay_angle,
                                  make(q.section_stiffness), make(q.section_prestrain),
                                  make(q.section_bar_stiffness), make(q.section_bar_prestrain),
-                                 make(q.section_width))
+                                 make(q.section_width), torsion=q.section_torsion)
     if q.section_law == "saturating":
         return SaturatingSection(make(q.sigma), make(q.mu),
                                  make(q.section_saturation * q.section_radius), make(q.section_width))

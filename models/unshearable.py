@@ -119,7 +119,8 @@ class UnshearableRod(RodModel):
         """T = sigma (|r'| - 1), Eq. (29); with a member section law (forms/section_law.py)
         its axial force N = dW/d eps (a slack tether carries nothing; sigma eps would)."""
         if c.section.name != "solid":
-            return c.section.axial_force(fields["centre_line"], c)
+            tau = self.twist(fields, c) if c.section.torsion else 0
+            return c.section.axial_force(fields["centre_line"], c, tau)
         return kinematics.tension(fields["centre_line"], c.sigma)
 
     def twist(self, fields: dict, c):
@@ -143,11 +144,14 @@ class UnshearableRod(RodModel):
         return c.kinematics.bending_modulus(fields["centre_line"], c) * self.curvature(fields, c)
 
     def moment(self, fields: dict, c):
-        """The torsional moment / GJ: tau, or the hysteresis component's
+        """The torsional moment / GJ: tau, the members' Q / GJ (``[section] torsion =
+        "members"``, forms/section_law.py) or the hysteresis component's
         rho tau + (1 - rho) z (forms/hysteresis.py)."""
         tau = self.twist(fields, c)
         z = fields["internal_twist"]
-        return tau if z is None else c.hysteresis.moment(tau, z)
+        if z is not None:
+            return c.hysteresis.moment(tau, z)
+        return c.section.twist_moment(fields["centre_line"], tau, c)
 
     # -- end conditions, Eqs. (35)-(37) ---------------------------------------------
     def end_conditions(self, pin_twist: bool) -> list[EndCondition]:

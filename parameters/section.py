@@ -6,8 +6,9 @@ its members' keys still describe the tensegrity that the ``limits`` block of eve
 result measures the solid's resultants against (members.py: what a tensegrity
 would feel).  ``law = "tensegrity"`` makes the section's resultants those of the
 members, ``law = "saturating"`` the solid's EA and EI inside the cone |M| <= c N R
-(forms/section_law.py: their stored energies in the extensible rod; the twist
-keeps helix.GJ_Nm2).
+(forms/section_law.py: their stored energies in the extensible rod).  The twist keeps
+helix.GJ_Nm2 unless ``torsion = "members"``: the tensegrity's members then carry it
+too (the lay's and the tension's torque, members.py).
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 #: "saturating" is the fallback law of issue 29 (members.py::ConeSection): the solid's
 #: EA and EI inside the cone |M| <= c N R of a tension-only section, convex
 LAWS = ("solid", "tensegrity", "saturating")
+#: who carries the twist: the scene's GJ ("helix") or the members ("members", tensegrity only)
+TORSIONS = ("helix", "members")
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,7 @@ class Section:
     breaking_force_N: float | None = None  # F_b, a tether's breaking force [N]; None: not set
     ring_spacing_m: float | None = None  # l, between adjacent rings (torsional collapse); None: off [m]
     slack_width: float = 1.0e-5  # w, the strain over which a tether goes slack (regularisation) [-]
+    torsion: str = "helix"  # the twist's moment: "helix" (GJ_Nm2) or "members" (their torque)
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -46,6 +50,11 @@ class Section:
         if isinstance(self.tethers, bool) or not isinstance(self.tethers, int) or self.tethers < 3:
             raise ParameterError("section.tethers", self.tethers,
                                  "must be an integer >= 3 (a ring of tethers)")
+        if self.torsion not in TORSIONS:
+            raise ParameterError("section.torsion", self.torsion, f"must be one of {list(TORSIONS)}")
+        if self.torsion == "members" and self.law != "tensegrity":
+            raise ParameterError("section.torsion", self.torsion,
+                                 "the members carry the twist only with section.law = 'tensegrity'")
         if not (0 <= self.lay_angle_deg < 60):
             raise ParameterError("section.lay_angle_deg", self.lay_angle_deg,
                                  "must lie in [0, 60) degrees")
@@ -84,7 +93,8 @@ class Section:
                        width=self.slack_width if width is None else width)
 
     def describe(self) -> str:
-        return (f"section: {self.law}, {self.tethers} tethers, lay {self.lay_angle_deg:g} deg, "
+        return (f"section: {self.law}, torsion by the {self.torsion}, {self.tethers} tethers, "
+                f"lay {self.lay_angle_deg:g} deg, "
                 f"self-stress {self.self_stress_N:g} N, slack width {self.slack_width:g}")
 
 
@@ -102,7 +112,8 @@ HOLDER, KEY, SECTION = "model", "section", Section
 NORMALISED = {"section_tensegrity": False, "section_law": "solid", "section_tethers": 0,
               "section_radius": 0.0, "section_lay_angle": 0.0, "section_stiffness": 0.0,
               "section_prestrain": 0.0, "section_bar_stiffness": 0.0,
-              "section_bar_prestrain": 0.0, "section_width": 0.0, "section_saturation": 0.0}
+              "section_bar_prestrain": 0.0, "section_width": 0.0, "section_saturation": 0.0,
+              "section_torsion": False}
 
 
 def normalise(p, scales: dict) -> dict:
@@ -117,7 +128,8 @@ def normalise(p, scales: dict) -> dict:
             "section_radius": m.R / scales["L0"], "section_lay_angle": m.beta,
             "section_stiffness": m.k / force, "section_prestrain": m.e0,
             "section_bar_stiffness": m.EA_b / force, "section_bar_prestrain": m.e_b0,
-            "section_width": m.width, "section_saturation": m.saturation}
+            "section_width": m.width, "section_saturation": m.saturation,
+            "section_torsion": section.torsion == "members"}
 
 
 def check(params) -> None:
@@ -135,4 +147,14 @@ def check(params) -> None:
         raise ParameterError("section.law", section.law,
                              f"'{section.law}' sets EI itself: remove helix.EI_law "
                              "(one bending law at a time)")
+    if section.torsion == "members" and params.model.torsion_hysteresis.active:
+        raise ParameterError("section.torsion", section.torsion,
+                             "the members' torque and [torsion_hysteresis] are two torsion laws: "
+                             "keep one")
+    if section.torsion == "members":  # a twist stiffness at zero strain: lay or self-stress
+        m = section.members(params.helix)
+        if m.taut_moduli()["GJ"] <= 0:
+            raise ParameterError("section.torsion", section.torsion,
+                                 "the members have no torsional stiffness at zero strain "
+                                 "(lay_angle_deg = 0 and self_stress_N = 0): set one of them")
     section.members(params.helix)  # the derived tether stiffness is positive

@@ -44,6 +44,7 @@ def test_tension_orders_outputs_and_resume(tmp_path, degree, order):
     assert [r["value"] for r in again["runs"]] == [r["value"] for r in summary["runs"]]
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_time_step_ladder(tmp_path):
     """A dt ladder (fixed steps, alpha2, N = 2) next to a space ladder: the
     spin overshoot of Sec. 5.2 converges at least at second order in dt

@@ -368,7 +368,7 @@ def _convexity_ratio(m, orbit, law, EA_N) -> float:
     return max(worst)
 
 
-@pytest.mark.slow
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_the_paper_resonance_lies_where_the_identified_law_is_not_convex():
     """Why the identified law has no Fig. 8 resonance (docs/explanation/model.md): on the
     paper model's own orbit near the resonance peak (12.59 Hz, T max 562.6 N,

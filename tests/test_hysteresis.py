@@ -174,6 +174,7 @@ def test_same_torsion_loop_on_one_and_two_ranks():
     assert np.max(np.abs(loops[0] - loops[1])) < 1e-9 * np.max(np.abs(loops[0]))
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_orbit_is_the_sweeps_periodic_point_with_z_carried():
     """Fig. 8 by the orbits with the Fig. 5 law (mobile_end, N = 4, dt = 0.5 ms,
     11.5 Hz; about 12 s).  z and its alpha2 rate and acceleration are carried

@@ -80,6 +80,7 @@ def test_the_linear_monodromy_is_exact_without_forcing():
     assert 8.0 <= distance[1e-5] / distance[1e-6] <= 12.0
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_the_linear_monodromy_is_a_chord_for_the_shooting(alpha_map):
     """At the scene's R1 (N = 4) the shooting from the 2.5 Hz orbit to 2 Hz with the
     linear monodromy as its first chord (``linear``, as a natural step shoots)
@@ -178,6 +179,7 @@ def test_orbit_is_the_brute_force_periodic_response(alpha_map):
     assert np.allclose(np.sort_complex(orbit.multipliers), np.sort_complex(orbit.multipliers.conj()))
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_sweep_periodicity_test_finds_the_orbit_at_5_hz():
     """Issue 13, the sweep's periodicity test: at 5 Hz the oscillation is 0.5 %
     of T.  With the sweep's own backend, test and tolerance (the transient's
@@ -261,6 +263,7 @@ def test_stable_branch_is_the_brute_force_sweep_at_the_converged_n(converged_map
     assert abs(orbit.tension_min_N - point.tension_min_N) <= 1e-3 * oscillation
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_continuation_points_are_orbits_and_the_command_writes_the_branch(alpha_map, tmp_path):
     """A short branch (9.0 -> 9.25 Hz, N = 4): every point is a fixed point of
     the period map (direct shooting at its f1 finds the same T max to 1e-6),
@@ -324,6 +327,7 @@ def test_floquet_multipliers_are_the_modes_exponentials(dt_s):
     assert torsional_17 and torsional_17[0] <= limit
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it
 def test_the_branch_resumes_without_recomputing(tmp_path):
     """`-o DIR` stores every point as it is found: a trace stopped after 2
     points and rerun continues from the stored state, computes every point once

@@ -10,6 +10,9 @@ from rawehelix.solvers.periodic import periodic_response
 from rawehelix.references.spline_galerkin.forced import SplineBackend
 from rawehelix.references.spline_galerkin.orbits import SplineMap
 
+#: 75 s in all (a shared fixture): make test's 12-minute budget (2026-12-04); make test-long
+pytestmark = pytest.mark.long
+
 # the torque ramp (69) short, so that the brute-force run sees the orbits' steady torque
 SCENE = {"torque.rise_time_s": 0.05, "sweep.periodic_tolerance": 1e-6, "sweep.lead_in_s": 1.0}
 

@@ -40,6 +40,7 @@ def run_cli(scene_path, outdir, f1="8:10:0.5", extra=()):
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
 
+@pytest.mark.long  # make test's 12-minute budget (2026-12-04); make test-long runs it; test_faults.py's Ctrl-C resume stays
 def test_kill_and_resume_equals_uninterrupted(tmp_path, fast_scene):
     """SIGKILL mid-sweep leaves a readable results file; re-running finishes
     without recomputing finished points, and the file equals an uninterrupted run's."""

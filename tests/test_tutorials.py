@@ -37,8 +37,13 @@ def test_there_are_the_five_tutorials():
                                         "frequency_response", "parameter_study"}
 
 
-@pytest.mark.parametrize("script", [pytest.param(s, id=s.stem, marks=[pytest.mark.slow]
-                                                 if s.stem in SLOW else [])
+#: the two longest (50 and 24 s): make test's 12-minute budget (2026-12-04); make test-long
+LONG = {"frequency_response", "mobile_end"}
+
+
+@pytest.mark.parametrize("script", [pytest.param(s, id=s.stem, marks=[pytest.mark.long]
+                                                 if s.stem in LONG else
+                                                 [pytest.mark.slow] if s.stem in SLOW else [])
                                     for s in SCRIPTS])
 def test_tutorial_runs_at_small_size(script, tmp_path):
     proc = run(script, tmp_path)
