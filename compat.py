@@ -140,6 +140,13 @@ def scalar_space(mesh, family: str, degree: int):
     return dolfinx.fem.FunctionSpace(mesh, (family, degree))
 
 
+def space_degree(V) -> int:
+    """The polynomial degree of a function space's element: a method of UFL's element
+    (0.5), a property of basix.ufl's (0.9)."""
+    degree = V.ufl_element().degree
+    return degree() if callable(degree) else int(degree)
+
+
 def vector_space(mesh, family: str, degree: int, dim: int = 3):
     if NEW:
         return dolfinx.fem.functionspace(mesh, (family, degree, (dim,)))

@@ -52,7 +52,7 @@ class SectionProbe:
             "twist": model.twist(by_role, c),  # (34)
         }
         self.names = tuple(fields)
-        V = compat.vector_space(mesh, "Lagrange", V_s.ufl_element().degree(), len(fields))
+        V = compat.vector_space(mesh, "Lagrange", compat.space_degree(V_s), len(fields))
         self._expr = compat.expression(ufl.as_vector(list(fields.values())), V)
         self._u = dolfinx.fem.Function(V)
 
