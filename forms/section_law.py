@@ -85,15 +85,10 @@ def ramp_energy(e, w):
     return 0.25 * (e * e + e * root + w * w * ufl.ln(plus / w))
 
 
-class SolidSection:
-    """The paper's section (the null object): forms/extensible.py::stored_energy."""
+class HelixTorsion:
+    """The scene's GJ carries the twist (every section unless its members do)."""
 
-    name = "solid"
-    torsion = False
-
-    def energy(self, r, c, alpha_ip, dx, dS, tau=None):
-        return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS,
-                             field=c.bending_law.field)
+    torsion = False  # the members carry the twist ([section] torsion = "members")
 
     def twist_moment(self, r, tau, c):
         """The twisting moment / GJ of Eq. (31): tau."""
@@ -103,32 +98,33 @@ class SolidSection:
         """The twist's stored energy per length, beta/2 tau^2 (forms/energy.py)."""
         return 0.5 * c.beta * tau**2
 
+
+class SolidSection(HelixTorsion):
+    """The paper's section (the null object): forms/extensible.py::stored_energy."""
+
+    name = "solid"
+
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None):
+        return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS,
+                             field=c.bending_law.field)
+
     def axial_force(self, r, c, tau=0):
         """N = sigma eps (Eq. 29), without the EI law's 1/2 mu'(eps) kappa^2."""
         return c.sigma * strain(r)
 
 
-class NonlinearSection:
+class NonlinearSection(HelixTorsion):
     """A section energy W(eps, kappa) with its IP node terms (module docstring);
     subclasses give :meth:`W`, :meth:`dW` (W_eps, W_kappa) and ``taut_bending``."""
 
     name = ""
     taut_bending = 0.0
-    torsion = False  # the members carry the twist ([section] torsion = "members")
 
     def W(self, eps, kappa, tau=0):
         raise NotImplementedError
 
     def dW(self, eps, kappa, tau=0):
         raise NotImplementedError
-
-    def twist_moment(self, r, tau, c):
-        """The twisting moment / GJ of Eq. (31): tau (the scene's GJ)."""
-        return tau
-
-    def twist_energy(self, tau, c):
-        """beta/2 tau^2 (the scene's GJ)."""
-        return 0.5 * c.beta * tau**2
 
     @staticmethod
     def curvature(q):
@@ -217,13 +213,13 @@ class TensegritySection(NonlinearSection):
     def twist_moment(self, r, tau, c):
         """The twisting moment / GJ of Eq. (31): Q / beta with the members' torque, or tau."""
         if not self.torsion:
-            return tau
+            return super().twist_moment(r, tau, c)
         eps, _, kappa = self.strains(r, c)
         return self.torque(eps, kappa, tau) / c.beta
 
     def twist_energy(self, tau, c):
         """beta/2 tau^2, or 0: the members' W holds the twist's energy."""
-        return 0 if self.torsion else 0.5 * c.beta * tau**2
+        return 0 if self.torsion else super().twist_energy(tau, c)
 
 
 class SaturatingSection(NonlinearSection):

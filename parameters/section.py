@@ -151,10 +151,9 @@ def check(params) -> None:
         raise ParameterError("section.torsion", section.torsion,
                              "the members' torque and [torsion_hysteresis] are two torsion laws: "
                              "keep one")
-    if section.torsion == "members":  # a twist stiffness at zero strain: lay or self-stress
-        m = section.members(params.helix)
-        if m.taut_moduli()["GJ"] <= 0:
-            raise ParameterError("section.torsion", section.torsion,
-                                 "the members have no torsional stiffness at zero strain "
-                                 "(lay_angle_deg = 0 and self_stress_N = 0): set one of them")
-    section.members(params.helix)  # the derived tether stiffness is positive
+    members = section.members(params.helix)  # the derived tether stiffness is positive
+    # the members' torque needs a twist stiffness at zero strain: a lay or a self-stress
+    if section.torsion == "members" and members.taut_moduli()["GJ"] <= 0:
+        raise ParameterError("section.torsion", section.torsion,
+                             "the members have no torsional stiffness at zero strain "
+                             "(lay_angle_deg = 0 and self_stress_N = 0): set one of them")
