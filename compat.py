@@ -140,6 +140,11 @@ def scalar_space(mesh, family: str, degree: int):
     return dolfinx.fem.FunctionSpace(mesh, (family, degree))
 
 
+def atan2(y, x):
+    """UFL's two-argument arctangent (atan_2 in UFL 2022; atan2 from UFL 2023.2)."""
+    return (ufl.atan2 if hasattr(ufl, "atan2") else ufl.atan_2)(y, x)
+
+
 def space_degree(V) -> int:
     """The polynomial degree of a function space's element: a method of UFL's element
     (0.5), a property of basix.ufl's (0.9)."""

@@ -18,9 +18,11 @@ strain, 1 / cos(beta) per unit rod length, is
 
     e(phi) = cos(beta) sqrt((1 + eps - R kappa cos phi)^2 + (R tau + tan beta)^2) - 1 + e0,
 
-e0 = P0 / k.  The members are taken at phi_m = 2 pi m / n: a member lies on the
-bending plane (the phase at which the first member slackens soonest, and the
-largest member force is largest; :func:`phase_spread` measures the other phases).
+e0 = P0 / k.  The members are taken at phi_m = 2 pi m / n + psi, psi the ring's phase
+against the bending plane: psi = 0 (the default, ``[section] ring = "worst"``) puts a
+member on the bending plane (the phase at which the first member slackens soonest,
+and the largest member force is largest; :func:`phase_spread` measures the other
+phases); with ``ring = "turning"`` psi follows the directors (forms/section_law.py).
 
 **The law.**  A tether carries tension only: its force is k <e>_w, the smooth
 positive part <e>_w = (e + sqrt(e^2 + w^2)) / 2 of width w (the slack width, a
@@ -147,38 +149,48 @@ class Members:
         return float(np.max(-np.cos(self.phi)))
 
     # -- the law ----------------------------------------------------------------------
-    def _stretch(self, eps, kappa, tau):
+    def phases(self, psi=0.0) -> np.ndarray:
+        """phi_m + psi (..., n): the members' angles from the bending plane's inner side,
+        psi the ring's phase (module docstring)."""
+        return self.phi + np.asarray(psi, dtype=float)[..., None]
+
+    def _stretch(self, eps, kappa, tau, psi=0.0):
         """(a, b, l): the axial and tangential advance per unit rod length, and
         l = sqrt(a^2 + b^2), each of shape (..., n)."""
         eps, kappa, tau = (np.asarray(x, dtype=float)[..., None] for x in (eps, kappa, tau))
-        a = 1 + eps - self.R * kappa * np.cos(self.phi)
+        a = 1 + eps - self.R * kappa * np.cos(self.phases(psi))
         b = self.R * tau + math.tan(self.beta) + 0 * a
         return a, b, np.sqrt(a * a + b * b)
 
-    def strains(self, eps, kappa, tau=0.0):
+    def strains(self, eps, kappa, tau=0.0, psi=0.0):
         """e_m (..., n): each member's strain, slack where <= 0."""
-        _, _, l = self._stretch(eps, kappa, tau)
+        _, _, l = self._stretch(eps, kappa, tau, psi)
         return math.cos(self.beta) * l - 1 + self.e0
 
-    def forces(self, eps, kappa, tau=0.0):
+    def forces(self, eps, kappa, tau=0.0, psi=0.0):
         """k <e_m>_w [N], (..., n)."""
-        return self.k * smooth_ramp(self.strains(eps, kappa, tau), self.width)
+        return self.k * smooth_ramp(self.strains(eps, kappa, tau, psi), self.width)
 
-    def energy(self, eps, kappa, tau=0.0):
+    def energy(self, eps, kappa, tau=0.0, psi=0.0):
         """W [N = J/m]: the members' and the bars' stored energy per unit rod length."""
-        e = self.strains(eps, kappa, tau)
+        e = self.strains(eps, kappa, tau, psi)
         tethers = self.k / math.cos(self.beta) * ramp_energy(e, self.width).sum(axis=-1)
         eps, tau = np.asarray(eps, dtype=float), np.asarray(tau, dtype=float)
         return tethers + 0.5 * self.EA_b * (eps + self.e_b0) ** 2 + self.Q_b0 * tau
 
-    def resultants(self, eps, kappa, tau=0.0) -> dict:
-        """N [N], M [N m] (>= 0 for kappa >= 0), Q [N m]: dW/d(eps, kappa, tau)."""
-        a, b, l = self._stretch(eps, kappa, tau)
-        f = self.forces(eps, kappa, tau)  # de/d(.) = cos(beta) (a da + b db) / l; x 1/cos(beta)
+    def resultants(self, eps, kappa, tau=0.0, psi=0.0) -> dict:
+        """N [N], M [N m] (>= 0 for kappa >= 0 at psi = 0), Q [N m]: dW/d(eps, kappa, tau);
+        and the ring's torque about the axis from its phase, dW/d psi [N m] (zero at
+        psi = 0 by symmetry, and whenever every member is taut and linear)."""
+        a, b, l = self._stretch(eps, kappa, tau, psi)
+        f = self.forces(eps, kappa, tau, psi)  # de/d(.) = cos(beta) (a da + b db) / l; x 1/cos(beta)
+        phases = self.phases(psi)
         N = (f * a / l).sum(axis=-1) + self.EA_b * (np.asarray(eps, dtype=float) + self.e_b0)
-        M = (f * a / l * (-self.R * np.cos(self.phi))).sum(axis=-1)
+        M = (f * a / l * (-self.R * np.cos(phases))).sum(axis=-1)
         Q = (f * b / l * self.R).sum(axis=-1) + self.Q_b0
-        return {"N": N, "M": M, "Q": Q}
+        kappa = np.asarray(kappa, dtype=float)
+        W_psi = (f * a / l * self.R * kappa[..., None] * np.sin(phases)).sum(axis=-1)
+        return {"N": N, "M": M, "Q": Q, "W_psi": W_psi}
 
     def tangent(self, eps=0.0, kappa=0.0, tau=0.0, h: float = 1e-7) -> dict:
         """The tangent moduli EA = dN/d eps, EI = dM/d kappa, GJ = dQ/d tau at a state
@@ -242,17 +254,10 @@ def phase_spread(members: Members, eps: float, kappa: float, tau: float = 0.0,
     """How much the fixed phase (a member on the bending plane) matters: the range of
     the moment and of the smallest member force over the bending plane's phase
     relative to the ring, psi in [0, 2 pi / n)."""
-    out = {"M": [], "f_min": []}
-    for psi in np.linspace(0, 2 * np.pi / members.n, phases, endpoint=False):
-        e = (math.cos(members.beta) * np.sqrt(
-            (1 + eps - members.R * kappa * np.cos(members.phi + psi)) ** 2
-            + (members.R * tau + math.tan(members.beta)) ** 2) - 1 + members.e0)
-        f = members.k * smooth_ramp(e, members.width)
-        a = 1 + eps - members.R * kappa * np.cos(members.phi + psi)
-        l = np.sqrt(a * a + (members.R * tau + math.tan(members.beta)) ** 2)
-        out["M"].append(float((f * a / l * (-members.R * np.cos(members.phi + psi))).sum()))
-        out["f_min"].append(float(f.min()))
-    return {k: (min(v), max(v)) for k, v in out.items()}
+    psi = np.linspace(0, 2 * np.pi / members.n, phases, endpoint=False)
+    M = members.resultants(eps + 0 * psi, kappa, tau, psi)["M"]
+    f_min = members.forces(eps + 0 * psi, kappa, tau, psi).min(axis=-1)
+    return {"M": (float(M.min()), float(M.max())), "f_min": (float(f_min.min()), float(f_min.max()))}
 
 
 @dataclass(frozen=True)

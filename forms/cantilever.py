@@ -45,16 +45,21 @@ def wall_weight(mesh):
     return 1 - ufl.SpatialCoordinate(mesh)[0]
 
 
-def clamp_energy(r, axis, mu, kinematics, degree: int, penalty, ds):
+def clamp_energy(r, axis, mu, kinematics, degree: int, penalty, ds, moment=None):
     """U_clamp at the wall s = 0 (see above); ``mu`` (a number, constant or UFL
     field) includes the bending switch, ``penalty`` is eta (discretisation.penalty);
     ``kinematics`` the component (c.kinematics): its jump and moment measure at
-    the wall, [[r']] n and r'' (paper) or [[t]] n and t' (extensible)."""
+    the wall, [[r']] n and r'' (paper) or [[t]] n and t' (extensible).  ``moment``: a
+    section law's dW/dt' (forms/section_law.py), the wall's moment in place of mu t',
+    with ``mu`` its taut bending modulus in the penalty."""
     mesh = ds.ufl_domain()
     n = ufl.FacetNormal(mesh)[0]
     alpha_ip = penalty * degree**2 / ufl.CellDiameter(mesh)
-    jump, moment = kinematics.clamp(r, axis)
-    return wall_weight(mesh) * mu * (-ufl.dot(moment, jump) * n
+    jump, bend = kinematics.clamp(r, axis)
+    if moment is not None:
+        return wall_weight(mesh) * (-ufl.dot(moment, jump) * n
+                                    + 0.5 * alpha_ip * mu * ufl.dot(jump, jump)) * ds
+    return wall_weight(mesh) * mu * (-ufl.dot(bend, jump) * n
                                      + 0.5 * alpha_ip * ufl.dot(jump, jump)) * ds
 
 

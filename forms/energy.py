@@ -53,7 +53,8 @@ def potential(r, alpha, c: Coefficients, degree: int, penalty, measures, kappa=N
     # stretch and bending: the kinematics component's (forms/paper.py, forms/extensible.py)
     # beta/2 tau^2, or 0 when the section's members carry the twist (forms/section_law.py)
     return ((c.section.twist_energy(tau, c) - c.gravity * ufl.dot(K_E, r)) * dx
-            + c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa, twist=tau)
+            + c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa, twist=tau,
+                                         ring=alpha)
             + sum(comp.energy(r, c, dx) for comp in c.extra))  # forms/coefficients.py
 
 
@@ -62,6 +63,6 @@ def non_variational_power(r, alpha, r_t, c: Coefficients, dx, kappa=None):
     P = int (T r' - F_NL) . r_t' = int [mu kappa^2 r' - beta tau (r' x r'')] . r_t',
     with F_NL of Eq. (32) and its variational part T r'."""
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
-    moment = c.section.twist_moment(r, tau, c)  # tau, or the members' Q / GJ
+    moment = c.section.twist_moment(r, tau, c, alpha)  # tau, or the members' Q / GJ
     f = c.kinematics.non_variational_force(r, moment, c, kappa=kappa)  # (29), (32)
     return ufl.inner(f, d(r_t)) * dx

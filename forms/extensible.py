@@ -93,7 +93,8 @@ import ufl
 from ufl.algorithms.apply_algebra_lowering import apply_algebra_lowering
 from ufl.algorithms.apply_derivatives import apply_derivatives
 from ufl.algorithms.map_integrands import map_integrands
-from ufl.algorithms.transformer import strip_variables
+from ufl.corealg.map_dag import map_expr_dag
+from ufl.corealg.multifunction import MultiFunction
 
 from rawehelix.forms.interior_penalty import ip_penalty, jump
 from rawehelix.forms.kinematics import d, stretch, unit_tangent
@@ -128,14 +129,30 @@ def stored_energy(r, sigma, mu, alpha_ip, dx, dS, field=False):
     return cells + mu * (-ufl.dot(avg_dt, jump_t) + 0.5 * alpha_ip * ufl.dot(jump_t, jump_t)) * dS
 
 
-def rod_energy(r, c, alpha_ip, dx, dS, twist=None):
+def rod_energy(r, c, alpha_ip, dx, dS, twist=None, ring=None):
     """The section law's stored energy, cells and nodes (``c.section``,
     forms/section_law.py): for the solid, :func:`stored_energy` with the coefficients
     ``c`` (forms/coefficients.py::Coefficients) and the bending modulus of
     :func:`bending_modulus`, built from ``r`` itself, so that its variation carries
     1/2 mu'(eps) kappa^2.  ``twist``: tau, held fixed, for a section whose members
-    carry it (forms/section_law.py)."""
-    return c.section.energy(r, c, alpha_ip, dx, dS, tau=twist)
+    carry it (forms/section_law.py); ``ring``: alpha, held fixed, for a ring whose phase
+    turns with it ([section] ring = "turning")."""
+    return c.section.energy(r, c, alpha_ip, dx, dS, tau=twist, alpha=ring)
+
+
+class _StripVariables(MultiFunction):
+    """Each ufl.variable by its expression, once per node of the DAG (UFL's own
+    strip_variables visits the tree: exponential in the shared subexpressions of a
+    turning ring's members, forms/section_law.py)."""
+
+    expr = MultiFunction.reuse_if_untouched
+
+    def variable(self, o, expression, label):
+        return expression
+
+
+def _strip_variables(expression):
+    return map_expr_dag(_StripVariables(), expression)
 
 
 def variation(energy, r, v, domain):
@@ -151,7 +168,7 @@ def variation(energy, r, v, domain):
     else:
         varied = energy(r + e * v)
     dE = apply_derivatives(apply_algebra_lowering(ufl.diff(varied, e)))
-    dE = map_integrands(strip_variables, dE) if isinstance(dE, ufl.Form) else strip_variables(dE)
+    dE = map_integrands(_strip_variables, dE) if isinstance(dE, ufl.Form) else _strip_variables(dE)
     return ufl.replace(dE, {e0: ufl.as_ufl(0.0)})
 
 
@@ -160,12 +177,12 @@ def twist_coupling(r, tau, beta):
     return beta * tau * ufl.cross(d(r), d(r, 2))
 
 
-def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS, twist=None):
+def centre_line_residual(r, v, tau, c, alpha_ip, dx, dS, twist=None, ring=None):
     """delta U(r; v) + int beta tau (r' x r'').v': the elastic forces of the
     centre-line equation (30) with extensible kinematics (``tau`` the moment / GJ,
     ``twist`` the twist that a member section's energy reads, held fixed)."""
     def energy(x):
-        return rod_energy(x, c, alpha_ip, dx, dS, twist=twist)
+        return rod_energy(x, c, alpha_ip, dx, dS, twist=twist, ring=ring)
     return variation(energy, r, v, dx.ufl_domain()) + ufl.inner(twist_coupling(r, tau, c.beta), d(v)) * dx
 
 
@@ -176,13 +193,13 @@ class ExtensibleKinematics:
     name = "extensible"
 
     def centre_line_residual(self, r, v, tau, c, degree: int, penalty, dx, dS, kappa=None, eta=None,
-                             twist=None):
+                             twist=None, ring=None):
         """delta U(r; v) + the twist coupling (IP bending only: no ``kappa``)."""
         return centre_line_residual(r, v, tau, c, ip_penalty(degree, penalty, dS), dx, dS,
-                                    twist=twist)
+                                    twist=twist, ring=ring)
 
-    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None, twist=None):
-        return rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS, twist=twist)
+    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None, twist=None, ring=None):
+        return rod_energy(r, c, ip_penalty(degree, penalty, dS), dx, dS, twist=twist, ring=ring)
 
     def non_variational_force(self, r, tau, c, kappa=None):
         """-beta tau (r' x r''): the twist coupling, the one non-variational part of F_NL."""

@@ -24,10 +24,10 @@ class PaperKinematics:
     name = "paper"
 
     def centre_line_residual(self, r, v, tau, c, degree: int, penalty, dx, dS, kappa=None, eta=None,
-                             twist=None):
+                             twist=None, ring=None):
         """int F_NL.v' + mu B(r, v) (32)-(33); with the curvature field ``kappa`` (test
         ``eta``) the mixed form and its equation kappa = r'' (37).  ``tau``: the moment /
-        GJ; ``twist``: the twist itself, unread (the paper's section is the solid)."""
+        GJ; ``twist``, ``ring``: the twist and alpha, unread (the paper's section is the solid)."""
         if kappa is None:
             return (ufl.inner(internal_force(r, tau, c.sigma, c.mu, c.beta), d(v)) * dx  # (32)
                     + c.bending * c.mu * bending(r, v, degree, penalty, dx, dS))  # (33)
@@ -35,7 +35,7 @@ class PaperKinematics:
                 + c.bending * c.mu * mixed.bending_force(kappa, v, dx)
                 - c.mu * mixed.curvature_equation(r, kappa, eta, dx))
 
-    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None, twist=None):
+    def stored_energy(self, r, c, degree: int, penalty, dx, dS, kappa=None, twist=None, ring=None):
         """int sigma (|r'|^3/3 - |r'|^2/2) + mu/2 B(r, r) (B(r, r) = int |kappa|^2, mixed)."""
         lam = stretch(r)
         bend = (0.5 * bending(r, r, degree, penalty, dx, dS) if kappa is None

@@ -36,6 +36,7 @@ from __future__ import annotations
 import ufl
 
 from rawehelix.forms.coefficients import Coefficients
+from rawehelix.forms.extensible import variation
 from rawehelix.forms.kinematics import d, frenet_torsion_rate, tension, twist
 
 K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
@@ -97,15 +98,20 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
     # the moment / GJ: tau, the members' Q / GJ (forms/section_law.py), or the
     # hysteresis component's (Fig. 5; the two are refused together)
-    moment = c.section.twist_moment(r, tau, c) if z is None else c.hysteresis.moment(tau, z)
+    moment = c.section.twist_moment(r, tau, c, alpha) if z is None else c.hysteresis.moment(tau, z)
     # the kinematics component: the paper's F_NL (32)-(33) (forms/paper.py) or the
     # variation of the extensible rod's stored energy (forms/extensible.py)
     F = c.kinematics.centre_line_residual(r, v, moment, c, degree, penalty, dx, dS,
-                                          kappa=kappa, eta=eta, twist=tau)
+                                          kappa=kappa, eta=eta, twist=tau, ring=alpha)
     for comp in c.extra:  # the energy components (forms/energy_component.py): delta W(r; v)
         F += comp.residual(r, v, c, dx)
     if psi is None:  # the planar model: no twist equation
         return F
+    if c.section.ring_turns:  # the ring's phase is alpha: (delta / beta) dU/d alpha (forms/energy.py)
+        def energy(a):
+            return c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa, twist=tau,
+                                              ring=a)
+        F += c.delta / c.beta * variation(energy, alpha, psi, dx.ufl_domain())
     return (F + c.delta * moment * d(psi) * dx  # (31)
             # (38)-(39): tau(0) = m0, tau(1) = mN; x = 0 or 1 on the two ends
             - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)

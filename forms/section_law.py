@@ -64,9 +64,13 @@ import math
 
 import ufl
 
+from rawehelix.compat import atan2
 from rawehelix.forms.extensible import bending_modulus, stored_energy, strain
 from rawehelix.forms.interior_penalty import jump
 from rawehelix.forms.kinematics import d, unit_tangent
+
+#: j_E, the turning ring's reference direction (normal to every chord, forms/rod.py's frame)
+J_E = ufl.as_vector((0.0, 1.0, 0.0))
 
 #: eta, the curvature's regularisation sqrt(t'.t' + eta^2) (normalised, 1/L0)
 KAPPA_ETA = 1.0e-10
@@ -89,10 +93,15 @@ class HelixTorsion:
     """The scene's GJ carries the twist (every section unless its members do)."""
 
     torsion = False  # the members carry the twist ([section] torsion = "members")
+    ring_turns = False  # the members' phase turns with alpha ([section] ring = "turning")
 
-    def twist_moment(self, r, tau, c):
+    def twist_moment(self, r, tau, c, alpha=None):
         """The twisting moment / GJ of Eq. (31): tau."""
         return tau
+
+    def ring_phase(self, r, c, alpha):
+        """The ring's phase psi against the bending plane (members.py): 0, a member on it."""
+        return 0.0
 
     def twist_energy(self, tau, c):
         """The twist's stored energy per length, beta/2 tau^2 (forms/energy.py)."""
@@ -104,11 +113,11 @@ class SolidSection(HelixTorsion):
 
     name = "solid"
 
-    def energy(self, r, c, alpha_ip, dx, dS, tau=None):
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None):
         return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS,
                              field=c.bending_law.field)
 
-    def axial_force(self, r, c, tau=0):
+    def axial_force(self, r, c, tau=0, alpha=None):
         """N = sigma eps (Eq. 29), without the EI law's 1/2 mu'(eps) kappa^2."""
         return c.sigma * strain(r)
 
@@ -136,27 +145,32 @@ class NonlinearSection(HelixTorsion):
         q = c.bending * d(unit_tangent(r))
         return strain(r), q, self.curvature(q)
 
-    def moment(self, r, c, tau=0):
+    def moment(self, r, c, tau=0, alpha=None):
         """dW/dt' = W_kappa t' / kappa (with the bending switch)."""
         eps, q, kappa = self.strains(r, c)
         return c.bending * self.dW(eps, kappa, tau)[1] / kappa * q
 
-    def axial_force(self, r, c, tau=0):
+    def axial_force(self, r, c, tau=0, alpha=None):
         """N = dW/d eps."""
         eps, _, kappa = self.strains(r, c)
         return self.dW(eps, kappa, tau)[0]
 
-    def energy(self, r, c, alpha_ip, dx, dS, tau=None):
-        """int W dx - sum {{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2; ``tau`` the
-        twist (held fixed in the centre line's variation), read if :attr:`torsion`."""
-        n = ufl.FacetNormal(dS.ufl_domain())
+    def cell_energy(self, r, c, tau=0, alpha=None):
+        """W per length at the rod's strains."""
         eps, _, kappa = self.strains(r, c)
+        return self.W(eps, kappa, tau)
+
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None):
+        """int W dx - sum {{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2; ``tau`` the
+        twist (held fixed in the centre line's variation), read if :attr:`torsion`;
+        ``alpha`` the twist angle, read if :attr:`ring_turns` (None: 0)."""
+        n = ufl.FacetNormal(dS.ufl_domain())
         tau = tau if self.torsion and tau is not None else 0
         jump_t = jump(unit_tangent(r), n)
-        m = self.moment(r, c, tau)
+        m = self.moment(r, c, tau, alpha)
         avg_m = 0.5 * (m("+") + m("-"))  # {{dW/dt'}}
         EI_t = c.bending * self.taut_bending
-        return (self.W(eps, kappa, tau) * dx
+        return (self.cell_energy(r, c, tau, alpha) * dx
                 + (-ufl.dot(avg_m, jump_t) + 0.5 * alpha_ip * EI_t * ufl.dot(jump_t, jump_t)) * dS)
 
 
@@ -165,9 +179,11 @@ class TensegritySection(NonlinearSection):
 
     name = "tensegrity"
 
-    def __init__(self, n: int, R, beta: float, k, e0, EA_b, e_b0, width, torsion: bool = False):
+    def __init__(self, n: int, R, beta: float, k, e0, EA_b, e_b0, width, torsion: bool = False,
+                 ring_turns: bool = False):
         self.n, self.R, self.beta, self.k, self.e0 = n, R, beta, k, e0
         self.EA_b, self.e_b0, self.width, self.torsion = EA_b, e_b0, width, torsion
+        self.ring_turns = ring_turns
         # the bars' torque at zero strain, -n P0 R sin(beta) (members.py::Members.Q_b0)
         self.Q_b0 = -n * k * e0 * R * math.sin(beta)
         self.phi = [2 * math.pi * m / n for m in range(n)]
@@ -175,47 +191,122 @@ class TensegritySection(NonlinearSection):
         # K R^2 / 2, K = n (k cos^3 beta + P0 cos beta sin^2 beta), P0 = k e0 (members.py)
         self.taut_bending = n * k * cb * (cb * cb + e0 * sb * sb) * R * R / 2
 
-    def _members(self, eps, kappa, tau=0):
+    # -- the turning ring: the members' phase from the directors ----------------------
+    @staticmethod
+    def ring_frame(r):
+        """(e1, e2): e1 the unit projection of j_E on the section's plane, e2 = t x e1.
+        j_E is normal to every chord of Eq. (66) (in the (i_E, k_E) plane), so e1 exists
+        while the tangent stays within 90 degrees of the chord."""
+        t = unit_tangent(r)
+        p = J_E - ufl.dot(J_E, t) * t
+        e1 = p / ufl.sqrt(ufl.dot(p, p))
+        return e1, ufl.cross(t, e1)
+
+    def directors(self, r, alpha):
+        """(d1, d2) = the ring frame (e1, e2) turned by the twist angle alpha (None: 0):
+        member m lies along cos(phi_m) d1 + sin(phi_m) d2."""
+        e1, e2 = self.ring_frame(r)
+        if alpha is None:
+            return e1, e2
+        ca, sa = ufl.cos(alpha), ufl.sin(alpha)
+        return ca * e1 + sa * e2, ca * e2 - sa * e1
+
+    def ring_phase(self, r, c, alpha):
+        """psi = alpha - theta, theta the angle of t' from e1: member m then bends by
+        kappa cos(phi_m + psi) (members.py's phase); 0 for the worst-phase ring."""
+        if not self.ring_turns:
+            return 0.0
+        e1, e2 = self.ring_frame(r)
+        q = d(unit_tangent(r))
+        theta = atan2(ufl.dot(q, e2), ufl.dot(q, e1) + KAPPA_ETA)
+        return (0 if alpha is None else alpha) - theta
+
+    def bends(self, r, c, alpha=None):
+        """kappa_m, member m's curvature: cos(phi_m) kappa_1 + sin(phi_m) kappa_2 with
+        kappa_i = q.d_i the curvatures in the directors' frame (the turning ring), or
+        kappa cos(phi_m)."""
+        _, q, kappa = self.strains(r, c)
+        if not self.ring_turns:
+            return [kappa * math.cos(phi) for phi in self.phi]
+        d1, d2 = self.directors(r, alpha)
+        k1, k2 = ufl.dot(q, d1), ufl.dot(q, d2)
+        return [math.cos(phi) * k1 + math.sin(phi) * k2 for phi in self.phi]
+
+    # -- the law ------------------------------------------------------------------------
+    def _members(self, eps, kappa, tau=0, bends=None):
         """[(a_m, b, l_m, e_m)] of members.py::Members._stretch and strains (tau = 0 unless
-        the members carry the twist)."""
+        the members carry the twist; ``bends`` the members' curvatures, kappa cos phi_m
+        unless given)."""
         cb, tb = math.cos(self.beta), math.tan(self.beta)
         b = self.R * tau + tb if self.torsion else tb
+        bends = [kappa * math.cos(phi) for phi in self.phi] if bends is None else bends
         out = []
-        for phi in self.phi:
-            a = 1 + eps - self.R * kappa * math.cos(phi)
+        for bend in bends:
+            a = 1 + eps - self.R * bend
             l = ufl.sqrt(a * a + b * b) if self.torsion or tb != 0 else a  # a > 0: the stretch
             out.append((a, b, l, cb * l - 1 + self.e0))
         return out
 
-    def member_strains(self, eps, kappa, tau=0):
-        return [e for *_, e in self._members(eps, kappa, tau)]
+    def member_strains(self, eps, kappa, tau=0, bends=None):
+        return [e for *_, e in self._members(eps, kappa, tau, bends)]
 
-    def W(self, eps, kappa, tau=0):
-        tethers = sum(ramp_energy(e, self.width) for *_, e in self._members(eps, kappa, tau))
+    def W(self, eps, kappa, tau=0, bends=None):
+        tethers = sum(ramp_energy(e, self.width) for *_, e in self._members(eps, kappa, tau, bends))
         W = self.k / math.cos(self.beta) * tethers + 0.5 * self.EA_b * (eps + self.e_b0)**2
         return W + self.Q_b0 * tau if self.torsion else W
+
+    def member_forces(self, eps, kappa, tau=0, bends=None):
+        """[(f_m a_m / l_m, b / l_m)]: dW/da_m and the members' share of the torque's lever."""
+        return [(self.k * ramp(e, self.width) * a / l, self.k * ramp(e, self.width) * b / l)
+                for a, b, l, e in self._members(eps, kappa, tau, bends)]
 
     def dW(self, eps, kappa, tau=0):
         """(N, M) of members.py::Members.resultants."""
         N, M = self.EA_b * (eps + self.e_b0), 0
-        for phi, (a, _, l, e) in zip(self.phi, self._members(eps, kappa, tau)):
-            f = self.k * ramp(e, self.width) * a / l
-            N, M = N + f, M - f * self.R * math.cos(phi)
+        for phi, (fa, _) in zip(self.phi, self.member_forces(eps, kappa, tau)):
+            N, M = N + fa, M - fa * self.R * math.cos(phi)
         return N, M
 
-    def torque(self, eps, kappa, tau):
-        """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
-        Q = self.Q_b0
-        for a, b, l, e in self._members(eps, kappa, tau):
-            Q = Q + self.k * ramp(e, self.width) * self.R * b / l
-        return Q
+    def _turning(self, r, c, alpha):
+        eps, _, kappa = self.strains(r, c)
+        return eps, kappa, self.bends(r, c, alpha)
 
-    def twist_moment(self, r, tau, c):
+    def cell_energy(self, r, c, tau=0, alpha=None):
+        if not self.ring_turns:
+            return super().cell_energy(r, c, tau)
+        eps, kappa, bends = self._turning(r, c, alpha)
+        return self.W(eps, kappa, tau, bends)
+
+    def moment(self, r, c, tau=0, alpha=None):
+        """dW/dt' (with the bending switch): W_kappa t' / kappa, or for the turning ring
+        M1 d1 + M2 d2, M_i = -R sum_m (dW/da_m) (cos, sin)(phi_m)."""
+        if not self.ring_turns:
+            return super().moment(r, c, tau)
+        eps, kappa, bends = self._turning(r, c, alpha)
+        forces = self.member_forces(eps, kappa, tau, bends)
+        d1, d2 = self.directors(r, alpha)
+        M1 = sum(-self.R * math.cos(phi) * fa for phi, (fa, _) in zip(self.phi, forces))
+        M2 = sum(-self.R * math.sin(phi) * fa for phi, (fa, _) in zip(self.phi, forces))
+        return c.bending * (M1 * d1 + M2 * d2)
+
+    def axial_force(self, r, c, tau=0, alpha=None):
+        """N = dW/d eps."""
+        if not self.ring_turns:
+            return super().axial_force(r, c, tau)
+        eps, kappa, bends = self._turning(r, c, alpha)
+        return self.EA_b * (eps + self.e_b0) + sum(fa for fa, _ in self.member_forces(eps, kappa, tau, bends))
+
+    def torque(self, eps, kappa, tau, bends=None):
+        """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
+        return self.Q_b0 + sum(self.R * fb for _, fb in self.member_forces(eps, kappa, tau, bends))
+
+    def twist_moment(self, r, tau, c, alpha=None):
         """The twisting moment / GJ of Eq. (31): Q / beta with the members' torque, or tau."""
         if not self.torsion:
             return super().twist_moment(r, tau, c)
         eps, _, kappa = self.strains(r, c)
-        return self.torque(eps, kappa, tau) / c.beta
+        bends = self.bends(r, c, alpha) if self.ring_turns else None
+        return self.torque(eps, kappa, tau, bends) / c.beta
 
     def twist_energy(self, tau, c):
         """beta/2 tau^2, or 0: the members' W holds the twist's energy."""
@@ -256,7 +347,8 @@ def from_normalised(q, make=float):
         return TensegritySection(q.section_tethers, make(q.section_radius), q.section_lay_angle,
                                  make(q.section_stiffness), make(q.section_prestrain),
                                  make(q.section_bar_stiffness), make(q.section_bar_prestrain),
-                                 make(q.section_width), torsion=q.section_torsion)
+                                 make(q.section_width), torsion=q.section_torsion,
+                                 ring_turns=q.section_ring_turns)
     if q.section_law == "saturating":
         return SaturatingSection(make(q.sigma), make(q.mu),
                                  make(q.section_saturation * q.section_radius), make(q.section_width))

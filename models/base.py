@@ -111,6 +111,12 @@ class RodModel(abc.ABC):
     def bending_moment(self, fields: dict, c):
         """The bending moment's magnitude (an observable, M g L0 units)."""
 
+    def ring_phase(self, fields: dict, c):
+        """The phase psi of the section's members against the bending plane (an
+        observable, members.py): 0, a member on the plane, unless the model's section
+        turns its ring."""
+        return 0.0
+
     @abc.abstractmethod
     def end_conditions(self, pin_twist: bool) -> list[EndCondition]:
         """The Dirichlet conditions of the ends (and of fields held at zero)."""

@@ -120,7 +120,7 @@ class UnshearableRod(RodModel):
         its axial force N = dW/d eps (a slack tether carries nothing; sigma eps would)."""
         if c.section.name != "solid":
             tau = self.twist(fields, c) if c.section.torsion else 0
-            return c.section.axial_force(fields["centre_line"], c, tau)
+            return c.section.axial_force(fields["centre_line"], c, tau, fields["twist"])
         return kinematics.tension(fields["centre_line"], c.sigma)
 
     def twist(self, fields: dict, c):
@@ -151,7 +151,12 @@ class UnshearableRod(RodModel):
         z = fields["internal_twist"]
         if z is not None:
             return c.hysteresis.moment(tau, z)
-        return c.section.twist_moment(fields["centre_line"], tau, c)
+        return c.section.twist_moment(fields["centre_line"], tau, c, fields["twist"])
+
+    def ring_phase(self, fields: dict, c):
+        """The section's ring phase psi against the bending plane (members.py; 0 unless
+        ``[section] ring = "turning"``, forms/section_law.py)."""
+        return c.section.ring_phase(fields["centre_line"], c, fields["twist"])
 
     # -- end conditions, Eqs. (35)-(37) ---------------------------------------------
     def end_conditions(self, pin_twist: bool) -> list[EndCondition]:

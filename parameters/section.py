@@ -24,6 +24,9 @@ from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 LAWS = ("solid", "tensegrity", "saturating")
 #: who carries the twist: the scene's GJ ("helix") or the members ("members", tensegrity only)
 TORSIONS = ("helix", "members")
+#: the ring's phase against the bending plane (members.py): "worst", a member on the
+#: bending plane (the envelope of every phase); "turning", the phase the directors give
+RINGS = ("worst", "turning")
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,7 @@ class Section:
     ring_spacing_m: float | None = None  # l, between adjacent rings (torsional collapse); None: off [m]
     slack_width: float = 1.0e-5  # w, the strain over which a tether goes slack (regularisation) [-]
     torsion: str = "helix"  # the twist's moment: "helix" (GJ_Nm2) or "members" (their torque)
+    ring: str = "worst"  # the ring's phase: "worst" (a member on the bending plane) or "turning" (with alpha)
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -52,6 +56,12 @@ class Section:
                                  "must be an integer >= 3 (a ring of tethers)")
         if self.torsion not in TORSIONS:
             raise ParameterError("section.torsion", self.torsion, f"must be one of {list(TORSIONS)}")
+        if self.ring not in RINGS:
+            raise ParameterError("section.ring", self.ring, f"must be one of {list(RINGS)}")
+        if self.ring == "turning" and self.law != "tensegrity":
+            raise ParameterError("section.ring", self.ring,
+                                 "only the tensegrity's members have a phase: set section.law = "
+                                 "'tensegrity' or ring = 'worst'")
         if self.torsion == "members" and self.law != "tensegrity":
             raise ParameterError("section.torsion", self.torsion,
                                  "the members carry the twist only with section.law = 'tensegrity'")
@@ -94,7 +104,7 @@ class Section:
 
     def describe(self) -> str:
         return (f"section: {self.law}, torsion by the {self.torsion}, {self.tethers} tethers, "
-                f"lay {self.lay_angle_deg:g} deg, "
+                f"lay {self.lay_angle_deg:g} deg, ring {self.ring}, "
                 f"self-stress {self.self_stress_N:g} N, slack width {self.slack_width:g}")
 
 
@@ -113,7 +123,7 @@ NORMALISED = {"section_tensegrity": False, "section_law": "solid", "section_teth
               "section_radius": 0.0, "section_lay_angle": 0.0, "section_stiffness": 0.0,
               "section_prestrain": 0.0, "section_bar_stiffness": 0.0,
               "section_bar_prestrain": 0.0, "section_width": 0.0, "section_saturation": 0.0,
-              "section_torsion": False}
+              "section_torsion": False, "section_ring_turns": False}
 
 
 def normalise(p, scales: dict) -> dict:
@@ -129,7 +139,8 @@ def normalise(p, scales: dict) -> dict:
             "section_stiffness": m.k / force, "section_prestrain": m.e0,
             "section_bar_stiffness": m.EA_b / force, "section_bar_prestrain": m.e_b0,
             "section_width": m.width, "section_saturation": m.saturation,
-            "section_torsion": section.torsion == "members"}
+            "section_torsion": section.torsion == "members",
+            "section_ring_turns": section.ring == "turning"}
 
 
 def check(params) -> None:

@@ -83,13 +83,17 @@ class CantileverSolver:
         self.force = dolfinx.fem.Constant(mesh, np.zeros(3, dtype=PETSc.ScalarType))
         axis = ufl.as_vector(AXIS)
         x = r.centre_line()
+        alpha = r.model.split(w)["twist"]
+        tau = kinematics.twist(x, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
         mu = c.kinematics.bending_modulus(x, c)  # with the EI law: mu(eps), forms/eilaw.py
-        U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds)
+        moment = None
+        if c.section.name != "solid":  # a section law's wall moment dW/dt' (forms/section_law.py)
+            mu = c.bending * c.section.taut_bending
+            moment = c.section.moment(x, c, tau if c.section.torsion else 0, alpha)
+        U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds, moment)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)
         self.newton = NewtonSolver(F, w, r.bcs, prefix=petsc_options.LABTEST_PREFIX)
-        alpha = r.model.split(w)["twist"]
-        tau = kinematics.twist(x, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
         T = kinematics.tension(x, c.sigma)  # (29)
         s = ufl.SpatialCoordinate(mesh)[0]
         dx = r.measures[0]

@@ -50,6 +50,7 @@ class SectionProbe:
             "torque": model.moment(by_role, c),  # / (GJ / L0)
             "tension": model.tension(by_role, c),  # (29)
             "twist": model.twist(by_role, c),  # (34)
+            "ring_phase": model.ring_phase(by_role, c),  # psi (members.py; 0: the worst phase)
         }
         self.names = tuple(fields)
         V = compat.vector_space(mesh, "Lagrange", compat.space_degree(V_s), len(fields))

@@ -112,8 +112,9 @@ def _refine_law(solver, tensions, targets, loads, start, bending_test,
 # solvers/analytic.py, no gravity) that the rod-level fit above solves in the rod.
 
 SECTION_LEVEL = ("section: members.py's law at one section, the lab segment's Eq. (63) "
-                 "through the tensioned cantilever's closed form (no gravity); the rod-level "
-                 "fit through the FE section law (forms/section_law.py) is not done yet")
+                 "through the tensioned cantilever's closed form (no gravity); the fitted "
+                 "members then run in the rod, the FE section law in the simulated tests "
+                 "(labtest.py::rod_check, the block's \"rod\")")
 GJ_TARGET = (140.0, 200.0)  # GJ [N m^2] at T_e [N]: Sec. 4, Fig. 5
 TWIST_RAD = np.radians(50.0)  # the torsion test's largest angle, about 50 deg (Sec. 4)
 

@@ -44,7 +44,7 @@ from mpi4py import MPI
 from rawehelix.errors import SolverError
 from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.solvers import analytic
-from rawehelix.studies import labfit, writers
+from rawehelix.studies import labfit, labmembers, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -230,13 +230,32 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
                        tension_N=list(tensions), load_N=list(loads), rod_EI_Nm2=rod_EI,
                        apparent_EI_Nm2=apparent, eq64_EI_Nm2=eq64(tensions).tolist(),
                        closed_form_apparent_EI_Nm2=closed_form_apparent_EI(params, rod_EI, tensions))
-    if fit:  # the members (issue 29), at the section level until the FE section law lands
+    if fit:  # the members (issue 29): fitted at the section level, then run in the rod
         members = helix_scene.model.section.members(helix_scene.helix, width=0.0)
-        summary["section_fit"] = labfit.section_fit(
-            test, members, helix_scene.helix.EA_N, LAB_LENGTH_M, section_lab(test, tensions, loads))
+        block = labfit.section_fit(test, members, helix_scene.helix.EA_N, LAB_LENGTH_M,
+                                   section_lab(test, tensions, loads))
+        block["rod"] = rod_check(helix_scene, block, elements, degree, gravity, comm)
+        summary["section_fit"] = block
     summary["wall_s"] = time.perf_counter() - start
     log.debug("labtest %s: %.2f s", test, summary["wall_s"])
     return LabTest(params, test, rows, summary, comm.rank)
+
+
+def rod_check(helix_scene: Parameters, block: dict, elements: int | None = None,
+              degree: int | None = None, gravity: bool = True, comm=MPI.COMM_WORLD) -> dict:
+    """The members' fit (``block``, labfit.section_fit) through the FE section law in
+    this module's simulated tests on the lab segment (labmembers.rod_check)."""
+    from rawehelix.solvers.cantilever import CantileverSolver
+
+    def solver(section: dict, **helix):
+        scene = helix_scene.replace(model={"kinematics": "extensible"}, section=section,
+                                    **({"helix": helix} if helix else {}))
+        return CantileverSolver(lab_parameters(scene, elements, degree, gravity), comm)
+
+    tests = {"axial": lambda S: axial_test(S, DEFAULT_TENSIONS_N["axial"]),
+             "torsion": torsion_test,
+             "bending": lambda S, T: bending_test(S, T, DEFAULT_LOADS["fit"])}
+    return {"gravity": gravity, **labmembers.rod_check(block, solver, tests, LAB_LENGTH_M)}
 
 
 def section_lab(test: str, tensions, loads) -> dict:
@@ -291,42 +310,7 @@ def report(result: LabTest) -> str:
     """The short table a user reads after a lab test (and the members' fit, --fit)."""
     text = _report(result)
     block = result.summary.get("section_fit")
-    return text if block is None else "\n".join([text, *section_report(block)])
-
-
-def section_report(b: dict) -> list:
-    """The members' fit (labfit.section_fit) in a few lines, its level first."""
-    lay = b["layout"]
-    lines = [f"members' fit at the {b['level']}",
-             f"  Eq. (62): {lay['tethers']} tethers at R = {lay['radius_m']:g} m, lay "
-             f"{lay['lay_angle_deg']:g} deg: k = {b['axial']['tether_EA_N']:.5g} N per tether "
-             f"reads EA = {b['axial']['apparent_EA_N']:.5g} N ({100 * b['axial']['relative_error']:+.3f} %)"]
-    for key in ("lay_angle_fit_held", "lay_angle_fit_dead_load", "self_stress_fit_dead_load"):
-        if key not in b:
-            continue
-        f = b[key]
-        if f is None:
-            lines.append(f"  GJ = 140 N m^2 at 200 N, {key}: no solution in range")
-            continue
-        m, rise = f["layout"], f["tension_change_at_fixed_length_N"]
-        lines.append(f"  GJ = 140 N m^2 at 200 N, {key}: lay {m['lay_angle_deg']:.3f} deg, P0 "
-                     f"{m['self_stress_N']:.4g} N, k {m['tether_EA_N']:.5g} N, bars {m['bar_EA_N']:.4g} N: "
-                     f"GJ dead load "
-                     f"{f['apparent_GJ_dead_load_Nm2']:.4g}, held {f['apparent_GJ_held_Nm2']:.4g} "
-                     f"N m^2; T change at fixed length +50 deg {rise['+50deg']:+.1f} N, -50 deg "
-                     f"{rise['-50deg']:+.1f} N")
-    if "bending" in b:
-        for T, EI, app, e64, R in zip(*(b["bending"][k] for k in (
-                "tension_N", "members_EI_Nm2", "apparent_EI_Nm2", "eq64_EI_Nm2", "radius_needed_m"))):
-            lines.append(f"  Eq. (64) at {T:g} N: members' EI {EI:.0f} reads {app:.0f} N m^2 against "
-                         f"{e64:.0f} ({100 * (app / e64 - 1):+.1f} %); needs R = {R:.3f} m")
-        c = b["cone"]
-        lines.append(f"  fallback (saturating, c = {c['c']:.3f}): reproduces Eq. (64) within "
-                     f"{100 * max(abs(e) for e in c['relative_error']):.2g} %, convex "
-                     f"{c['convex']}; moment saturates at F_N = " + ", ".join(
-                         f"{r['saturation_load_N']:.2f}" for r in c["rows"]) + " N")
-        lines.append(f"  verdict: {b['verdict']}")
-    return lines
+    return text if block is None else "\n".join([text, *labmembers.report(block)])
 
 
 def _report(result: LabTest) -> str:

@@ -53,21 +53,22 @@ class Tracker:
                 "moment_saturation": m.saturation,
                 "torsional_collapse": None if not np.isfinite(dcrit) else dcrit}
 
-    def forces(self, N, M, Q, eps=None, kappa=None, tau=None):
-        """The members' forces (..., n) [N] and their slack mask."""
+    def forces(self, N, M, Q, eps=None, kappa=None, tau=None, psi=0.0):
+        """The members' forces (..., n) [N] and their slack mask (``psi`` the ring's phase
+        of a turning ring, members.py)."""
         m = self.members
         if self.law == "tensegrity":
-            e = m.strains(eps, kappa, tau)
-            return m.forces(eps, kappa, tau), e <= 0
+            e = m.strains(eps, kappa, tau, psi)
+            return m.forces(eps, kappa, tau, psi), e <= 0
         f = m.linear_forces(N, M, Q)
         return f, f <= 0
 
-    def law_resultants(self, N, M, eps, kappa, tau):
+    def law_resultants(self, N, M, eps, kappa, tau, psi=0.0):
         """(N, M) of the section law: the members' or the cone's own resultants at the
         strains (the model's tension and bending-moment observables are the solid's,
         sigma eps and EI kappa); the solid's given N and M otherwise."""
         if self.law == "tensegrity":
-            r = self.members.resultants(eps, kappa, tau)
+            r = self.members.resultants(eps, kappa, tau, psi)
             return r["N"], np.abs(r["M"])
         if self.law == "saturating":
             r = self.cone.resultants(eps, kappa)
@@ -79,25 +80,25 @@ class Tracker:
         tension = N > 0
         return np.where(tension, np.abs(M) / np.where(tension, N * self.members.R, 1.0), 0.0), tension
 
-    def profile(self, N, M, Q, tau, eps=None, kappa=None) -> dict:
+    def profile(self, N, M, Q, tau, eps=None, kappa=None, psi=0.0) -> dict:
         """Along s, one time: ``member_force_min_N``, ``member_force_max_N`` and
         ``moment_ratio`` per section (the fields of simulate's frames)."""
         N, M, Q, tau = (np.asarray(x, dtype=float) for x in (N, M, Q, tau))
         kappa = np.abs(kappa) if kappa is not None else None
-        N, M = self.law_resultants(N, M, eps, kappa, tau)
-        f, _ = self.forces(N, M, Q, eps, kappa, tau)
+        N, M = self.law_resultants(N, M, eps, kappa, tau, psi)
+        f, _ = self.forces(N, M, Q, eps, kappa, tau, psi)
         return {"member_force_min_N": f.min(axis=-1), "member_force_max_N": f.max(axis=-1),
                 "moment_ratio": self.moment_ratio(N, M)[0]}
 
-    def add(self, s_m, N, M, Q, tau, t_s=None, eps=None, kappa=None):
+    def add(self, s_m, N, M, Q, tau, t_s=None, eps=None, kappa=None, psi=0.0):
         """The sections at ``s_m`` (ns,) at the time ``t_s`` (None: a stationary
         state): N [N], M [N m] (magnitude), Q [N m], tau [rad/m] of shape (ns,); eps and
-        kappa [1/m] for a member law.  Each time's smallest and largest member force
+        kappa [1/m] for a member law, psi [rad] the ring's phase (a turning ring).  Each time's smallest and largest member force
         is kept in :attr:`history` (t, min, max)."""
         s_m, N, M, Q, tau = (np.asarray(x, dtype=float) for x in (s_m, N, M, Q, tau))
         kappa = np.abs(kappa) if kappa is not None else None
-        N, M = self.law_resultants(N, M, eps, kappa, tau)
-        f, slack = self.forces(N, M, Q, eps, kappa, tau)
+        N, M = self.law_resultants(N, M, eps, kappa, tau, psi)
+        f, slack = self.forces(N, M, Q, eps, kappa, tau, psi)
         self.history.append((np.nan if t_s is None else float(t_s), float(f.min()), float(f.max())))
         i = int(np.argmin(f.min(axis=-1)))
         if self._min is None or f[i].min() < self._min["value"]:
@@ -157,13 +158,15 @@ class Tracker:
 
 def si(q, section: dict) -> dict:
     """A section state along s in the model's normalised units (solvers/probes.py::
-    SectionProbe.section: s, tension, twist, strain, curvature, bending_moment, torque)
+    SectionProbe.section: s, tension, twist, strain, curvature, bending_moment, torque,
+    ring_phase)
     as :meth:`Tracker.add`'s SI arguments; ``q`` the scene's Normalised."""
     L0 = q.L0
     return {"s_m": q.length_m(section["s"]), "N": q.tension_N(section["tension"]),
             "M": section["bending_moment"] * q.force_scale * L0,
             "Q": q.torque_Nm(section["torque"]), "tau": section["twist"] / L0,
-            "eps": section["strain"], "kappa": section["curvature"] / L0}
+            "eps": section["strain"], "kappa": section["curvature"] / L0,
+            "psi": section.get("ring_phase", 0.0)}
 
 
 def add_normalised(tracker: Tracker, q, section: dict, t=None):

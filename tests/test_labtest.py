@@ -281,10 +281,26 @@ def test_members_cannot_give_eq64_and_the_fallback_can(bending_fit, table2):
                                       rel=0.02)
 
 
+def test_section_fit_in_the_rod(bending_fit, table2):
+    """The fitted members through the FE section law in the simulated tests (N = 4,
+    gravity on, labtest.rod_check): the axial layout reads Eq. (62), the dead-load
+    self-stress GJ = 140 N m^2 at 200 N and the cone Eq. (64)'s three points, each
+    within 1 %; the held lay has no rod test (the lab's ballast is a dead load)."""
+    rod = labtest.rod_check(table2, bending_fit, elements=4)
+    assert abs(rod["axial"]["relative_error"]) < 0.01
+    assert abs(rod["self_stress_fit_dead_load"]["relative_error"]) < 0.01
+    assert "lay_angle_fit_held" not in rod and "lay_angle_fit_dead_load" not in rod
+    assert rod["cone"]["within_1_percent"]
+    assert rod["cone"]["apparent_EI_Nm2"] == pytest.approx(
+        list(labtest.eq64(labtest.PAPER_BENDING_TENSIONS_N)), rel=0.01)
+
+
 def test_command_line_fit_says_its_level(tmp_path, capsys):
     assert cli.main(["labtest", "torsion", "--fit", "--tension", "200", "--elements", "2",
                      "-o", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "members' fit at the section" in out and "lay_angle_fit_held" in out
+    assert "in the rod (FE section law, gravity on): Eq. (62) EA" in out
     written = json.loads((tmp_path / "summary.json").read_text())
     assert written["section_fit"]["lay_angle_fit_held"]["relative_error"] == pytest.approx(0, abs=0.01)
+    assert set(written["section_fit"]["rod"]) == {"gravity", "axial", "self_stress_fit_dead_load"}
