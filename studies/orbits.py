@@ -161,7 +161,19 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
 def period_map(params: Parameters):
     """The scene's scheme's period map on this rank: the FE generalised-alpha
     map, or the paper's spline-Galerkin flow (``discretisation.scheme``)."""
+    refuse_turning_ring(params)
     return schemes.of(params).period_map(params)
+
+
+def refuse_turning_ring(params: Parameters) -> None:
+    """A turning ring's slack members make the response quasi-periodic (the spin turns
+    them through the bending plane): no orbit of period 1/f1 exists to find."""
+    if params.model.section.ring == "turning":
+        from rawehelix.errors import SceneError
+        raise SceneError(params.name, "section.ring",
+                         "'turning' breaks the rotation symmetry in alpha that a periodic orbit of "
+                         "the spinning helix needs (docs/explanation/section.md): trace it with "
+                         "rawehelix sweep, or set section.ring = 'worst'")
 
 
 def driven_frequencies(params: Parameters, m, f_max_Hz: float) -> tuple[list[float], float]:
@@ -251,6 +263,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
                           f"different frequencies > 0 [Hz]")
+    refuse_turning_ring(params)  # before any output
     tension_step = TENSION_STEP if tension_step is None else tension_step
     superharmonics = tuple(SUPERHARMONIC_ORDERS if superharmonics is None else superharmonics)
     if any(int(k) != k or k < 2 for k in superharmonics):

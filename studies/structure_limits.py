@@ -35,8 +35,9 @@ def _at(value, s, t) -> dict:
 class Tracker:
     """The extremes of the members' state over the sections and times it is given."""
 
-    def __init__(self, members: Members, law: str = "solid", cone=None):
+    def __init__(self, members: Members, law: str = "solid", cone=None, ring: str = "worst"):
         self.members, self.law, self.cone = members, law, cone  # cone: the saturating law's
+        self.ring = ring  # the ring's phase: "worst" (psi = 0) or "turning" (the probe's psi)
         self._min = self._max = self._ratio = self._twist = None
         self._slack = 0.0
         self._no_tension = None
@@ -143,7 +144,7 @@ class Tracker:
         return {
             "law": self.law,
             "members": {"tethers": m.n, "radius_m": m.R, "lay_angle_deg": float(np.degrees(m.beta)),
-                        "tether_EA_N": m.k, "self_stress_N": m.P0},
+                        "tether_EA_N": m.k, "self_stress_N": m.P0, "ring": self.ring},
             "min_member_force_N": self._min,
             "max_member_force_N": self._max,
             "slack_fraction_max": self._slack,
@@ -183,7 +184,7 @@ def of_params(params) -> Tracker:
     if section.law == "saturating":  # forms/section_law.py::SaturatingSection's constants
         cone = ConeSection(EA=helix.EA_N, EI=helix.EI_Nm2, R=members.R, c=members.saturation,
                            width=section.slack_width)
-    return Tracker(members, section.law, cone)
+    return Tracker(members, section.law, cone, section.ring)
 
 
 def line(block: dict | None) -> str:

@@ -163,3 +163,15 @@ def test_taut_unlaid_turning_ring_is_the_worst_phase():
 def test_ring_refusals(section, match):
     with pytest.raises(ParameterError, match=match):
         scene.load("stationary_table2").replace(model={"kinematics": "extensible"}, section=section)
+
+
+def test_orbits_refuse_the_turning_ring(tmp_path, capsys):
+    """No orbit of period 1/f1 with a turning ring (its slack breaks the rotation
+    symmetry in alpha): `rawehelix orbits` says so, exit 2, nothing written."""
+    from rawehelix.cli import main as cli
+    out = tmp_path / "o"
+    assert cli.main(["orbits", "mobile_end", "--f1", "9:10", "--elements", "4",
+                     "--set", "model.kinematics=extensible", "--set", "section.law=tensegrity",
+                     "--set", "section.ring=turning", "-o", str(out)]) == 2
+    assert "section.ring: 'turning' breaks the rotation symmetry" in capsys.readouterr().err
+    assert not out.exists()
