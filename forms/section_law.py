@@ -25,6 +25,12 @@ parameters/section.py::normalise gives R~ = R / L0, k~ = k / (M g), EA_b~ = EA_b
   torque) and the twisting moment's shear force of F_NL is Q (r' x r'') (Eq. 32 with
   beta tau -> Q).  The centre line's variation holds tau fixed, as the solid's does
   (forms/energy.py: the gamma coupling is one way).
+  With ``[section] ring = "turning"`` the members' phase follows the directors:
+  d1, d2 are (e1, e2) = (j_E projected on the section's plane, t x e1) turned by
+  alpha, member m bends by kappa_m = cos(phi_m) kappa_1 + sin(phi_m) kappa_2 with
+  kappa_i = t'.d_i (the worst phase's kappa cos(phi_m) otherwise), the moment is
+  M1 d1 + M2 d2, and W depends on alpha: the twist equation gains
+  (delta / beta) dW/d alpha (forms/rod.py), zero while every member is taut.
 * :class:`SaturatingSection` (``"saturating"``, the fallback): the conjugate of the
   complementary energy N^2/(2 EA) + M^2/(2 EI) on the cone |M| <= c R N.  With
   rho = c R, A = EA, B = EI, D = 1/A + rho^2/B, g = eps + rho kappa (the cone's ray)
