@@ -175,3 +175,26 @@ def test_orbits_refuse_the_turning_ring(tmp_path, capsys):
                      "--set", "section.ring=turning", "-o", str(out)]) == 2
     assert "section.ring: 'turning' breaks the rotation symmetry" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_taut_spinning_turning_ring_is_the_worst_phase():
+    """A spinning helix whose tethers stay taut (mobile_end with a 1 cm circle at
+    3.5 Hz, the torque's rise 0.5 s, N = 4, 1 s): alpha turns the ring through the
+    bending plane, yet the tension at the ground and the spin are the worst phase's to
+    1e-5 N and 1e-6 rpm (N = 8, 4 s: 6e-7 N), and the turning ring's smallest member
+    force is no smaller (the worst phase bounds it)."""
+    import rawehelix as rh
+    runs = {}
+    for ring in ("worst", "turning"):
+        scene = rh.load_scene("mobile_end", elements=4, overrides={
+            "model.kinematics": "extensible", "section.law": "tensegrity", "section.ring": ring,
+            "ends.circle_frequency_Hz": 3.5, "ends.circle_radius_m": 0.01,
+            "torque.rise_time_s": 0.5})
+        runs[ring] = rh.simulate(scene, until_s=1.0)
+    a, b = runs["worst"], runs["turning"]
+    assert np.ptp(b.spin_rpm[:, 2]) > 10  # it spins up
+    assert np.abs(a.tension_s0_N - b.tension_s0_N).max() < 1e-5
+    assert np.abs(a.spin_rpm - b.spin_rpm).max() < 1e-6
+    fa, fb = (r.summary["limits"]["min_member_force_N"]["value"] for r in (a, b))
+    assert fb >= fa - 1e-9 and b.summary["limits"]["slack_fraction_max"] == 0.0
+    assert b.summary["limits"]["members"]["ring"] == "turning"
