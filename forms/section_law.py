@@ -171,7 +171,7 @@ class NonlinearSection(HelixTorsion):
         twist (held fixed in the centre line's variation), read if :attr:`torsion`;
         ``alpha`` the twist angle, read if :attr:`ring_turns` (None: 0)."""
         n = ufl.FacetNormal(dS.ufl_domain())
-        tau = tau if self.torsion and tau is not None else 0
+        tau = 0 if tau is None else tau  # read by the members' law only if it carries the twist
         jump_t = jump(unit_tangent(r), n)
         m = self.moment(r, c, tau, alpha)
         avg_m = 0.5 * (m("+") + m("-"))  # {{dW/dt'}}
@@ -266,21 +266,20 @@ class TensegritySection(NonlinearSection):
         return [(self.k * ramp(e, self.width) * a / l, self.k * ramp(e, self.width) * b / l)
                 for a, b, l, e in self._members(eps, kappa, tau, bends)]
 
-    def dW(self, eps, kappa, tau=0):
-        """(N, M) of members.py::Members.resultants."""
+    def dW(self, eps, kappa, tau=0, bends=None):
+        """(N, M) of members.py::Members.resultants (M at the worst phase)."""
         N, M = self.EA_b * (eps + self.e_b0), 0
-        for phi, (fa, _) in zip(self.phi, self.member_forces(eps, kappa, tau)):
+        for phi, (fa, _) in zip(self.phi, self.member_forces(eps, kappa, tau, bends)):
             N, M = N + fa, M - fa * self.R * math.cos(phi)
         return N, M
 
-    def _turning(self, r, c, alpha):
+    def member_state(self, r, c, alpha=None):
+        """(eps, kappa, the members' curvatures of :meth:`bends`) at the rod's strains."""
         eps, _, kappa = self.strains(r, c)
         return eps, kappa, self.bends(r, c, alpha)
 
     def cell_energy(self, r, c, tau=0, alpha=None):
-        if not self.ring_turns:
-            return super().cell_energy(r, c, tau)
-        eps, kappa, bends = self._turning(r, c, alpha)
+        eps, kappa, bends = self.member_state(r, c, alpha)
         return self.W(eps, kappa, tau, bends)
 
     def moment(self, r, c, tau=0, alpha=None):
@@ -288,7 +287,7 @@ class TensegritySection(NonlinearSection):
         M1 d1 + M2 d2, M_i = -R sum_m (dW/da_m) (cos, sin)(phi_m)."""
         if not self.ring_turns:
             return super().moment(r, c, tau)
-        eps, kappa, bends = self._turning(r, c, alpha)
+        eps, kappa, bends = self.member_state(r, c, alpha)
         forces = self.member_forces(eps, kappa, tau, bends)
         d1, d2 = self.directors(r, alpha)
         M1 = sum(-self.R * math.cos(phi) * fa for phi, (fa, _) in zip(self.phi, forces))
@@ -297,10 +296,8 @@ class TensegritySection(NonlinearSection):
 
     def axial_force(self, r, c, tau=0, alpha=None):
         """N = dW/d eps."""
-        if not self.ring_turns:
-            return super().axial_force(r, c, tau)
-        eps, kappa, bends = self._turning(r, c, alpha)
-        return self.EA_b * (eps + self.e_b0) + sum(fa for fa, _ in self.member_forces(eps, kappa, tau, bends))
+        eps, kappa, bends = self.member_state(r, c, alpha)
+        return self.dW(eps, kappa, tau, bends)[0]
 
     def torque(self, eps, kappa, tau, bends=None):
         """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
@@ -310,8 +307,7 @@ class TensegritySection(NonlinearSection):
         """The twisting moment / GJ of Eq. (31): Q / beta with the members' torque, or tau."""
         if not self.torsion:
             return super().twist_moment(r, tau, c)
-        eps, _, kappa = self.strains(r, c)
-        bends = self.bends(r, c, alpha) if self.ring_turns else None
+        eps, kappa, bends = self.member_state(r, c, alpha)
         return self.torque(eps, kappa, tau, bends) / c.beta
 
     def twist_energy(self, tau, c):

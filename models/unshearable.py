@@ -118,10 +118,7 @@ class UnshearableRod(RodModel):
     def tension(self, fields: dict, c):
         """T = sigma (|r'| - 1), Eq. (29); with a member section law (forms/section_law.py)
         its axial force N = dW/d eps (a slack tether carries nothing; sigma eps would)."""
-        if c.section.name != "solid":
-            tau = self.twist(fields, c) if c.section.torsion else 0
-            return c.section.axial_force(fields["centre_line"], c, tau, fields["twist"])
-        return kinematics.tension(fields["centre_line"], c.sigma)
+        return c.section.axial_force(fields["centre_line"], c, self.twist(fields, c), fields["twist"])
 
     def twist(self, fields: dict, c):
         """tau = gamma + alpha', Eq. (34)."""

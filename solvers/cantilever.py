@@ -89,7 +89,7 @@ class CantileverSolver:
         moment = None
         if c.section.name != "solid":  # a section law's wall moment dW/dt' (forms/section_law.py)
             mu = c.bending * c.section.taut_bending
-            moment = c.section.moment(x, c, tau if c.section.torsion else 0, alpha)
+            moment = c.section.moment(x, c, tau, alpha)
         U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds, moment)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)

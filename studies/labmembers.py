@@ -18,10 +18,9 @@ from rawehelix.studies import labfit
 
 
 def _members(layout: dict, **keys) -> dict:
-    """A scene's ``[section]`` of a fitted layout (labfit._layout)."""
-    return {"law": "tensegrity", "tethers": layout["tethers"], "radius_m": layout["radius_m"],
-            "lay_angle_deg": layout["lay_angle_deg"], "tether_EA_N": layout["tether_EA_N"],
-            "self_stress_N": layout["self_stress_N"], "bar_EA_N": layout["bar_EA_N"], **keys}
+    """A scene's ``[section]`` of a fitted layout (labfit._layout: its keys are the
+    section's)."""
+    return {"law": "tensegrity", **layout, **keys}
 
 
 def rod_check(block: dict, solver, tests: dict, L0: float) -> dict:
