@@ -223,6 +223,19 @@ def collapse(V_sub):
 
 
 
+def shearable_element(cell, degree: int):
+    """The shearable rod's (r, alpha, n) element: vector P_p, scalar P_p and the
+    director n, vector P_(p-1) (forms/shearable.py)."""
+    if NEW:
+        vec = basix.ufl.element("Lagrange", "interval", degree, shape=(3,))
+        sca = basix.ufl.element("Lagrange", "interval", degree)
+        low = basix.ufl.element("Lagrange", "interval", degree - 1, shape=(3,))
+        return basix.ufl.mixed_element([vec, sca, low])
+    return ufl.MixedElement([ufl.VectorElement("Lagrange", cell, degree, dim=3),
+                             ufl.FiniteElement("Lagrange", cell, degree),
+                             ufl.VectorElement("Lagrange", cell, degree - 1, dim=3)])
+
+
 def rod_pair_element(cell, degree: int):
     """The first-order (r, alpha, r_t, alpha_t) element: two copies of :func:`rod_element`'s
     fields, flattened into one mixed element of four sub-elements."""

@@ -13,6 +13,11 @@ LATERAL = FAMILIES[1:3]
 #: the families of vibrations, with a classical model each (solvers.analytic)
 VIBRATIONS = FAMILIES[:-1]
 
+#: the shearable rod's modes with most of their kinetic energy in the sections' rotary
+#: inertia (forms/shearable.py): shear modes, and the director's gauge |n|; not a vibration
+#: of Table 3's families, listed when a window holds one
+ROTATION = "rotation"
+
 #: the labels of Table 3
 FAMILY_LABELS = {
     "longitudinal": "Longitudinal",
@@ -20,6 +25,7 @@ FAMILY_LABELS = {
     "lateral_out_of_plane": "Lateral (y)",
     "torsional": "Torsional",
     "rigid": "Rigid rotation",
+    "rotation": "Section rotation (shear)",
     "overdamped": "Overdamped",
 }
 

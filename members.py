@@ -212,6 +212,34 @@ class Members:
         return {"EA": K + self.EA_b, "EI": K * self.R**2 / 2,
                 "GJ": self.n * cb * self.R**2 * (self.k * sb**2 + self.P0 * cb**2)}
 
+    def shear_stiffness(self, tether_force_N: float | None = None) -> float:
+        """GA [N] of the ring under a shear strain gamma (the section's normal turned by
+        gamma from the centre line's tangent, forms/shearable.py), all taut and linear:
+
+            GA = n cos(beta) [k sin^2 beta + f (1 + cos^2 beta)] / 2,
+
+        f each tether's force (default P0).  A shear gamma (along d1) adds to a tether
+        at phi the tangential advance -gamma sin(phi) and the radial gamma cos(phi):
+        its strain changes by -sin(beta) cos(beta) sin(phi) gamma to first order (the
+        lay's elastic share, GJ_el / (2 R^2): a thin tube's shear coefficient 1/2) and
+        by cos^2(beta) (1 - sin^2 beta sin^2 phi) gamma^2 / 2 to second order (the
+        tension's geometric share); the bars on the axis turn with the section and add
+        nothing.  :meth:`sheared_energy` checks it by differences."""
+        f = self.P0 if tether_force_N is None else tether_force_N
+        cb, sb = math.cos(self.beta), math.sin(self.beta)
+        return self.n * cb * (self.k * sb * sb + f * (1 + cb * cb)) / 2
+
+    def sheared_energy(self, gamma, tether_force_N: float | None = None):
+        """The tethers' energy per unit length [J/m] at the shear strain gamma (along d1)
+        and no other strain, each tether prestrained to the force f (default P0):
+        (k / cos beta) Phi(e), e = cos(beta) l - 1 + f / k, l^2 = 1 + (tan(beta) -
+        gamma sin phi)^2 + (gamma cos phi)^2 (w = 0)."""
+        f = self.P0 if tether_force_N is None else tether_force_N
+        gamma = np.asarray(gamma, dtype=float)[..., None]
+        b = math.tan(self.beta) - gamma * np.sin(self.phi)
+        e = math.cos(self.beta) * np.sqrt(1 + b * b + (gamma * np.cos(self.phi)) ** 2) - 1 + f / self.k
+        return (self.k / math.cos(self.beta) * ramp_energy(e, 0.0)).sum(axis=-1)
+
     def first_slack_curvature(self, eps: float, tau: float = 0.0) -> float:
         """kappa at which the member on the inner side (phi = 0) slackens: e = 0,
         (1 + eps - R kappa)^2 = ((1 - e0) / cos beta)^2 - (R tau + tan beta)^2."""

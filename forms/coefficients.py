@@ -10,10 +10,12 @@ from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
 from rawehelix.forms.extensible import ExtensibleKinematics
 from rawehelix.forms.hysteresis import BoucWen, NoneHysteresis
 from rawehelix.forms.paper import PaperKinematics
+from rawehelix.forms.shearable import ShearableKinematics
 from rawehelix.forms import section_law
 
 #: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py)
-KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics}
+KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics,
+              "shearable": ShearableKinematics}
 
 #: the components that add a stored energy per length W(r) and nothing else
 #: (forms/energy_component.py): the residual gets their variation (forms/rod.py), the
@@ -43,6 +45,8 @@ class Coefficients:
     bending: Any = 1.0
     gamma_eps: Any = 1.0e-3
     gamma_coupling: Any = 1.0  # 0 drops gamma (the paper's own code)
+    shear: Any = 0.0  # GA / (M g), the shearable rod's (parameters/shear.py)
+    rotary: Any = 0.0  # its sections' rotary inertia EI / (EA L0^2), 0: none
     # the kinematics, a component chosen by model.kinematics (:data:`KINEMATICS`)
     kinematics: Any = field(default_factory=PaperKinematics)
     # structural damping, a component (forms/damping.py): KelvinVoigt, or the null
@@ -70,6 +74,7 @@ class Coefficients:
             gravity=make(q.gravity), drag=make(q.drag), bending=make(q.bending),
             gamma_eps=make(model.gamma_eps),
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
+            shear=make(q.shear_stiffness), rotary=make(q.rotary_inertia),
             kinematics=KINEMATICS[model.kinematics](),
             damping=KelvinVoigt.from_normalised(q, make),
             bending_law=TensionDependentBending.from_normalised(q, make),

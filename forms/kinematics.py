@@ -15,6 +15,9 @@ from __future__ import annotations
 
 import ufl
 
+K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
+I_E = ufl.as_vector((1.0, 0.0, 0.0))  # i_E: the wind blows along -i_E
+
 
 def d(f, k: int = 1):
     """The k-th derivative along the normalised arc length s."""

@@ -37,10 +37,7 @@ import ufl
 
 from rawehelix.forms.coefficients import Coefficients
 from rawehelix.forms.extensible import variation
-from rawehelix.forms.kinematics import d, frenet_torsion_rate, tension, twist
-
-K_E = ufl.as_vector((0.0, 0.0, 1.0))  # k_E: z points down, Sec. 2.1
-I_E = ufl.as_vector((1.0, 0.0, 0.0))  # i_E: the wind blows along -i_E
+from rawehelix.forms.kinematics import I_E, K_E, d, frenet_torsion_rate, tension, twist  # noqa: F401
 
 
 def quadrature_degree(degree: int, chosen: int = 0) -> int | None:

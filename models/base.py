@@ -22,10 +22,12 @@ from dataclasses import dataclass
 import ufl
 
 from rawehelix.errors import SceneError
+from rawehelix.forms import kinematics
 
 #: the roles of a rod's fields; the unshearable rod has the first two always,
-#: "curvature" with the mixed bending form, "internal_twist" with hysteresis
-ROLES = ("centre_line", "twist", "curvature", "internal_twist")
+#: "curvature" with the mixed bending form, "internal_twist" with hysteresis; the
+#: shearable rod (models/shearable.py) the first two and "director"
+ROLES = ("centre_line", "twist", "curvature", "internal_twist", "director")
 
 #: the solvers a model is asked about (:meth:`RodModel.refuse`)
 SOLVERS = ("stationary", "second_order", "first_order", "modal")
@@ -84,8 +86,9 @@ class RodModel(abc.ABC):
         """U of the fields (:meth:`split`)."""
 
     @abc.abstractmethod
-    def kinetic_energy(self, rates: dict, c, dx):
-        """K of the rates (:meth:`split` of w_t)."""
+    def kinetic_energy(self, rates: dict, c, dx, fields: dict | None = None):
+        """K of the rates (:meth:`split` of w_t) at the state ``fields`` (a rotary inertia
+        reads it)."""
 
     @abc.abstractmethod
     def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):
@@ -94,6 +97,10 @@ class RodModel(abc.ABC):
     @abc.abstractmethod
     def non_variational_power(self, fields: dict, rates: dict, c, dx):
         """The power of the terms that are not the variation of an energy."""
+
+    def strain(self, fields: dict, c):
+        """The axial strain (an observable): eps = |r'| - 1 (Eq. 29)."""
+        return kinematics.stretch(fields["centre_line"]) - 1
 
     @abc.abstractmethod
     def tension(self, fields: dict, c):

@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import dataclasses
 
-from rawehelix.parameters import damping, eilaw, hysteresis, section
+from rawehelix.parameters import damping, eilaw, hysteresis, section, shear
 
 #: the sections, in the order of their checks
-SECTIONS = (eilaw, damping, hysteresis, section)
+SECTIONS = (eilaw, damping, hysteresis, section, shear)
 
 
 def group_keys() -> dict:

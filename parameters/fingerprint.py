@@ -9,7 +9,8 @@ from rawehelix.parameters.sections import Helix, Model
 #: convergence cache): left out of :meth:`Parameters.as_dict` at their
 #: defaults, so that those results keep their fingerprints: the kinematics and
 #: every component's section (parameters/components.py)
-LATER_MODEL_SWITCHES = {"kinematics": "paper", **components.later_switches("model", Model)}
+LATER_MODEL_SWITCHES = {"kinematics": "paper", "rotary_inertia": True,
+                        **components.later_switches("model", Model)}
 #: the same for the helix section (the EI law)
 LATER_HELIX_SWITCHES = components.later_switches("helix", Helix)
 

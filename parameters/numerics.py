@@ -26,6 +26,11 @@ MESHES = ("uniform", "graded")
 BENDINGS = ("ip", "mixed")  # the FE bending operator: forms/rod.py, forms/mixed.py
 
 
+#: the largest cell quadrature degree a scene may ask for: 3p at p = 8 is 24, UFL's own
+#: estimate 20 at p = 3 (forms/rod.py::quadrature_degree)
+QUADRATURE_MAX = 40
+
+
 @dataclass(frozen=True)
 class Discretisation:
     scheme: str = "fe"  # "fe" (FEniCSx, C0 interior penalty) or "spline" (paper, Sec. 3)
@@ -60,9 +65,11 @@ class Discretisation:
             raise ParameterError("discretisation.penalty", self.penalty,
                                  f"must be a number in (0, {PENALTY_MAX:g}]: a larger one spoils "
                                  "the bending operator by its round-off (parameters.PENALTY_MAX)")
-        if self.quadrature_degree < -1:
+        if not -1 <= self.quadrature_degree <= QUADRATURE_MAX:
             raise ParameterError("discretisation.quadrature_degree", self.quadrature_degree,
-                                 "must be 0 (the rule 3p), -1 (UFL's estimate) or a degree >= 1")
+                                 f"must be 0 (the rule 3p), -1 (UFL's estimate) or a degree from "
+                                 f"1 to {QUADRATURE_MAX} (3p is 24 at p = 8; a rule of degree "
+                                 f"262401, which a fuzzed scene asked for, compiles for minutes)")
 
     def ip_limit(self) -> int:
         """The largest N at which the IP bending form is trusted: 512 (3/p)^(4/3).

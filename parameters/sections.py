@@ -32,10 +32,13 @@ class Helix:
     drag_length_m: float = 0.012  # l_a, sum of the bar diameters [m], Eq. (14)
     drag_coefficient: float = 1.0  # C_D, Eq. (14)
     EI_law: EILaw | None = None  # EI = a T + b (Eq. 64); None: EI = EI_Nm2
+    GA_N: float | None = None  # GA, the shear stiffness [N] (the shearable rod); None: none
 
     def __post_init__(self):
         _positive("helix", self, "length_m", "mass_kg", "EA_N", "EI_Nm2", "GJ_Nm2", "radius_m")
         _non_negative("helix", self, "drag_length_m", "drag_coefficient")
+        if self.GA_N is not None:
+            _positive("helix", self, "GA_N")
         if self.EI_Nm2 / self.EA_N / self.length_m > self.length_m:
             # a rod (Eqs. 30-34) is slender: the radius of gyration sqrt(EI/EA) of its
             # sections is far below its length (Table 2: 0.6 m of 16 m); past L0 no
@@ -130,7 +133,8 @@ class Controller:
 
 
 GAMMA_TREATMENTS = ("regularised", "off")
-KINEMATICS = ("paper", "extensible")  # forms/paper.py (Eqs. 30-33), forms/extensible.py
+#: forms/paper.py (Eqs. 30-33), forms/extensible.py, forms/shearable.py (Simo-Reissner)
+KINEMATICS = ("paper", "extensible", "shearable")
 
 
 def check_kinematics(params) -> None:
@@ -168,6 +172,9 @@ class Model:
     # tension force is T r'); "extensible": stretch and bending from the stored
     # energy 1/2 EA eps^2 + 1/2 EI |t'|^2, t = r'/|r'| (forms/extensible.py)
     kinematics: str = "paper"
+    # the shearable rod's sections' rotary inertia about a diameter (parameters/shear.py);
+    # the unshearable rods have none (their sections turn with the tangent)
+    rotary_inertia: bool = True
     # then the components' tables it holds (parameters/components.py::holds), which
     # studies/scene.py fills from the scene's sections: damping (the [damping]
     # section, Damping), torsion_hysteresis ([torsion_hysteresis], TorsionHysteresis)

@@ -5,6 +5,8 @@
    P(lambda) (:meth:`Classifier.block_residuals`).  Energy alone cannot
    decide this when the gamma coupling of Eq. (34) is on: a slaved twist then
    dominates the kinetic energy of the out-of-plane lateral modes.
+0. the shearable rod's ``rotation``: most of the kinetic energy in the sections'
+   rotary inertia (its shear modes and the director's gauge, forms/shearable.py);
 2. for the centre line, the largest kinetic-energy fraction of the
    displacement along the local tangent t of the stationary centre line
    (``longitudinal``), along n = j_E x t (``lateral_in_plane``) and along j_E
@@ -22,6 +24,7 @@ import math
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix.families import ROTATION
 from rawehelix.solvers.linearise import COMPONENTS, Linearisation
 
 
@@ -101,10 +104,12 @@ class Classifier:
     def family(self, lam: complex, xr, xi, fractions: dict) -> str:
         """Torsional if the twist block resonates (:meth:`block_residuals`),
         else the centre-line family with the largest kinetic energy."""
+        if fractions.get(ROTATION, 0.0) > 0.5:  # the shearable rod's sections turn
+            return ROTATION
         rho = self.block_residuals(lam, xr, xi)
         if rho["twist"] < rho["centre_line"]:
             return "torsional"
-        lateral = {k: v for k, v in fractions.items() if k != "torsional"}
+        lateral = {k: v for k, v in fractions.items() if k not in ("torsional", ROTATION)}
         return max(lateral, key=lateral.get)
 
     @staticmethod

@@ -24,9 +24,17 @@ from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.state import RodState
 from rawehelix.forms import rod
-from rawehelix.models.unshearable import UnshearableRod
+from rawehelix.models import rod_model
 from rawehelix.parameters import Parameters
 from rawehelix.meshes import interval
+
+
+def unit_tangent_of(centre_line, s, h: float = 1e-6):
+    """t(s) (n, 3) of a callable s -> r(s) (n, 3), by central differences (one-sided
+    at the ends): the shearable rod's director of a centre line without shear."""
+    lo, hi = np.clip(s - h, 0.0, 1.0), np.clip(s + h, 0.0, 1.0)
+    dr = np.asarray(centre_line(hi)) - np.asarray(centre_line(lo))
+    return dr / np.linalg.norm(dr, axis=1)[:, None]
 
 
 class RodDiscretisation:
@@ -41,7 +49,7 @@ class RodDiscretisation:
         self.comm = comm
         self.degree = disc.degree
         self.penalty = disc.penalty
-        self.model = model = UnshearableRod(params)  # its fields and forms, models/
+        self.model = model = rod_model(params)  # its fields and forms, models/
         self.mixed = model.has("curvature")  # the curvature field kappa, forms/mixed.py
         self.hysteretic = model.has("internal_twist")  # z, forms/hysteresis.py
         self.mesh = interval.mesh_from_parameters(comm, params)
@@ -141,14 +149,22 @@ class RodDiscretisation:
         top = self.q.top_position(0.0)
         w.sub(self.model.index("centre_line")).interpolate(lambda x: np.outer(top, x[0]))
         w.sub(self.model.index("twist")).interpolate(lambda x: np.zeros(x.shape[1]))
+        if self.model.has("director"):  # d3 = the chord's direction (forms/shearable.py)
+            w.sub(self.model.index("director")).interpolate(
+                lambda x: np.outer(top / np.linalg.norm(top), np.ones(x.shape[1])))
         w.x.scatter_forward()
         self.update_curvature(w)
 
-    def set_centre_line(self, centre_line, w=None):
-        """w <- (r(s) from a callable s -> (n, 3), alpha = 0)."""
+    def set_centre_line(self, centre_line, w=None, director=None):
+        """w <- (r(s) from a callable s -> (n, 3), alpha = 0); the shearable rod's
+        director from ``director`` (s -> (n, 3)), or the unit tangent."""
         w = w or self.w
         w.sub(self.model.index("centre_line")).interpolate(lambda x: np.asarray(centre_line(x[0])).T)
         w.sub(self.model.index("twist")).interpolate(lambda x: np.zeros(x.shape[1]))
+        if self.model.has("director"):  # d3 = the unit tangent (forms/shearable.py)
+            w.sub(self.model.index("director")).interpolate(
+                lambda x: (unit_tangent_of(centre_line, x[0]) if director is None
+                           else np.asarray(director(x[0]))).T)
         w.x.scatter_forward()
         self.update_curvature(w)
 

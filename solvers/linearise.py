@@ -114,6 +114,9 @@ class Linearisation:
         }
         comps = {"x": u[0] * v[0] * dx, "y": u[1] * v[1] * dx, "z": u[2] * v[2] * dx,
                  "alpha": rot * a * b * dx}
+        if model.has("director"):  # the sections' rotary inertia, forms/shearable.py
+            n, m = model.split(rod.trial)["director"], model.split(rod.test)["director"]
+            family["rotation"] = rod.c.rotary * ufl.dot(n, m) * dx
         return {"family": family, "component": comps}
 
     def assemble(self, state: RodState):

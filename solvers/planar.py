@@ -29,7 +29,8 @@ def planar_allowed(params: Parameters) -> bool:
     """The stationary scene is planar: its upper end lies in the x-z plane (and
     the bending form is the IP one: the mixed form's kappa field is not reduced
     here; it runs on the full rod)."""
-    return params.ends.circle_radius_m == 0 and params.discretisation.bending == "ip"
+    return (params.ends.circle_radius_m == 0 and params.discretisation.bending == "ip"
+            and params.model.kinematics != "shearable")  # its director is not reduced
 
 
 def embed(u):
@@ -77,7 +78,7 @@ class PlanarRod:
     def set_chord(self, w=None):
         (w or self.w).interpolate(lambda x: np.outer(self.top_xz, x[0]))
 
-    def set_centre_line(self, centre_line, w=None):
+    def set_centre_line(self, centre_line, w=None, director=None):  # no director here
         (w or self.w).interpolate(lambda x: np.asarray(centre_line(x[0]))[:, [0, 2]].T)
 
     def gather_centre_line(self):

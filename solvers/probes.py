@@ -16,8 +16,7 @@ import dolfinx.fem
 from petsc4py import PETSc
 
 from rawehelix import compat
-from rawehelix.forms import kinematics
-from rawehelix.models.unshearable import UnshearableRod
+from rawehelix.models import rod_model
 from rawehelix.solvers import fields as fe_fields
 
 
@@ -44,7 +43,7 @@ class SectionProbe:
         mesh = V_s.mesh
         self.comm = mesh.comm
         fields = {
-            "strain": kinematics.stretch(r) - 1,  # eps = |r'| - 1
+            "strain": model.strain(by_role, c),  # eps = |r'| - 1 (Gamma_3: shearable)
             "curvature": model.curvature(by_role, c),
             "bending_moment": model.bending_moment(by_role, c),
             "torque": model.moment(by_role, c),  # / (GJ / L0)
@@ -68,7 +67,7 @@ class SectionProbe:
         zero = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
         by_role = {"centre_line": embed(rod.w), "twist": zero, "curvature": None,
                    "internal_twist": None}
-        return cls(UnshearableRod(rod.params), by_role, rod.c,
+        return cls(rod_model(rod.params), by_role, rod.c,
                    compat.scalar_space(mesh, "Lagrange", rod.degree))
 
     def section(self) -> dict | None:

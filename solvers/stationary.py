@@ -50,7 +50,9 @@ class StationarySolver:
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
         p = self.rod.degree
         self.V_T = compat.scalar_space(self.rod.mesh, "DG", p - 1)
-        self.tension_expr = tension(self.rod.centre_line(), self.rod.c.sigma)  # (29)
+        self.tension_expr = (tension(self.rod.centre_line(), self.rod.c.sigma) if planar  # (29)
+                             else self.rod.model.tension(self.rod.model.split(self.rod.w),
+                                                         self.rod.c))
 
     def solve(self, first_guess=None) -> StationaryResult:
         """Solve from the chord (or ``first_guess``: s -> (n, 3) centre line)."""
@@ -97,10 +99,11 @@ class StationarySolver:
         sT, Tv = fields.gather(T)
         return StationaryResult(s, x, sT, None if Tv is None else Tv[:, 0], 0, 0.0)
 
-    def residual_at(self, centre_line) -> float:
-        """|F| at the state (r = centre_line(s), alpha = 0): the FE residual of
-        an outside solution such as the shooting one (paper Sec. 5.1)."""
-        self.rod.set_centre_line(centre_line)
+    def residual_at(self, centre_line, director=None) -> float:
+        """|F| at the state (r = centre_line(s), alpha = 0; the shearable rod's director,
+        s -> (n, 3)): the FE residual of an outside solution such as the shooting one
+        (paper Sec. 5.1)."""
+        self.rod.set_centre_line(centre_line, director=director)
         return self.newton.residual_norm()
 
 

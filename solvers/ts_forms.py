@@ -59,9 +59,10 @@ class Fields:
     curvature field ``kappa`` of the mixed bending form (None: r'') and the
     Bouc-Wen twist ``z`` of the hysteretic torsion (None: elastic)."""
 
-    def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None):
+    def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None, n=None, n_t=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
         self.kappa, self.z = kappa, z
+        self.n, self.n_t = n, n_t  # the shearable rod's director and its rate
 
     @classmethod
     def of(cls, model, u, v):
@@ -69,13 +70,13 @@ class Fields:
         (models/base.py): the roles' fields under the paper's names."""
         f, f_t = model.split(u), model.split(v)
         return cls(f["centre_line"], f["twist"], f_t["centre_line"], f_t["twist"],
-                   f["curvature"], f["internal_twist"])
+                   f["curvature"], f["internal_twist"], f["director"], f_t["director"])
 
     def roles(self) -> tuple[dict, dict]:
         """(fields, rates) by role, as the model's forms take them."""
         return ({"centre_line": self.r, "twist": self.alpha, "curvature": self.kappa,
-                 "internal_twist": self.z},
-                {"centre_line": self.r_t, "twist": self.alpha_t})
+                 "internal_twist": self.z, "director": self.n},
+                {"centre_line": self.r_t, "twist": self.alpha_t, "director": self.n_t})
 
 
 def controller_torque(c: rod.Coefficients, q, fields: Fields, time, offset):
@@ -116,7 +117,7 @@ class _Formulation:
         rod_, model = self.rod, self.rod.model
         dx = rod_.measures[0]
         f, f_t = fields.roles()
-        self.kinetic = dolfinx.fem.form(model.kinetic_energy(f_t, rod_.c, dx))
+        self.kinetic = dolfinx.fem.form(model.kinetic_energy(f_t, rod_.c, dx, fields=f))
         self.potential = dolfinx.fem.form(model.stored_energy(
             f, rod_.c, rod_.degree, rod_.penalty, rod_.measures))
         self.power_nv = dolfinx.fem.form(model.non_variational_power(f, f_t, rod_.c, dx))

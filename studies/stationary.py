@@ -87,7 +87,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     elastica, references/shooting.py::solve_extensible, with model.kinematics = "extensible")
     where it applies: a scene off the x-z plane (the circle of Eq. 70) is solved
     without it, and ``summary["shooting"]`` says why."""
-    from rawehelix.references import shooting
+    from rawehelix.references import shooting, shooting_shear
 
     if params.discretisation.scheme != "fe":
         raise SceneError(params.name, "discretisation.scheme",
@@ -104,9 +104,11 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     reference = None
     if not_applicable is None:
         # the reference of each kinematics (model.kinematics), by name
-        solve_reference = {"paper": shooting.solve, "extensible": shooting.solve_extensible}
+        solve_reference = {"paper": shooting.solve, "extensible": shooting.solve_extensible,
+                           "shearable": shooting_shear.solve_shearable}
         reference = solve_reference[params.model.kinematics](q)
-        residual_at_shooting = solver.residual_at(reference.centre_line)  # collective
+        residual_at_shooting = solver.residual_at(  # collective
+            reference.centre_line, getattr(reference, "director", None))
     out = Stationary(params, None, None, None, None, None, state=result.state, rank=comm.rank)
     summary = None
     if comm.rank == 0:

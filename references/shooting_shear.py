@@ -1,0 +1,105 @@
+"""The stationary shearable rod's independent reference: the planar Simo-Reissner
+elastica shot as an ODE (model.kinematics = "shearable", forms/shearable.py).
+
+It shares no code with the FE forms: the strains and the equilibrium are written
+out here from the section's law.  With the section's normal d3 = (cos theta,
+sin theta), d1 = (-sin theta, cos theta) in the (x, z) plane (z down, as
+references/shooting.py) and the resultant N = N(0) - q s of the load q
+(shooting.load_vector),
+
+    N.d3 = sigma Gamma_3,   N.d1 = GA~ gamma,          (C_N = diag(GA, EA), Gamma = R^T r' - e3)
+    r' = (1 + Gamma_3) d3 + gamma d1,
+    (mu theta')' + r' x N = 0,   r' x N = (1 + Gamma_3) N.d1 - gamma N.d3,
+
+with the zero moments theta' = 0 at both ends (37).  As GA~ -> infinity gamma -> 0
+and the system is references/shooting.py::extensible_rhs without the EI law.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import root
+
+from rawehelix.references.shooting import _bending_modulus, _integrate, _top_conditions, load_vector
+
+
+def shearable_rhs(normalised, resultant0):
+    """f(s, y), y = (x, z, theta, kappa = theta')."""
+    q = normalised
+    sigma, shear, mu = q.sigma, q.shear_stiffness, _bending_modulus(q)
+    load = load_vector(q)
+    N0 = np.asarray(resultant0, dtype=float)
+
+    def f(s, y):
+        theta, kappa = y[2], y[3]
+        c, sn = np.cos(theta), np.sin(theta)
+        Nx, Nz = N0[0] - load[0] * s, N0[1] - load[1] * s
+        Nt, Nn = Nx * c + Nz * sn, -Nx * sn + Nz * c
+        stretch, gamma = 1.0 + Nt / sigma, Nn / shear
+        return np.array([stretch * c - gamma * sn, stretch * sn + gamma * c, kappa,
+                         -(stretch * Nn - gamma * Nt) / mu])
+
+    return f
+
+
+@dataclass
+class ShearableSolution:
+    """The stationary planar shearable rod; all quantities normalised."""
+
+    normalised: object
+    resultant0: np.ndarray
+    boundary_residual: float
+    _dense: object = field(repr=False, default=None)
+
+    def centre_line(self, s) -> np.ndarray:
+        y = self._dense(np.atleast_1d(np.asarray(s, dtype=float)))
+        return np.column_stack([y[0], 0 * y[0], y[1]])
+
+    def angle(self, s) -> np.ndarray:
+        """theta, the director's angle to x."""
+        return self._dense(np.atleast_1d(np.asarray(s, dtype=float)))[2]
+
+    def director(self, s) -> np.ndarray:
+        """d3 = [cos theta, 0, sin theta], shape (n, 3)."""
+        theta = self.angle(s)
+        return np.column_stack([np.cos(theta), 0 * theta, np.sin(theta)])
+
+    def tension(self, s) -> np.ndarray:
+        """N.d3 = sigma Gamma_3, the axial force."""
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        theta = self.angle(s)
+        N = self.resultant0[:, None] - np.outer(load_vector(self.normalised), s)
+        return N[0] * np.cos(theta) + N[1] * np.sin(theta)
+
+
+def solve_shearable(normalised, rtol: float = 1e-11, atol: float = 1e-13,
+                    tol: float = 1e-10) -> ShearableSolution:
+    """Shoot from s = 0 (r = 0, theta' = 0) for (N(0), theta(0)) to r(1) = the top of
+    Eq. (66) and theta'(1) = 0.  Raises RuntimeError past ``tol``."""
+    q = normalised
+    if not q.shear_stiffness > 0:
+        raise ValueError("the shearable reference needs GA > 0 (helix.GA_N)")
+    target = _top_conditions(q)
+    chord = math.hypot(*target)
+    t0 = target / chord
+    u0 = np.array([*(q.sigma * (chord - 1) * t0 + 0.5 * load_vector(q)),
+                   math.atan2(t0[1], t0[0])])
+
+    def end_state(u, dense=False):
+        return _integrate(shearable_rhs(q, u[:2]), 0.0, 1.0, np.array([0.0, 0.0, u[2], 0.0]),
+                          rtol, atol, dense)
+
+    def residual(u):
+        y1 = end_state(u).y[:, -1]
+        return np.array([y1[0] - target[0], y1[1] - target[1], y1[3]])
+
+    sol = root(residual, u0, method="hybr", options={"xtol": 1e-14})
+    mismatch = float(np.max(np.abs(residual(sol.x))))
+    if not np.isfinite(mismatch) or mismatch > tol:
+        raise RuntimeError(f"shearable shooting did not converge: boundary mismatch "
+                           f"{mismatch:.3e} > {tol:.1e} ({sol.message})")
+    return ShearableSolution(normalised=q, resultant0=sol.x[:2], boundary_residual=mismatch,
+                             _dense=end_state(sol.x, dense=True).sol)
