@@ -13,7 +13,9 @@ sections and keeps the others' last results.
 2. Cost of one time step against N (10 to 10^4) and the fitted exponent;
    ``section_law``: the same with the section laws against the solid (extensible
    kinematics both), ratios of medians at N = 100 and 1000, and the parts of an
-   orbit point of ``mobile_end`` at N = 8, 2 Hz, in CPU time (issue 29).
+   orbit point of ``mobile_end`` at N = 8, 2 Hz, in CPU time (issue 29);
+   ``shearable``: the shearable rod against the extensible one, the same two
+   measures (issue 30).
 3. The same FE sweep on 2 MPI ranks against 1 (mpirun, same command).
 4. The modal solve (20 eigenpairs) at N = 2000, p = 3.
 5. Real-time factor of the Sec. 5.2 and 5.3 scenes at converged resolution.
@@ -171,17 +173,20 @@ SECTION_LAW_N = (100, 1000)  # the section laws' step cost at these N
 SECTION_LAW_ORBIT = {"elements": 8, "f1_Hz": 2.0}  # an orbit point where every law is periodic
 
 
-def orbit_point_cost(law: str, repeats: int, elements: int, f1_Hz: float) -> dict:
+def orbit_point_cost(law: str, repeats: int, elements: int, f1_Hz: float,
+                     changes: dict | None = None) -> dict:
     """CPU time (time.process_time) of the FE orbits' parts for ``mobile_end`` with a
     section law, extensible kinematics: one plain period, one tangent (Floquet) period,
     and a point, the orbit at f1 + 0.05 Hz solved from the orbit at f1 (its Newton
-    iterations and the closing tangent period), ``repeats`` times each."""
+    iterations and the closing tangent period), ``repeats`` times each.  ``changes``:
+    Parameters.replace's sections instead (the shearable rod)."""
     from rawehelix.solvers.orbits import AlphaMap
     from rawehelix.studies import scene
     from rawehelix.studies.orbits import LEAD_IN_PERIODS
-    changes = {"model": {"kinematics": "extensible"}}
-    if law != "solid":
-        changes["section"] = {"law": law}
+    if changes is None:
+        changes = {"model": {"kinematics": "extensible"}}
+        if law != "solid":
+            changes["section"] = {"law": law}
     m = AlphaMap(scene.load("mobile_end", elements=elements, degree=3).replace(**changes))
     X = m.orbit(m.X_stationary, f1_Hz, lead_in=LEAD_IN_PERIODS).X
     plain, tangent, point, its = [], [], [], []
@@ -224,6 +229,30 @@ def bench_section_law(repeats: int, ladder=SECTION_LAW_N, orbit=SECTION_LAW_ORBI
         row[law] = orbit_point_cost(law, repeats, **orbit)
         row[f"{law}_ratio"] = {part: row[law][part]["median"] / row["solid"][part]["median"]
                                for part in ("plain_period_s", "tangent_period_s", "point_s")}
+    out["orbit_point"] = row
+    return out
+
+
+SHEARABLE = {"model": {"kinematics": "shearable"}, "helix": {"GA_N": 3896.0}}  # GA of the members
+
+
+def bench_shearable(repeats: int, ladder=SECTION_LAW_N, orbit=SECTION_LAW_ORBIT):
+    """Issue 30: one Newton iteration of a time step (:func:`newton_iteration_cost`) and
+    the parts of an orbit point (:func:`orbit_point_cost`) of the shearable rod (GA of
+    the members, 3896 N) against the extensible unshearable rod, same scenes and N, as
+    ratios of medians."""
+    extensible = {"model": {"kinematics": "extensible"}}
+    out = {}
+    step_repeats = max(repeats, 25)
+    for N in ladder:
+        row = {"extensible": newton_iteration_cost(N, step_repeats, **extensible),
+               "shearable": newton_iteration_cost(N, step_repeats, **SHEARABLE)}
+        row["ratio"] = row["shearable"]["median"] / row["extensible"]["median"]
+        out[str(N)] = row
+    row = {**orbit, "extensible": orbit_point_cost("", repeats, changes=extensible, **orbit),
+           "shearable": orbit_point_cost("", repeats, changes=SHEARABLE, **orbit)}
+    row["ratio"] = {part: row["shearable"][part]["median"] / row["extensible"][part]["median"]
+                    for part in ("plain_period_s", "tangent_period_s", "point_s")}
     out["orbit_point"] = row
     return out
 
@@ -460,6 +489,7 @@ TARGETS = {
     "sweep": "FE at converged N: as fast as or faster than the paper's N = 2 reference (ratio <= 1)",
     "step_cost": "linear in N (exponent 1)",
     "section_law": "tensegrity / solid <= 1.5 per step (issue 29)",
+    "shearable": "measured, no target (issue 30)",
     "mpi": "2 ranks: speed-up near 2 (2 cores)",
     "modal": "seconds (the paper: N = 2 only)",
     "rtf": {"sec5.2": "real-time factor >= 5 (Sec. 5.2)",
@@ -583,6 +613,19 @@ def markdown(r: dict) -> str:
                      f"kinematics, wall | solid {_spread(row['solid'], '.4f')}: tensegrity "
                      f"x{row['tensegrity_ratio']:.2f}, saturating x{row['saturating_ratio']:.2f} "
                      f"(ratios of medians) | {TARGETS['section_law']} |")
+    for N, row in (r.get("shearable") or {}).items():
+        if N == "orbit_point":
+            v = row["ratio"]
+            lines.append(
+                f"| 13. shearable rod (GA 3896 N) against the extensible rod, an orbit point of "
+                f"`mobile_end`, N = {row['elements']}, {row['f1_Hz']} Hz, CPU | extensible: point "
+                f"{_spread(row['extensible']['point_s'], '.2f')}; shearable x{v['plain_period_s']:.2f} "
+                f"(plain period), x{v['tangent_period_s']:.2f} (tangent period), x{v['point_s']:.2f} "
+                f"(point) | {TARGETS['shearable']} |")
+            continue
+        lines.append(f"| 13. shearable rod against the extensible rod, one Newton iteration of a "
+                     f"step, N = {N}, wall | extensible {_spread(row['extensible'], '.4f')}: "
+                     f"shearable x{row['ratio']:.2f} (ratio of medians) | {TARGETS['shearable']} |")
     if r.get("study"):
         lines.append(study_bench.markdown(r["study"]).replace("| ", "| 9. ", 1))
     for key, v in (r.get("orbits") or {}).items():
@@ -601,7 +644,7 @@ def markdown(r: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-SECTIONS = ("step_cost", "section_law", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
+SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
             "orbits", "curve")
 
 
@@ -627,6 +670,7 @@ def main():
     steps = (10, 30, 100, 300, 1000, 3000, 10000)
     for name, fn in (("step_cost", lambda: bench_step_cost(repeats, steps)),
                      ("section_law", lambda: bench_section_law(repeats)),
+                     ("shearable", lambda: bench_shearable(repeats)),
                      ("modal", lambda: bench_modal(repeats)),
                      ("rtf", lambda: bench_rtf(repeats)),
                      ("sweep", lambda: bench_sweep(f1, 1 if args.quick else args.sweep_repeats)),

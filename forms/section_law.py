@@ -113,6 +113,11 @@ class HelixTorsion:
         """The twist's stored energy per length, beta/2 tau^2 (forms/energy.py)."""
         return 0.5 * c.beta * tau**2
 
+    def shear_stiffness(self, eps, kappa, c):
+        """GA~ of the shearable rod (forms/shearable.py) at the strains: the scene's
+        helix.GA_N, unless the section's members give it."""
+        return c.shear
+
 
 class SolidSection(HelixTorsion):
     """The paper's section (the null object): forms/extensible.py::stored_energy."""
@@ -298,6 +303,14 @@ class TensegritySection(NonlinearSection):
         """N = dW/d eps."""
         eps, kappa, bends = self.member_state(r, c, alpha)
         return self.dW(eps, kappa, tau, bends)[0]
+
+    def shear_stiffness(self, eps, kappa, c):
+        """GA~ = n cos(beta) [k sin^2 beta + f (1 + cos^2 beta)] / 2 at the members' mean
+        force f = mean_m k <e_m>_w (members.py::Members.shear_stiffness: the members'
+        energy to second order in the shear strain, all taut)."""
+        cb, sb = math.cos(self.beta), math.sin(self.beta)
+        f = sum(self.k * ramp(e, self.width) for e in self.member_strains(eps, kappa)) / self.n
+        return self.n * cb * (self.k * sb * sb + f * (1 + cb * cb)) / 2
 
     def torque(self, eps, kappa, tau, bends=None):
         """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""

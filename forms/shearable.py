@@ -80,6 +80,7 @@ import ufl
 
 from rawehelix.forms.extensible import variation
 from rawehelix.forms.kinematics import K_E, d
+from rawehelix.forms.section_law import NonlinearSection
 
 #: the gauge's stiffness kappa_g, in units of sigma: any positive value gives the same
 #: solution (|n| = 1); sigma keeps the Jacobian's scale
@@ -113,14 +114,25 @@ def bending_strain(n):
     return d(director(n))
 
 
+def section_strains(r, n, c):
+    """(Gamma_3, kappa): the stretch and the regularised curvature |bending switch x d3'|
+    that a member section law reads (forms/section_law.py::NonlinearSection.curvature)."""
+    return stretch_strain(r, n), NonlinearSection.curvature(c.bending * bending_strain(n))
+
+
 def elastic_density(r, n, c):
     """sigma/2 Gamma_3^2 + GA~/2 |Gamma_s|^2 + mu/2 |d3'|^2 + the gauge's energy
-    (without the twist, whose energy alpha alone carries)."""
+    (without the twist, whose energy alpha alone carries); with a member section law
+    W(Gamma_3, |d3'|) + GA~(Gamma_3, |d3'|)/2 |Gamma_s|^2, GA~ the section's
+    (forms/section_law.py: the members' GA at their mean force, or helix.GA_N)."""
     g, k = shear_strain(r, n), bending_strain(n)
-    gauge = ufl.sqrt(ufl.dot(n, n)) - 1
-    return (0.5 * c.sigma * stretch_strain(r, n) ** 2 + 0.5 * c.shear * ufl.dot(g, g)
-            + 0.5 * c.bending_law.modulus(r, c) * ufl.dot(k, k)
-            + 0.5 * GAUGE * c.sigma * gauge ** 2)
+    gauge = 0.5 * GAUGE * c.sigma * (ufl.sqrt(ufl.dot(n, n)) - 1) ** 2
+    if c.section.name == "solid":
+        return (0.5 * c.sigma * stretch_strain(r, n) ** 2 + 0.5 * c.shear * ufl.dot(g, g)
+                + 0.5 * c.bending_law.modulus(r, c) * ufl.dot(k, k) + gauge)
+    eps, kappa = section_strains(r, n, c)
+    return (c.section.W(eps, kappa) + 0.5 * c.section.shear_stiffness(eps, kappa, c) * ufl.dot(g, g)
+            + gauge)
 
 
 def stored_energy(r, alpha, n, c, dx):

@@ -148,12 +148,13 @@ def check(params) -> None:
     are the variation of the members' energy, so it needs the extensible kinematics
     (model.kinematics = "extensible") of the FE scheme with the IP bending form."""
     section, disc = params.model.section, params.discretisation
-    if section.active and (params.model.kinematics != "extensible" or disc.scheme != "fe"
-                           or disc.bending != "ip"):
+    if section.active and (params.model.kinematics not in ("extensible", "shearable")
+                           or disc.scheme != "fe" or disc.bending != "ip"):
         raise ParameterError("section.law", section.law,
-                             f"'{section.law}' needs model.kinematics = 'extensible' on the FE "
-                             "scheme with discretisation.bending = 'ip' (its forces are the "
-                             "variation of the section's energy, forms/section_law.py)")
+                             f"'{section.law}' needs model.kinematics = 'extensible' (or "
+                             "'shearable') on the FE scheme with discretisation.bending = 'ip' "
+                             "(its forces are the variation of the section's energy, "
+                             "forms/section_law.py)")
     if section.active and params.helix.EI_law is not None:
         raise ParameterError("section.law", section.law,
                              f"'{section.law}' sets EI itself: remove helix.EI_law "

@@ -25,7 +25,7 @@ def thin_tube_GA(helix) -> float:
     return helix.GJ_Nm2 / (2 * helix.radius_m ** 2)
 
 
-def normalise(p, scales: dict) -> dict:
+def normalise(p, scales: dict) -> dict:  # (the members' GA is a field: forms/section_law.py)
     """GA~ = GA / (M g) (0 without GA_N) and, with the shearable kinematics and
     ``model.rotary_inertia``, the rotary inertia of a section about a diameter,
     rho I_d / (rho A L0^2) = EI / (EA L0^2): half the polar inertia of Eq. (27)
@@ -42,8 +42,10 @@ _REFUSED = {
     "helix.EI_law": "the EI law is written on the extensible rod's stored energy",
     "damping": "the Kelvin-Voigt potential is written on the unshearable rod's strains",
     "torsion_hysteresis": "the Bouc-Wen twist is not coupled to the shearable rod",
-    "section.law": "the members' law acts on the unshearable rod's strains only "
-                   "(the shearable rod takes helix.GA_N with the solid section)",
+    "section.torsion": "the members' torque is written on the unshearable rod's twist "
+                       "(keep torsion = 'helix')",
+    "section.ring": "the turning ring's phase is written on the unshearable rod's frame "
+                    "(keep ring = 'worst')",
     "model.gamma": "the shearable rod's twist is alpha' (gamma = 'off')",
 }
 
@@ -62,14 +64,28 @@ def check(params) -> None:
         raise ParameterError("model.kinematics", "shearable",
                              "is implemented by the FE scheme (discretisation.scheme = 'fe', "
                              "bending = 'ip', its default) only")
-    if helix.GA_N is None:
+    members = model.section.law == "tensegrity"
+    if helix.GA_N is None and not members:
         raise ParameterError("helix.GA_N", None,
-                             f"the shearable rod needs the shear stiffness GA [N]; a thin tube "
-                             f"of this helix's GJ and radius has GJ / (2 R^2) = "
+                             f"the shearable rod needs the shear stiffness GA [N] (or "
+                             f"section.law = 'tensegrity': the members' GA); a thin tube of "
+                             f"this helix's GJ and radius has GJ / (2 R^2) = "
                              f"{thin_tube_GA(helix):.4g} N")
+    if members and model.section.members(helix).shear_stiffness() <= 0:
+        raise ParameterError("section.law", "tensegrity",
+                             "with model.kinematics = 'shearable' the members need a shear "
+                             "stiffness of their own: without a lay or a self-stress their GA is "
+                             "the rod's tension, the lateral stiffness GA - T is zero and the "
+                             "sections turn freely (docs/explanation/shearable.md); set "
+                             "section.lay_angle_deg or section.self_stress_N")
+    if helix.GA_N is not None and members:
+        raise ParameterError("helix.GA_N", helix.GA_N,
+                             "with section.law = 'tensegrity' GA is the members' (members.py::"
+                             "Members.shear_stiffness, at their force): remove helix.GA_N")
     active = {"helix.EI_law": helix.EI_law is not None, "damping": model.damping.active,
               "torsion_hysteresis": model.torsion_hysteresis.active,
-              "section.law": model.section.active, "model.gamma": model.gamma != "off"}
+              "section.torsion": model.section.torsion != "helix",
+              "section.ring": model.section.ring != "worst", "model.gamma": model.gamma != "off"}
     for key, on in active.items():
         if on:
             raise ParameterError(key, "set", f"with model.kinematics = 'shearable': {_REFUSED[key]}")

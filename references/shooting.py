@@ -336,6 +336,18 @@ def solve_extensible(normalised: Normalised, rtol: float = 1e-11, atol: float = 
     Table 2).
 
     Raises RuntimeError if the conditions at s~ = 1 are not met to ``tol``."""
+    resultant0, mismatch, dense = shoot_planar_rod(normalised, extensible_rhs, "extensible",
+                                                   rtol, atol, tol)
+    return ExtensibleSolution(normalised=normalised, resultant0=resultant0,
+                              boundary_residual=mismatch, _dense=dense)
+
+
+def shoot_planar_rod(normalised: Normalised, rhs_of, name: str, rtol: float, atol: float,
+                     tol: float):
+    """Shoot a planar rod y = (x, z, theta, theta') with the right side ``rhs_of(q, N(0))``
+    from s~ = 0, where r = 0 (35) and theta' = 0, for the unknowns (N(0), theta(0)), to
+    r(1) = the top of Eq. (66) and theta'(1) = 0: (N(0), boundary mismatch, the dense
+    solution).  Raises RuntimeError (naming the rod ``name``) past ``tol``."""
     q = normalised
     target = _top_conditions(q)
     chord = math.hypot(*target)
@@ -344,7 +356,7 @@ def solve_extensible(normalised: Normalised, rtol: float = 1e-11, atol: float = 
                    math.atan2(t0[1], t0[0])])
 
     def end_state(u, dense=False):
-        f = extensible_rhs(q, u[:2])
+        f = rhs_of(q, u[:2])
         return _integrate(f, 0.0, 1.0, np.array([0.0, 0.0, u[2], 0.0]), rtol, atol, dense)
 
     def residual(u):
@@ -354,7 +366,6 @@ def solve_extensible(normalised: Normalised, rtol: float = 1e-11, atol: float = 
     sol = root(residual, u0, method="hybr", options={"xtol": 1e-14})
     mismatch = float(np.max(np.abs(residual(sol.x))))
     if not np.isfinite(mismatch) or mismatch > tol:
-        raise RuntimeError(f"extensible shooting did not converge: boundary mismatch "
+        raise RuntimeError(f"{name} shooting did not converge: boundary mismatch "
                            f"{mismatch:.3e} > {tol:.1e} ({sol.message})")
-    return ExtensibleSolution(normalised=q, resultant0=sol.x[:2], boundary_residual=mismatch,
-                              _dense=end_state(sol.x, dense=True).sol)
+    return sol.x[:2], mismatch, end_state(sol.x, dense=True).sol

@@ -17,13 +17,11 @@ and the system is references/shooting.py::extensible_rhs without the EI law.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import root
 
-from rawehelix.references.shooting import _bending_modulus, _integrate, _top_conditions, load_vector
+from rawehelix.references.shooting import _bending_modulus, load_vector, shoot_planar_rod
 
 
 def shearable_rhs(normalised, resultant0):
@@ -75,31 +73,22 @@ class ShearableSolution:
         return N[0] * np.cos(theta) + N[1] * np.sin(theta)
 
 
+def not_applicable(params) -> str | None:
+    """Why this reference does not apply to a shearable scene, or None: it takes a
+    constant GA (helix.GA_N), not the members' (section.law = "tensegrity")."""
+    if params.model.kinematics == "shearable" and params.helix.GA_N is None:
+        return ("the members' GA follows their force (section.law = 'tensegrity'); the "
+                "shearable shooting reference takes a constant GA (helix.GA_N)")
+    return None
+
+
 def solve_shearable(normalised, rtol: float = 1e-11, atol: float = 1e-13,
                     tol: float = 1e-10) -> ShearableSolution:
     """Shoot from s = 0 (r = 0, theta' = 0) for (N(0), theta(0)) to r(1) = the top of
     Eq. (66) and theta'(1) = 0.  Raises RuntimeError past ``tol``."""
-    q = normalised
-    if not q.shear_stiffness > 0:
+    if not normalised.shear_stiffness > 0:
         raise ValueError("the shearable reference needs GA > 0 (helix.GA_N)")
-    target = _top_conditions(q)
-    chord = math.hypot(*target)
-    t0 = target / chord
-    u0 = np.array([*(q.sigma * (chord - 1) * t0 + 0.5 * load_vector(q)),
-                   math.atan2(t0[1], t0[0])])
-
-    def end_state(u, dense=False):
-        return _integrate(shearable_rhs(q, u[:2]), 0.0, 1.0, np.array([0.0, 0.0, u[2], 0.0]),
-                          rtol, atol, dense)
-
-    def residual(u):
-        y1 = end_state(u).y[:, -1]
-        return np.array([y1[0] - target[0], y1[1] - target[1], y1[3]])
-
-    sol = root(residual, u0, method="hybr", options={"xtol": 1e-14})
-    mismatch = float(np.max(np.abs(residual(sol.x))))
-    if not np.isfinite(mismatch) or mismatch > tol:
-        raise RuntimeError(f"shearable shooting did not converge: boundary mismatch "
-                           f"{mismatch:.3e} > {tol:.1e} ({sol.message})")
-    return ShearableSolution(normalised=q, resultant0=sol.x[:2], boundary_residual=mismatch,
-                             _dense=end_state(sol.x, dense=True).sol)
+    resultant0, mismatch, dense = shoot_planar_rod(normalised, shearable_rhs, "shearable",
+                                                   rtol, atol, tol)
+    return ShearableSolution(normalised=normalised, resultant0=resultant0,
+                             boundary_residual=mismatch, _dense=dense)

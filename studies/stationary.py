@@ -100,7 +100,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     block = limits_block(params, solver)  # collective; before residual_at moves the state
     # the independent reference: Sys. (67), or the extensible elastica (with the EI law);
     # planar only: a scene off the x-z plane is reported without it
-    not_applicable = shooting.not_applicable(q)
+    not_applicable = shooting.not_applicable(q) or shooting_shear.not_applicable(params)
     reference = None
     if not_applicable is None:
         # the reference of each kinematics (model.kinematics), by name

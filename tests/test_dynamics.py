@@ -123,6 +123,35 @@ def perturbed(p, options, lateral=1e-3, twist=1e-3):
     return solver
 
 
+def energy_balance(solver, until: float, dt: float):
+    """(max |E - E(0)|, max |E - E(0) - W|, periods of y_mid), both over the perturbation
+    energy E(0) - E_stationary, of ``solver`` (:func:`perturbed`) run to ``until`` with
+    outputs every ``dt``: E = K + U (the model's forms), W the trapezoidal integral of the
+    non-variational terms' power."""
+    E, y, power = [], [], []
+    moving = solver.form.u.x.array.copy()
+    solver.form.u.x.array[:] = solver.stationary_w
+    e_stat = solver.energy()["potential"]
+    solver.form.u.x.array[:] = moving
+
+    def out(sv):
+        e = sv.energy()
+        E.append(e["kinetic"] + e["potential"])
+        power.append(e["power_nv"])
+        y.append(sv.probes.values()["y_mid"])
+    solver.advance(until, on_output=out, output_every=dt)
+    E, y, power = np.array(E), np.array(y), np.array(power)
+    work = np.concatenate([[0.0], np.cumsum(dt * (power[1:] + power[:-1]) / 2)])
+    periods = np.count_nonzero(np.diff(np.sign(y)) != 0) / 2
+    perturbation = E[0] - e_stat
+    drift = np.abs(E - E[0]).max() / perturbation
+    balance = np.abs(E - E[0] - work).max() / perturbation
+    print(f"\nenergy: {periods:.0f} periods, perturbation energy {perturbation:.3e}, "
+          f"max drift {drift:.2e}, max non-variational work {np.abs(work).max() / perturbation:.2e}, "
+          f"balance {balance:.2e}")
+    return drift, balance, periods
+
+
 def final_fields(solver):
     f = solver.probes.fields()
     return np.concatenate([f["r"].ravel(), f["alpha"]])
@@ -213,27 +242,7 @@ def test_energy_is_conserved(kinematics):
     solver = perturbed(p.replace(time={"dt_s": q.time_s(dt)}),
                        {"ts_alpha_radius": 1.0, "ts_adapt_type": "none"},
                        lateral=1e-2 / q.L0, twist=1e-3)
-    E, y, power = [], [], []
-    moving = solver.form.u.x.array.copy()
-    solver.form.u.x.array[:] = solver.stationary_w
-    e_stat = solver.energy()["potential"]
-    solver.form.u.x.array[:] = moving
-
-    def out(sv):
-        e = sv.energy()
-        E.append(e["kinetic"] + e["potential"])
-        power.append(e["power_nv"])
-        y.append(sv.probes.values()["y_mid"])
-    solver.advance(52 * period, on_output=out, output_every=dt)
-    E, y, power = np.array(E), np.array(y), np.array(power)
-    work = np.concatenate([[0.0], np.cumsum(dt * (power[1:] + power[:-1]) / 2)])
-    periods = np.count_nonzero(np.diff(np.sign(y)) != 0) / 2
-    perturbation = E[0] - e_stat
-    drift = np.abs(E - E[0]).max() / perturbation
-    balance = np.abs(E - E[0] - work).max() / perturbation
-    print(f"\nenergy: {periods:.0f} periods, perturbation energy {perturbation:.3e}, "
-          f"max drift {drift:.2e}, max non-variational work {np.abs(work).max() / perturbation:.2e}, "
-          f"balance {balance:.2e}")
+    drift, balance, periods = energy_balance(solver, 52 * period, dt)
     assert periods >= 50
     assert drift < 1e-3
     assert balance < 1e-6

@@ -259,3 +259,23 @@ def test_the_members_own_resultants_lie_in_the_cone(n, beta_deg, width):
     assert np.all(np.abs(r["M"]) <= m.saturation * m.R * r["N"] * (1 + 1e-12) + 1e-12)
     assert np.all(r["N"] >= 0)
     assert (np.abs(r["M"]) / (m.saturation * m.R * np.maximum(r["N"], 1e-300))).max() > 0.99
+
+
+@pytest.mark.parametrize("beta_deg, P0", [(0.0, 0.0), (0.0, 632.6), (16.8, 0.0), (30.0, 50.0)])
+def test_shear_stiffness_is_the_sheared_energy_curvature(beta_deg, P0):
+    """GA = n cos(beta) [k sin^2 beta + f (1 + cos^2 beta)] / 2 (the shearable rod's GA from
+    the members) against the second difference of the tethers' energy under a shear strain
+    (Members.sheared_energy, which writes the tethers' lengths out), to 1e-6; at beta = 0 with
+    no self-stress and tether force f it is n f, the tension: a ring of parallel tethers resists
+    shear by its tension alone; and the lay's part is GJ_el / (2 R^2)."""
+    m = Members(n=6, R=0.19, beta=math.radians(beta_deg), k=6000.0, P0=P0,
+                EA_b=1e4 if P0 else 0.0)
+    for f in (P0 + 30.0, P0 + 60.0):  # taut: at f = 0 half the tethers would go slack
+        h = 1e-4
+        numeric = (m.sheared_energy(h, f) - 2 * m.sheared_energy(0.0, f)
+                   + m.sheared_energy(-h, f)) / h**2
+        assert m.shear_stiffness(f) == pytest.approx(float(numeric), rel=1e-6)
+    if beta_deg == 0:
+        assert m.shear_stiffness(25.0) == pytest.approx(6 * 25.0)
+    GJ_el = m.taut_moduli()["GJ"] - m.n * math.cos(m.beta) ** 3 * m.R**2 * m.P0
+    assert m.shear_stiffness(0.0) == pytest.approx(GJ_el / (2 * m.R**2), rel=1e-12, abs=1e-9)
