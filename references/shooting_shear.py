@@ -17,11 +17,10 @@ and the system is references/shooting.py::extensible_rhs without the EI law.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from rawehelix.references.shooting import _bending_modulus, load_vector, shoot_planar_rod
+from rawehelix.references.shooting import (ExtensibleSolution, _bending_modulus, load_vector,
+                                           shoot_planar_rod)
 
 
 def shearable_rhs(normalised, resultant0):
@@ -43,34 +42,15 @@ def shearable_rhs(normalised, resultant0):
     return f
 
 
-@dataclass
-class ShearableSolution:
-    """The stationary planar shearable rod; all quantities normalised."""
-
-    normalised: object
-    resultant0: np.ndarray
-    boundary_residual: float
-    _dense: object = field(repr=False, default=None)
-
-    def centre_line(self, s) -> np.ndarray:
-        y = self._dense(np.atleast_1d(np.asarray(s, dtype=float)))
-        return np.column_stack([y[0], 0 * y[0], y[1]])
-
-    def angle(self, s) -> np.ndarray:
-        """theta, the director's angle to x."""
-        return self._dense(np.atleast_1d(np.asarray(s, dtype=float)))[2]
+class ShearableSolution(ExtensibleSolution):
+    """The stationary planar shearable rod, normalised: the extensible solution's
+    accessors on y = (x, z, theta, theta') with theta the director's angle, so that its
+    tension N.t is N.d3 (references/shooting.py, no EI law here) and :meth:`director`."""
 
     def director(self, s) -> np.ndarray:
         """d3 = [cos theta, 0, sin theta], shape (n, 3)."""
-        theta = self.angle(s)
+        theta = self._dense(np.atleast_1d(np.asarray(s, dtype=float)))[2]
         return np.column_stack([np.cos(theta), 0 * theta, np.sin(theta)])
-
-    def tension(self, s) -> np.ndarray:
-        """N.d3 = sigma Gamma_3, the axial force."""
-        s = np.atleast_1d(np.asarray(s, dtype=float))
-        theta = self.angle(s)
-        N = self.resultant0[:, None] - np.outer(load_vector(self.normalised), s)
-        return N[0] * np.cos(theta) + N[1] * np.sin(theta)
 
 
 def not_applicable(params) -> str | None:
