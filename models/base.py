@@ -86,9 +86,8 @@ class RodModel(abc.ABC):
         """U of the fields (:meth:`split`)."""
 
     @abc.abstractmethod
-    def kinetic_energy(self, rates: dict, c, dx, fields: dict | None = None):
-        """K of the rates (:meth:`split` of w_t) at the state ``fields`` (a rotary inertia
-        reads it)."""
+    def kinetic_energy(self, rates: dict, c, dx):
+        """K of the rates (:meth:`split` of w_t)."""
 
     @abc.abstractmethod
     def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):

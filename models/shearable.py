@@ -64,7 +64,7 @@ class ShearableRod(RodModel):
         return shearable.stored_energy(fields["centre_line"], fields["twist"], fields["director"],
                                        c, measures[0])
 
-    def kinetic_energy(self, rates: dict, c, dx, fields: dict | None = None):
+    def kinetic_energy(self, rates: dict, c, dx):
         return shearable.kinetic_density(rates["centre_line"], rates["twist"], rates["director"],
                                          c) * dx
 

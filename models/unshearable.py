@@ -102,7 +102,7 @@ class UnshearableRod(RodModel):
         return energy.potential(fields["centre_line"], fields["twist"], c, degree, penalty,
                                 measures, kappa=fields["curvature"])
 
-    def kinetic_energy(self, rates: dict, c, dx, fields: dict | None = None):
+    def kinetic_energy(self, rates: dict, c, dx):
         return energy.kinetic(rates["centre_line"], rates["twist"], c, dx)
 
     def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):

@@ -117,7 +117,7 @@ class _Formulation:
         rod_, model = self.rod, self.rod.model
         dx = rod_.measures[0]
         f, f_t = fields.roles()
-        self.kinetic = dolfinx.fem.form(model.kinetic_energy(f_t, rod_.c, dx, fields=f))
+        self.kinetic = dolfinx.fem.form(model.kinetic_energy(f_t, rod_.c, dx))
         self.potential = dolfinx.fem.form(model.stored_energy(
             f, rod_.c, rod_.degree, rod_.penalty, rod_.measures))
         self.power_nv = dolfinx.fem.form(model.non_variational_power(f, f_t, rod_.c, dx))
