@@ -37,6 +37,7 @@ import ufl
 
 from rawehelix.forms.coefficients import Coefficients
 from rawehelix.forms.extensible import variation
+from rawehelix.forms.twist import twist_equation
 from rawehelix.forms.kinematics import I_E, K_E, d, frenet_torsion_rate, tension, twist  # noqa: F401
 
 
@@ -91,7 +92,6 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
     ``c.kinematics = "extensible"``: the centre-line forces are the variation
     of the extensible rod's stored energy, :mod:`rawehelix.forms.extensible`
     (IP bending only; the twist terms are the same)."""
-    x = ufl.SpatialCoordinate(ds.ufl_domain())
     tau = twist(r, alpha, c.gamma_eps, c.gamma_coupling, k=kappa)  # (34)
     # the moment / GJ: tau, the members' Q / GJ (forms/section_law.py), or the
     # hysteresis component's (Fig. 5; the two are refused together)
@@ -109,9 +109,7 @@ def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx
             return c.kinematics.stored_energy(r, c, degree, penalty, dx, dS, kappa=kappa, twist=tau,
                                               ring=a)
         F += c.delta / c.beta * variation(energy, alpha, psi, dx.ufl_domain())
-    return (F + c.delta * moment * d(psi) * dx  # (31)
-            # (38)-(39): tau(0) = m0, tau(1) = mN; x = 0 or 1 on the two ends
-            - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)
+    return F + twist_equation(moment, psi, c, dx, ds)  # (31), (38)-(39)
 
 
 def test_fields(test):

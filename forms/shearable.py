@@ -81,6 +81,7 @@ import ufl
 from rawehelix.forms.extensible import variation
 from rawehelix.forms.kinematics import K_E, d
 from rawehelix.forms.section_law import NonlinearSection
+from rawehelix.forms.twist import twist_equation
 
 #: the gauge's stiffness kappa_g, in units of sigma: any positive value gives the same
 #: solution (|n| = 1); sigma keeps the Jacobian's scale
@@ -159,18 +160,14 @@ def twist_coupling(n, tau, eta, c):
                                   director_rate(n, eta))
 
 
-def elastic_residual(r, alpha, n, tests, c, dx, ds, moment=None):
-    """delta U on (r, n), the scaled twist equation (31) and the end torques (38)-(39):
-    the shearable rod's internal forces, as forms/rod.py::elastic_residual gives the
-    paper's (the twist equation times delta / beta, so it reads alpha_tt + ...)."""
+def elastic_residual(r, alpha, n, tests, c, dx, ds):
+    """delta U on (r, n), the scaled twist equation (31) and the end torques (38)-(39)
+    (forms/twist.py): the shearable rod's internal forces, as forms/rod.py::elastic_residual
+    gives the paper's (the twist equation times delta / beta, so it reads alpha_tt + ...)."""
     v, psi, eta = tests
-    x = ufl.SpatialCoordinate(ds.ufl_domain())
-    tau = d(alpha)  # K_3 = alpha'
-    moment = tau if moment is None else moment
+    tau = d(alpha)  # K_3 = alpha', the moment / GJ
     F = variation(lambda a, b: elastic_density(a, b, c) * dx, (r, n), (v, eta), dx.ufl_domain())
-    F += twist_coupling(n, moment, eta, c) * dx
-    return (F + c.delta * moment * d(psi) * dx  # (31)
-            - c.delta * (c.mN * x[0] - c.m0 * (1 - x[0])) * psi * ds)  # (38)-(39)
+    return F + twist_coupling(n, tau, eta, c) * dx + twist_equation(tau, psi, c, dx, ds)
 
 
 def non_variational_power(alpha, n, n_t, c, dx):

@@ -266,14 +266,21 @@ class ExtensibleSolution:
     def axial_force(self, s) -> np.ndarray:
         """N.t, the force along the tangent: the tension T plus the EI law's 1/2 mu' kappa^2."""
         s = np.atleast_1d(np.asarray(s, dtype=float))
-        theta = self._dense(s)[2]
-        N = self.resultant0[:, None] - np.outer(load_vector(self.normalised), s)
-        return N[0] * np.cos(theta) + N[1] * np.sin(theta)
+        return resultant_in_frame(self.resultant0, load_vector(self.normalised), s,
+                                  self._dense(s)[2])[2]
 
     def tension(self, s) -> np.ndarray:
         """T = sigma (|r'| - 1) = N.t - 1/2 mu' kappa^2, normalised (= N.t without the EI law)."""
         a, _ = bending_law(self.normalised)
         return self.axial_force(s) - 0.5 * a * self.normalised.sigma * self.curvature(s)**2
+
+
+def resultant_in_frame(resultant0, load, s, theta):
+    """(cos theta, sin theta, N.t, N.n) of the resultant N = N(0) - q s at s in the frame
+    t = (cos theta, sin theta), n = (-sin theta, cos theta) of a planar rod."""
+    c, sn = np.cos(theta), np.sin(theta)
+    Nx, Nz = resultant0[0] - load[0] * s, resultant0[1] - load[1] * s
+    return c, sn, Nx * c + Nz * sn, -Nx * sn + Nz * c
 
 
 def bending_law(normalised: Normalised) -> tuple[float, float]:
@@ -314,9 +321,7 @@ def extensible_rhs(normalised: Normalised, resultant0):
 
     def f(s, y):
         theta, kappa = y[2], y[3]
-        c, sn = np.cos(theta), np.sin(theta)
-        Nx, Nz = N0[0] - q[0] * s, N0[1] - q[1] * s
-        Nt, Nn = Nx * c + Nz * sn, -Nx * sn + Nz * c
+        c, sn, Nt, Nn = resultant_in_frame(N0, q, s, theta)
         eps = Nt / sigma - 0.5 * a * kappa**2
         lam, mu = 1.0 + eps, a * sigma * eps + b
         qt = q[0] * c + q[1] * sn

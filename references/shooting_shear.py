@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from rawehelix.references.shooting import (ExtensibleSolution, _bending_modulus, load_vector,
-                                           shoot_planar_rod)
+                                           resultant_in_frame, shoot_planar_rod)
 
 
 def shearable_rhs(normalised, resultant0):
@@ -31,10 +31,8 @@ def shearable_rhs(normalised, resultant0):
     N0 = np.asarray(resultant0, dtype=float)
 
     def f(s, y):
-        theta, kappa = y[2], y[3]
-        c, sn = np.cos(theta), np.sin(theta)
-        Nx, Nz = N0[0] - load[0] * s, N0[1] - load[1] * s
-        Nt, Nn = Nx * c + Nz * sn, -Nx * sn + Nz * c
+        c, sn, Nt, Nn = resultant_in_frame(N0, load, s, y[2])
+        kappa = y[3]
         stretch, gamma = 1.0 + Nt / sigma, Nn / shear
         return np.array([stretch * c - gamma * sn, stretch * sn + gamma * c, kappa,
                          -(stretch * Nn - gamma * Nt) / mu])
