@@ -23,9 +23,9 @@ Subpackages:
 
 __version__ = "0.2.0"
 
-from rawehelix.api import (Parameters, SceneError, SolverError, labtest, load_scene,  # noqa: E402
-                           modes, orbits, response, simulate, stationary, sweep,
+from rawehelix.api import (Parameters, SceneError, SolverError, envelope, labtest,  # noqa: E402
+                           load_scene, modes, orbits, response, simulate, stationary, sweep,
                            torsion_loop)
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters", "__version__"]
+           "envelope", "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters", "__version__"]

@@ -23,6 +23,7 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
 __all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
+           "envelope",
            "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters"]
 
 
@@ -126,7 +127,8 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
 
 
 def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None,
-           outdir=None, tension_step=None, max_points: int = 400, superharmonics=None):
+           outdir=None, tension_step=None, max_points: int = 400, superharmonics=None,
+           method: str = "shooting"):
     """The branch of periodic orbits of Sec. 5.3 from f1_start towards f1_stop [Hz]:
     shooting on the period map of the generalised-alpha integrator, Floquet
     multipliers from its tangent, pseudo-arclength continuation through folds,
@@ -138,12 +140,33 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     ``max_multiplier``, ``newton_iterations``), ``folds``, ``bifurcations``,
     ``peaks`` and ``summary``.  ``progress(orbit)`` is called at every point.
     Each rank of ``comm`` traces one f1 window (joined on rank 0); with
-    ``outdir`` every point is stored as found and a rerun resumes after the last."""
+    ``outdir`` every point is stored as found and a rerun resumes after the last.
+    ``method``: "shooting" (above), "hb" (harmonic balance, Hill's method for the
+    multipliers, H chosen by accuracy and reported per point) or "auto" (the rule
+    of :func:`rawehelix.studies.orbit_method.choose`)."""
     _resources(scene, "orbits")
     from rawehelix.studies import orbits as study
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
-                         superharmonics=superharmonics)
+                         superharmonics=superharmonics, method=method)
+
+
+def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=None,
+             outdir=None, method: str = "hb", progress=None):
+    """The operating envelope of Sec. 5.3's forced helix in (f1, KEY): ``vary`` is
+    "KEY=LO:HI[:COUNT]" (a dotted scene key, COUNT values, default 5); at each value the
+    branch over [f1_lo, f1_hi] (``method``: "hb", "shooting" or "auto"), the f1 where the
+    first limit of the structure is reached, and the folds continued in KEY (the band of
+    two coexisting stable responses).  An
+    :class:`~rawehelix.studies.envelope.EnvelopeResult` (``summary``, ``write(outdir)``:
+    summary.json and envelope.png).  The values are dealt to the ranks of ``comm``; with
+    ``outdir`` each value's branch is stored and a rerun resumes."""
+    from rawehelix.studies import envelope as study
+    from rawehelix.studies.sampling import Variable, parse_vary
+    _resources(scene, "orbits")
+    vary = vary if isinstance(vary, Variable) else parse_vary(vary)
+    return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=_world(comm), outdir=outdir,
+                         method=method, progress=progress)
 
 
 def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=None,

@@ -32,6 +32,8 @@ sections and keeps the others' last results.
 10. ``orbits``: the cost of a continuation point of the FE periodic orbits at
     N = 4 and 8 (benchmarks/orbits.py), the former full-Newton dense map
     against the chord steps with the sparse tangent, CPU time in one process.
+14. ``hb``: harmonic balance (benchmarks/harmonic_balance.py): the whole curve at N = 8
+    against the sweep, at N = 32, a fold curve over EI x 4, and a point's parts.
 11. ``curve``: the issue-13 target, the whole Fig. 8 curve by continuation
     (``rawehelix orbits --f1 15:0.5``, both branches) against the brute-force
     sweep (``rawehelix sweep --f1 0.5:15:0.5``) at the same N and dt, each a
@@ -52,6 +54,7 @@ from pathlib import Path
 
 import numpy as np
 
+import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
 import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
@@ -641,11 +644,13 @@ def markdown(r: dict) -> str:
                      f"N = {c['elements']}, CPU time of each command | "
                      f"{_spread(c['orbits_cpu_s'])} against {_spread(c['sweep_cpu_s'])}: ratio "
                      f"{c['ratio']:.2f} | {TARGETS['curve']} |")
+    if r.get("hb"):
+        lines += hb_bench.markdown(r["hb"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve")
+            "orbits", "curve", "hb")
 
 
 def main():
@@ -679,7 +684,8 @@ def main():
                      ("chord", lambda: bench_chord(repeats)),
                      ("study", lambda: study_bench.bench_study(repeats)),
                      ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
-                     ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats))):
+                     ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
+                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

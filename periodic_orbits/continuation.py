@@ -44,6 +44,7 @@ import logging
 import time
 
 import numpy as np
+import scipy.sparse
 
 from rawehelix.errors import SolverError
 from rawehelix.periodic_orbits import bifurcations
@@ -93,13 +94,22 @@ class State:
     natural: bool = False  # the next point by shooting at fixed f1, if no fold is near
 
     def arrays(self) -> dict:
-        return {"tau": self.tau, "A": self.A, "gf": self.gf, "w": self.w, "ds": np.array(self.ds),
+        A = {"A": self.A}
+        if scipy.sparse.issparse(self.A):  # harmonic balance's: CSR in four arrays
+            S = self.A.tocsr()
+            A = {"A": S.data, "A_indices": S.indices, "A_indptr": S.indptr,
+                 "A_shape": np.array(S.shape)}
+        return {"tau": self.tau, **A, "gf": self.gf, "w": self.w, "ds": np.array(self.ds),
                 "fresh": np.array(self.fresh), "natural": np.array(self.natural)}
 
     @classmethod
     def from_arrays(cls, data) -> "State":
         flag = lambda key: bool(data[key]) if key in data else False  # noqa: E731 (older stores)
-        return cls(tau=data["tau"], A=data["A"], gf=data["gf"], w=data["w"], ds=float(data["ds"]),
+        A = data["A"]
+        if "A_indptr" in data:
+            A = scipy.sparse.csr_matrix((A, data["A_indices"], data["A_indptr"]),
+                                        shape=tuple(int(x) for x in data["A_shape"]))
+        return cls(tau=data["tau"], A=A, gf=data["gf"], w=data["w"], ds=float(data["ds"]),
                    fresh=flag("fresh"), natural=flag("natural"))
 
 
@@ -122,7 +132,11 @@ class Branch:
         self.state: State | None = None
 
     def _bordered(self, A, gf, tau):
-        """[[G_X, G_f1], [(w^2 tau)^T]]: the corrector's and the tangent's matrix."""
+        """[[G_X, G_f1], [(w^2 tau)^T]]: the corrector's and the tangent's matrix
+        (sparse where the problem's G_X is)."""
+        if scipy.sparse.issparse(A):
+            row = (self.w**2 * tau)[None, :]
+            return scipy.sparse.bmat([[A, gf[:, None]], [row[:, :-1], row[:, -1:]]], format="csr")
         return np.block([[A, gf[:, None]], [(self.w**2 * tau)[None, :]]])
 
     def _tangent(self, orbit: Orbit, tau_prev, steps):
@@ -132,7 +146,7 @@ class Branch:
         K = self._bordered(A, gf, tau_prev)
         rhs = np.zeros(K.shape[0])
         rhs[-1] = 1.0
-        tau = np.linalg.solve(K, rhs)
+        tau = self.problem.factor(K).solve(rhs)
         return tau / np.linalg.norm(self.w * tau), A, gf
 
     def _cap(self, points, f1_s, ds, last_ds) -> float:
@@ -174,7 +188,7 @@ class Branch:
                 return self.problem.settle(X, G), f1, its, res, samples, refreshed
             r = np.concatenate([G, [(self.w**2 * tau) @ (Y - Y0) - ds]])
             if H is None:
-                H = Broyden(K)
+                H = Broyden(K, self.problem.factor)
             elif previous is not None:  # the secant of the last step
                 H.update(Y - previous[0], r - previous[1])
             previous = (Y, r)
@@ -217,9 +231,20 @@ class Branch:
         ds = self._cap(self.points, tau[-1], self.ds, None)
         self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=ds)
 
+    def _restart(self, prev: Orbit, st: State):
+        """The branch's last point replaced by ``prev`` at a finer resolution (a larger
+        X): its tangent from the old one padded, the metric's state weight kept."""
+        n = prev.X.size
+        tau = np.append(self.problem.embed(st.tau[:-1], prev.steps), st.tau[-1])
+        self.w = np.append(np.full(n, self.w[0]), self.w[-1])
+        tau, A, gf = self._tangent(prev, tau, prev.steps)
+        self.points[-1] = prev
+        self.state = State(tau=tau, A=A, gf=gf, w=self.w.copy(), ds=st.ds, fresh=True)
+
     def resume(self, points: list[Orbit], state: State, folds=(), bifurcations=(), peaks=()):
         """Continue from stored points and the state after the last of them."""
         self.points, self.state, self.w = list(points), state, state.w.copy()
+        self.problem.resume_from(self.points[-1])
         self.folds, self.bifurcations = list(folds), list(bifurcations)
         self.peaks = list(peaks)
 
@@ -268,6 +293,10 @@ class Branch:
                 continue
             if not natural:
                 orbit = self.problem.finish(X, f1, its, res, start, steps)
+            again = self.problem.refine(prev, orbit)
+            if again is not None:  # a finer resolution from here on: redo the step from prev
+                self._restart(again, st)
+                continue
             # the new point's tangent with the steps it was found with (a natural step:
             # its own at its f1); the events between the two with the last point's
             tau_new, A, gf = self._tangent(orbit, st.tau, orbit.steps)

@@ -45,10 +45,10 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import scipy.linalg
 
 from rawehelix.errors import SolverError
-from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem  # noqa: F401  (Orbit re-exported)
+from rawehelix.periodic_orbits.problem import (DenseLU, Orbit,  # noqa: F401  (Orbit re-exported)
+                                               PeriodicOrbitProblem)
 
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
 #: a Newton iteration on a held monodromy (a chord) that leaves more than this fraction of
@@ -72,13 +72,13 @@ class Broyden:
     the directions the steps take, where a period of the map costs a tenth of
     a fresh monodromy (a tangent period of 3n columns)."""
 
-    def __init__(self, B: np.ndarray):
-        self.lu = scipy.linalg.lu_factor(B)
+    def __init__(self, B, factor=DenseLU):
+        self.lu = factor(B)  # solve(r, transpose): problem.factor
         self.terms: list[tuple[np.ndarray, np.ndarray]] = []  # (u, v): H += u v^T
 
     def solve(self, r: np.ndarray, transpose: bool = False) -> np.ndarray:
         """H r (or H^T r)."""
-        x = scipy.linalg.lu_solve(self.lu, r, trans=1 if transpose else 0)
+        x = self.lu.solve(r, transpose)
         for u, v in self.terms:
             x += v * (u @ r) if transpose else u * (v @ r)
         return x

@@ -49,6 +49,7 @@ import dataclasses
 from typing import Callable
 
 import numpy as np
+import scipy.linalg
 
 
 @dataclasses.dataclass
@@ -74,6 +75,10 @@ class Orbit:
     internal_multipliers: np.ndarray | None = dataclasses.field(default=None, repr=False)
     #: G = P(X) - X - Delta e_alpha at X, from the Floquet period (None: not kept)
     G: np.ndarray | None = dataclasses.field(default=None, repr=False)
+    #: dG/dX at X where the problem keeps it apart from a monodromy (harmonic balance)
+    jacobian: object = dataclasses.field(default=None, repr=False)
+    #: the resolution's own accuracy at the orbit (harmonic balance: H, samples, tail)
+    accuracy: dict = dataclasses.field(default_factory=dict)
 
     @property
     def max_multiplier(self) -> float:
@@ -91,6 +96,8 @@ class Orbit:
                "steps_per_period": self.steps, "wall_s": self.wall_s}
         if self.defects:
             out["defects"] = dict(self.defects)
+        if self.accuracy:
+            out["accuracy"] = dict(self.accuracy)
         if self.internal_multipliers is not None:
             mu = self.internal_multipliers
             out["internal_multipliers"] = {
@@ -126,6 +133,16 @@ class Observable:
         return self.of_samples(samples)
 
 
+class DenseLU:
+    """scipy's LU of a dense matrix, with solve(r, transpose)."""
+
+    def __init__(self, K):
+        self.lu = scipy.linalg.lu_factor(K)
+
+    def solve(self, r, transpose: bool = False) -> np.ndarray:
+        return scipy.linalg.lu_solve(self.lu, r, trans=1 if transpose else 0)
+
+
 class PeriodicOrbitProblem(abc.ABC):
     """The periodic orbits of the forced rod as a problem in unknowns X and f1 [Hz]
     (see the module docstring).  ``resolution``: the discretisation of the period
@@ -159,6 +176,26 @@ class PeriodicOrbitProblem(abc.ABC):
     @abc.abstractmethod
     def jacobian(self, orbit: Orbit) -> np.ndarray:
         """dG/dX at an orbit of :meth:`finish`, as :meth:`residual` gives it."""
+
+    def factor(self, K):
+        """A factorisation of K (dG/dX, or the continuation's bordered matrix on it) with
+        ``solve(r, transpose=False)``: dense LU here; a problem with sparse Jacobians
+        gives its own (harmonic balance: PETSc's)."""
+        return DenseLU(K)
+
+    def refine(self, prev: Orbit, orbit: Orbit) -> Orbit | None:
+        """Where ``orbit`` (the point after ``prev``) is not resolved to the problem's
+        accuracy: raise the resolution for the rest of the branch and return ``prev``
+        solved again at it (the continuation retries the step from there); None: it is
+        resolved (shooting: the steps per period follow f1 by themselves)."""
+        return None
+
+    def embed(self, X, resolution: int) -> np.ndarray:
+        """X (or a vector in X's space) at another resolution (:meth:`refine`)."""
+        return X
+
+    def resume_from(self, orbit: Orbit) -> None:
+        """Take up the resolution of a stored branch's last point (a resumed trace)."""
 
     @abc.abstractmethod
     def norm(self, G, X) -> float:

@@ -22,7 +22,8 @@ directory per window, whole or not at all and checked when read
 
 Both schemes: the FE generalised-alpha map (:mod:`rawehelix.solvers.orbits`)
 and the paper's spline-Galerkin flow (:mod:`rawehelix.references.spline_galerkin.orbits`),
-chosen by ``discretisation.scheme`` (``--scheme spline``).
+chosen by ``discretisation.scheme`` (``--scheme spline``); or harmonic balance on the
+FE rod (``method``, :mod:`rawehelix.studies.orbit_method`).
 
 Superharmonic sites: the lateral natural frequencies f_n of the scene's
 linearisation (the families the end's circle drives; the FE's SLEPc modes or
@@ -31,9 +32,6 @@ sites f_n / k (k in ``superharmonics``, default 2 and 3) inside the window,
 where the continuation's step closes in on the multiplier's crossing of +1
 (the step guards of :mod:`rawehelix.periodic_orbits.resonances`, given to the
 continuation by :func:`branch` with T max, the branch's observable).
-
-Not yet: the free twist rotation without a controller
-(refused).
 """
 
 from __future__ import annotations
@@ -49,6 +47,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.studies import branch_limits, schemes, writers
+from rawehelix.studies.orbits_report import report  # noqa: F401  (the command's text)
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
@@ -72,18 +71,27 @@ class OrbitsResult:
     tension_step: float = 0.0
     scheme: str = "fe"  # "fe" (generalised-alpha, dt_s) or "spline" (Radau, adaptive)
     superharmonics: tuple = ()  # the orders k of the sites the step closed in on
+    method: str = "shooting"  # the periodic-orbit problem: "shooting" or "hb"
+    method_reason: str = ""  # why (studies/orbit_method.py::choose)
+    orbits: list = field(default_factory=list, repr=False)  # the Orbits, in branch order
 
     @property
     def discretisation(self) -> str:
         if self.scheme == "spline":
             return f"spline N = {self.elements}, Radau"
+        if self.method == "hb":
+            Hs = [p["accuracy"]["H"] for p in self.branch if "accuracy" in p] or [0]
+            return (f"N = {self.elements}, p = {self.degree}, harmonic balance H = "
+                    f"{min(Hs)}-{max(Hs)}")
         return f"N = {self.elements}, p = {self.degree}, dt = {self.dt_s * 1e3:g} ms"
 
     @property
     def summary(self) -> dict:
         return {"scene": self.scene, "scheme": self.scheme, "elements": self.elements,
                 "degree": self.degree,
-                "dt_s": self.dt_s, "torque": "the ramp (69) at its final value",
+                "dt_s": self.dt_s if self.method == "shooting" else None,
+                "method": self.method, "method_reason": self.method_reason,
+                "torque": "the ramp (69) at its final value",
                 "tension_step": self.tension_step,
                 "superharmonic_orders": list(self.superharmonics),
                 "branch": self.branch, "folds": self.folds, "bifurcations": self.bifurcations,
@@ -158,11 +166,14 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
     return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
 
 
-def period_map(params: Parameters):
-    """The scene's scheme's period map on this rank: the FE generalised-alpha
-    map, or the paper's spline-Galerkin flow (``discretisation.scheme``)."""
+def period_map(params: Parameters, method: str = "shooting"):
+    """The scene's periodic-orbit problem on this rank: shooting on its scheme's
+    period map (the FE generalised-alpha map, or the paper's spline-Galerkin flow,
+    ``discretisation.scheme``) or harmonic balance (``method`` "hb",
+    studies/orbit_method.py)."""
+    from rawehelix.studies import orbit_method
     refuse_turning_ring(params)
-    return schemes.of(params).period_map(params)
+    return orbit_method.problem(params, method)
 
 
 def refuse_turning_ring(params: Parameters) -> None:
@@ -207,14 +218,14 @@ def branch(m, tension_step: float | None = None, sites=(), **options):
 
 
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
-                  superharmonics=()):
+                  superharmonics=(), method="shooting"):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
     from rawehelix.periodic_orbits.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
 
     start_f1, stop_f1 = window
     lo, hi = sorted(window)
-    m = period_map(params)
+    m = period_map(params, method)
     sites, about = (), {"sites": []}
     if superharmonics:
         try:
@@ -247,16 +258,19 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
                  on_point=store.save if store else None)
     limits = branch_limits.OrbitLimits(m, params)  # one period more an orbit (AlphaMap.sections)
     entries = [limits.entry(o) for o in traced.points]
+    about["orbits"] = traced.points  # for the envelope (not in the summary)
     return entries, traced.folds, traced.bifurcations, traced.peaks, about
 
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
             progress=None, outdir=None, tension_step: float | None = None,
-            max_points: int = 400, superharmonics=None) -> OrbitsResult:
+            max_points: int = 400, superharmonics=None, method: str = "shooting") -> OrbitsResult:
     """The branch from f1_start to f1_stop (either order), one window per rank
     of ``comm``; with ``outdir``, stored point by point and resumed from it.
     ``superharmonics``: the orders k of the k:1 sites the step closes in on
-    (default SUPERHARMONIC_ORDERS; () for none)."""
+    (default SUPERHARMONIC_ORDERS; () for none); ``method``: "shooting", "hb" or
+    "auto" (studies/orbit_method.py)."""
+    from rawehelix.studies import orbit_method
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
@@ -264,6 +278,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
                           f"different frequencies > 0 [Hz]")
     refuse_turning_ring(params)  # before any output
+    method, method_reason = orbit_method.choose(params, method)
     tension_step = TENSION_STEP if tension_step is None else tension_step
     superharmonics = tuple(SUPERHARMONIC_ORDERS if superharmonics is None else superharmonics)
     if any(int(k) != k or k < 2 for k in superharmonics):
@@ -274,7 +289,8 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     if outdir is not None:
         from rawehelix.studies.sweep_store import fingerprint
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
-                  "tension_step": tension_step, "superharmonics": list(superharmonics)}
+                  "tension_step": tension_step, "superharmonics": list(superharmonics),
+                  **({"method": method} if method != "shooting" else {})}
         store = WindowStore.open(Path(outdir), header, comm)
 
     def stop():  # another rank failed: stop here too
@@ -284,7 +300,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     error, sent, piece = None, [], None
     try:
         piece = _trace_window(params, cuts[comm.rank], tension_step, max_points, store,
-                              progress, stop, superharmonics)
+                              progress, stop, superharmonics, method)
     except _Stopped:
         error = (False, f"rank {comm.rank}: stopped")
     except Exception as err:  # noqa: BLE001 - reported on every rank below
@@ -308,6 +324,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     if comm.rank == 0:
         result = _join(params, cuts, pieces, tension_step, time.perf_counter() - start)
         result.superharmonics = superharmonics
+        result.method, result.method_reason = method, method_reason
     return comm.bcast(result, root=0)
 
 
@@ -318,7 +335,9 @@ class _Stopped(Exception):
 def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
     """The windows' pieces in order, with T max on both sides of each cut."""
     branch, folds, bifurcations, found, info, junctions = [], [], [], [], [], []
+    orbits = []
     for k, (entries, f, b, p, sites) in enumerate(pieces):
+        orbits += sites.pop("orbits", [])
         if k > 0:
             left, right, x = branch[-2:], entries[0], cuts[k][0]
             if len(left) < 2:
@@ -342,48 +361,4 @@ def _join(params, cuts, pieces, tension_step, wall_s) -> OrbitsResult:
                         scheme=disc.scheme,
                         branch=branch, folds=folds,
                         bifurcations=bifurcations, wall_s=wall_s, peaks=found, windows=info,
-                        junctions=junctions, tension_step=tension_step)
-
-
-def report(result: OrbitsResult) -> str:
-    s = result.summary
-    lines = [f"{result.title}: {len(s['branch'])} periodic orbits, {result.discretisation}, "
-             f"in {result.wall_s:.1f} s "
-             f"(torque: {s['torque']})"]
-    unstable = [p["f1_Hz"] for p in s["branch"] if not p["stable"]]
-    lines.append(f"  largest Floquet multiplier modulus: "
-                 f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
-                 f"{len(unstable)}")
-    ratio = s.get("limits", {}).get("moment_ratio_max")
-    if ratio:
-        lines.append(f"  largest |M| / (N R): {ratio['value']:.3f} at f1 = {ratio['f1_Hz']:.4f} Hz")
-    for w in s["windows"]:
-        if "sites_error" in w:
-            lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
-    defects = [p["defects"] for p in s["branch"] if "defects" in p]
-    if defects:  # carried entries (hysteretic torsion: z, periodic_orbits/floquet.py)
-        internal = [p["internal_multipliers"] for p in s["branch"]
-                    if p.get("internal_multipliers", {}).get("count")]
-        lines.append("  carried along by the shooting (hysteretic torsion's z): largest drift of "
-                     "z over a period " + f"{max(d.get('z', 0.0) for d in defects):.2g}" +
-                     " of z, largest residual after it " +
-                     f"{max(d.get('carried', 0.0) for d in defects):.2g}" +
-                     (f"; z's multipliers (set aside from the stability) within "
-                      f"{max(i.get('max_distance_to_1', 0.0) for i in internal):.1g} of 1"
-                      if internal else ""))
-    for kind, items in (("fold", s["folds"]), ("bifurcation", s["bifurcations"]),
-                        ("peak", s["peaks"])):
-        for x in items:
-            error = f" (+- {x['f1_error_Hz']:.1e} Hz)" if "f1_error_Hz" in x else ""
-            if x.get("kind") == "superharmonic":
-                error = (f" ({x['order']}:1 of {x['f_n_Hz']:.3f} Hz, |mu - 1| = "
-                         f"{x['distance']:.3g}, T max - T min {x['oscillation_N']:.3f} N)")
-            lines.append(f"  {x.get('kind', kind)} at f1 = {x['f1_Hz']:.4f} Hz{error}, "
-                         f"T max = {x['tension_max_N']:.2f} N")
-    for j in s["junctions"]:
-        if not j["same_branch"]:
-            lines.append(f"  warning: at the cut f1 = {j['f1_Hz']:.4f} Hz between two ranks' "
-                         f"windows T max is {j['tension_max_N_left']:.2f} N on the left and "
-                         f"{j['tension_max_N_right']:.2f} N on the right: the windows are on "
-                         f"different branches there (trace it on one rank)")
-    return "\n".join(lines)
+                        junctions=junctions, tension_step=tension_step, orbits=orbits)

@@ -121,7 +121,8 @@ class WindowStore:
                                 multipliers=mu, newton_iterations=e["newton_iterations"],
                                 residual=e["residual"], steps=e["steps_per_period"],
                                 wall_s=e["wall_s"], defects=e.get("defects", {}),
-                                internal_multipliers=internal))
+                                internal_multipliers=internal,
+                                accuracy=e.get("accuracy", {})))
             for ev in record["events"]:
                 kind = "peak" if ev["kind"] == "superharmonic" else ev["kind"]
                 events.get(kind, events["bifurcation"]).append(ev)

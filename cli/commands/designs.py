@@ -97,11 +97,39 @@ def _write_and_say(comm, result, text: str, outdir) -> int:
     return result.exit_status
 
 
+def _envelope_arguments(p):
+    p.add_argument("--vary", required=True, metavar="KEY=LO:HI[:COUNT]",
+                   help="the dotted scene key across the map and its range (COUNT values, "
+                        "default 5), e.g. helix.EI_Nm2=2000:8000:5 or ends.elongation")
+    p.add_argument("--f1", required=True, metavar="LO:HI", help="the f1 window in Hz")
+    p.add_argument("--method", default="hb", choices=("hb", "shooting", "auto"),
+                   help="the periodic-orbit problem of the branches and the fold curves "
+                        "(default hb)")
+
+
+def _envelope(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import envelope
+    try:
+        lo, hi = (float(x) for x in args.f1.split(":"))
+    except ValueError:
+        raise SceneError("--f1", args.f1, "must be LO:HI in Hz") from None
+    result = rh.envelope(params, args.vary, lo, hi, comm=comm, outdir=outdir,
+                         method=args.method,
+                         progress=lambda v, o: say(comm, f"  {v:g}: f1 = {o.f1_Hz:.4f} Hz, "
+                                                   f"T max {o.tension_max_N:.2f} N"))
+    if comm.rank == 0:
+        result.write(outdir)
+    say(comm, envelope.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
 COMMANDS = [
     Command("converge", "refinement study and work-precision figure", _converge_arguments,
             _converge, kept="runs/*.json"),
     Command("study", "named quantities over a design of scene keys, on MPI ranks",
             _study_arguments, _study, kept="points/*.json"),
+    Command("envelope", "design map in (f1, a scene key): folds, first limits, stability",
+            _envelope_arguments, _envelope, kept="tick*/window*/p*.json"),
     Command("calibrate", "fit scene keys to target quantities (least squares)",
             _calibrate_arguments, _calibrate, kept="points/*.json"),
 ]

@@ -101,6 +101,11 @@ def _orbits_arguments(p):
                    help="orders k of the k:1 resonances f_n / k of the lateral natural "
                         "frequencies where the step closes in on a multiplier's "
                         "crossing of +1 ('none': the T max step only)")
+    p.add_argument("--method", default="shooting", choices=("shooting", "hb", "auto"),
+                   help="the periodic-orbit problem: shooting on the period map, harmonic "
+                        "balance ('hb': H chosen by accuracy, Hill's method for the "
+                        "multipliers) or 'auto' (hb where every law is smooth; the choice "
+                        "and its reason are in summary.json)")
 
 
 def _orbits(rh, params, args, outdir, comm) -> int:
@@ -123,10 +128,12 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
-                           superharmonics=orders,
+                           superharmonics=orders, method=args.method,
                            progress=lambda o: say(comm, f"  f1 = {o.f1_Hz:.4f} Hz: T max "
                                                   f"{o.tension_max_N:.2f} N, |multiplier| "
-                                                  f"{o.max_multiplier:.5f}"))
+                                                  f"{o.max_multiplier:.5f}" + (
+                                                      f", H = {o.accuracy['H']}"
+                                                      if o.accuracy else "")))
     except orbits.OrbitsStoreError as err:
         raise SceneError("-o", str(outdir), str(err)) from None
     if comm.rank == 0:

@@ -1,0 +1,268 @@
+"""`rawehelix envelope SCENE --vary KEY=LO:HI[:COUNT] --f1 LO:HI`: the operating
+envelope in (f1, KEY), a design map (issue 31).
+
+For COUNT values of the dotted scene key KEY (default DEFAULT_VALUES, the "ticks"):
+
+1. the one-parameter branch over the f1 window (``rawehelix orbits``, by harmonic
+   balance unless ``method`` says otherwise), with its folds, bifurcations and each
+   point's limits block (studies/branch_limits.py);
+2. the boundary where the first limit is reached: the f1 where a point's
+   ``first_limit`` changes along the branch, located by bisection in f1 between the
+   two branch points (FIRST_LIMIT_BISECTIONS orbits at fixed f1 and KEY, each with its
+   limits over a period), reported with its bracket;
+3. the fold curves: each fold of a tick continued in KEY to the next tick by the
+   minimally augmented system (periodic_orbits/fold_curve.py), FOLD_SUBSTEPS natural
+   steps a tick; its end is checked against the next tick's own fold
+   (``fold_check_Hz``), and a fold that has no partner there ends at a cusp, said so.
+   Where the two folds of a resonance exist, two stable responses coexist between them.
+
+Period doublings and Neimark-Sackers are reported per tick (the branches'
+``bifurcations``), not continued in KEY.
+
+MPI: the ticks are dealt to the ranks (a rank's ticks, one branch each); the fold
+curves are traced on rank 0 from the gathered ticks.  Resumable (``outdir``): each
+tick's branch is an orbits store (``tick<k>/``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.errors import SceneError, SolverError
+from rawehelix.parameters import Parameters
+from rawehelix.studies import branch_limits, orbits, writers
+from rawehelix.studies.sampling import Variable
+
+DEFAULT_VALUES = 5  # ticks when --vary gives no COUNT
+FOLD_SUBSTEPS = 4  # natural steps in KEY from one tick's fold to the next tick
+FIRST_LIMIT_BISECTIONS = 8  # the limit's f1 to 1/256 of the branch's spacing
+FOLD_CHECK_HZ = 1e-3  # a fold curve's end and the next tick's fold agree within this
+FOLD_MATCH_HZ = 0.05  # the next tick's fold nearer than this is the same fold (checked)
+
+
+def values_of(vary: Variable) -> list[float]:
+    from rawehelix.studies.study import cast
+    count = vary.count or DEFAULT_VALUES
+    if count < 2:
+        raise SceneError("--vary", f"{vary.key}={vary.start}:{vary.stop}:{count}",
+                         "an envelope needs COUNT >= 2 values of KEY")
+    return [cast(vary.key, v) for v in np.linspace(vary.start, vary.stop, count)]
+
+
+def params_at(params: Parameters, key: str, value) -> Parameters:
+    """``params`` with the dotted scene key set (SceneError for a key the scene has not)."""
+    section, _, name = key.partition(".")
+    holder = getattr(params, section, None)
+    if holder is None and hasattr(params.model, section):  # [damping], [section], ...
+        holder = getattr(params.model, section)
+    if holder is None or not name or not hasattr(holder, name):
+        raise SceneError("--vary", key, "is not a scene key (example.toml lists them)")
+    try:
+        return params.replace(**{section: {name: value}})
+    except (TypeError, ValueError) as err:
+        raise SceneError("--vary", f"{key}={value}", str(err)) from None
+
+
+@dataclasses.dataclass
+class EnvelopeResult:
+    scene: str
+    title: str
+    key: str
+    values: list
+    f1_window_Hz: list
+    method: str
+    method_reason: str
+    elements: int
+    ticks: list  # per value: branch (f1, T max, stable, first_limit), folds, ...
+    fold_curves: list
+    limit_curve: list
+    wall_s: float
+    fold_curves_wall_s: float = 0.0
+
+    @property
+    def summary(self) -> dict:
+        checks = [abs(c["fold_check_Hz"]) for c in self.fold_curves
+                  if c.get("fold_check_Hz") is not None]
+        return {"scene": self.scene, "key": self.key, "values": self.values,
+                "f1_window_Hz": self.f1_window_Hz, "method": self.method,
+                "method_reason": self.method_reason, "elements": self.elements,
+                "ticks": self.ticks, "fold_curves": self.fold_curves,
+                "limit_curve": self.limit_curve,
+                "fold_check_max_Hz": max(checks) if checks else None,
+                "fold_curves_wall_s": self.fold_curves_wall_s, "wall_s": self.wall_s}
+
+    def write(self, outdir) -> Path:
+        from rawehelix.studies.envelope_figure import envelope_png
+        outdir = Path(outdir)
+        outdir.mkdir(parents=True, exist_ok=True)
+        writers.write_json(outdir / "summary.json", self.summary)
+        envelope_png(outdir / "envelope.png", self.summary, self.title)
+        return outdir
+
+
+def _tick(params, key, value, f1_window, method, outdir, progress):
+    """One value of KEY: its branch, limit crossings and fold starts."""
+    p = params_at(params, key, value)
+    lo, hi = f1_window
+    branch = orbits.compute(p, hi, lo, comm=MPI.COMM_SELF, method=method, superharmonics=(),
+                            outdir=None if outdir is None else Path(outdir),
+                            progress=progress)
+    points = branch.orbits
+    m = orbits.period_map(p, branch.method)
+    limits = branch_limits.OrbitLimits(m, p)
+    crossings = [_crossing(m, limits, a, b, ea["first_limit"], eb["first_limit"], value)
+                 for a, b, ea, eb in zip(points, points[1:], branch.branch, branch.branch[1:])
+                 if (ea["first_limit"] is None) != (eb["first_limit"] is None)]
+    starts = []
+    for fold in branch.folds:
+        fa, fb = fold["bracket_Hz"]
+        for a, b in zip(points, points[1:]):
+            if a.f1_Hz == fa and b.f1_Hz == fb:
+                starts.append({"f1_Hz": fold["f1_Hz"], "Xa": a.X, "Xb": b.X,
+                               "resolution": a.steps})
+    tick = {"value": value, "branch": [
+        {k: e.get(k) for k in ("f1_Hz", "tension_max_N", "stable", "first_limit")}
+        for e in branch.branch], "folds": branch.folds, "bifurcations": branch.bifurcations,
+        "wall_s": branch.wall_s}
+    return tick, crossings, starts, branch.method, branch.method_reason
+
+
+def _crossing(m, limits, a, b, ka, kb, value) -> dict:
+    """The f1 between branch points a and b where the first limit is reached (or left),
+    by bisection at fixed f1 from the nearer point's orbit."""
+    X, H = a.X, a.steps
+    reached = lambda o: limits.block(o)["first_limit"] is not None  # noqa: E731
+    side_a = reached(a)
+    f_lo, f_hi, kind = a.f1_Hz, b.f1_Hz, kb or ka
+    try:
+        for _ in range(FIRST_LIMIT_BISECTIONS):
+            mid = 0.5 * (f_lo + f_hi)
+            o = m.orbit(X, mid, steps=H)
+            if reached(o) == side_a:
+                f_lo, X = mid, o.X
+            else:
+                f_hi = mid
+                kind = limits.block(o)["first_limit"]["kind"] if reached(o) else kind
+    except SolverError:  # near a fold f1 does not parametrise the branch: the bracket stands
+        pass
+    return {"value": value, "f1_Hz": 0.5 * (f_lo + f_hi), "f1_error_Hz": 0.5 * abs(f_hi - f_lo),
+            "kind": kind if isinstance(kind, str) else None, "entering": not side_a}
+
+
+def _fold_curves(params, key, values, ticks, starts, method, substeps):
+    """Each tick's folds continued to the next tick (rank 0)."""
+    from rawehelix.periodic_orbits import fold_curve
+    curves = []
+    problems = {}
+
+    def problem_at(v):
+        if v not in problems:
+            problems.clear()  # one at a time: each holds a rod
+            problems[v] = orbits.period_map(params_at(params, key, v), method)
+        return problems[v]
+
+    for k in range(len(values) - 1):
+        v0, v1 = values[k], values[k + 1]
+        for s in starts[k]:
+            m = problem_at(v0)
+            d = s["Xb"] - s["Xa"]
+            d /= max(np.linalg.norm(d), 1e-300)
+            curve = {"from_value": v0, "to_value": v1, "points": [], "end": None,
+                     "fold_check_Hz": None}
+            try:
+                first = fold_curve.locate(m, 0.5 * (s["Xa"] + s["Xb"]), s["f1_Hz"],
+                                          s["resolution"], d, d, p=v0)
+            except SolverError as err:
+                curve["end"] = f"not located at the tick: {err}"
+                curves.append(curve)
+                continue
+            curve["tick_fold_Hz"] = s["f1_Hz"]
+            folds, why = fold_curve.trace(problem_at, first, v1, (v1 - v0) / substeps)
+            curve["points"] = [{"value": f.p, "f1_Hz": f.f1_Hz} for f in folds]
+            curve["end"] = why
+            end = folds[-1].f1_Hz
+            partners = [f["f1_Hz"] for f in ticks[k + 1]["folds"]]
+            near = min(partners, key=lambda f: abs(f - end)) if partners else None
+            if folds[-1].p != v1:
+                pass
+            elif near is not None and abs(near - end) <= FOLD_MATCH_HZ:
+                curve["fold_check_Hz"] = end - near
+            else:  # the next tick's branch has no fold here: it left the window there
+                curve["end"] += (f"; the branch at {key} = {v1:g} has no fold near "
+                                 f"{end:.4f} Hz (outside the f1 window, or not traced)")
+            curves.append(curve)
+    return curves
+
+
+def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
+            comm=MPI.COMM_WORLD, outdir=None, method: str = "hb", progress=None,
+            substeps: int = FOLD_SUBSTEPS) -> EnvelopeResult:
+    """The envelope (module docstring); ``progress(value, orbit)`` at every branch point."""
+    if not (0 < f1_lo < f1_hi):
+        raise SceneError("--f1", f"{f1_lo}:{f1_hi}", "must be LO:HI with 0 < LO < HI [Hz]")
+    values = values_of(vary)
+    for v in values:
+        params_at(params, vary.key, v)  # every value checked before any work
+    start = time.perf_counter()
+    mine, error = [], None
+    for k in range(comm.rank, len(values), comm.size):
+        tick_dir = None if outdir is None else Path(outdir) / f"tick{k}"
+        each = None if progress is None else (lambda o, v=values[k]: progress(v, o))
+        try:
+            mine.append((k, _tick(params, vary.key, values[k], (f1_lo, f1_hi), method,
+                                  tick_dir, each)))
+        except Exception as err:  # noqa: BLE001 - raised on every rank below
+            if comm.size == 1:
+                raise
+            error = f"rank {comm.rank} ({vary.key} = {values[k]}): {type(err).__name__}: {err}"
+            break
+    errors = [e for e in comm.allgather(error) if e]
+    if errors:
+        raise SolverError("envelope: " + "; ".join(errors))
+    gathered = comm.gather(mine, root=0)
+    result = None
+    if comm.rank == 0:
+        pieces = dict(kv for part in gathered for kv in part)
+        ticks = [pieces[k][0] for k in range(len(values))]
+        crossings = [c for k in range(len(values)) for c in pieces[k][1]]
+        starts = [pieces[k][2] for k in range(len(values))]
+        used, reason = pieces[0][3], pieces[0][4]
+        clock = time.perf_counter()
+        curves = _fold_curves(params, vary.key, values, ticks, starts, used, substeps)
+        fold_wall = time.perf_counter() - clock
+        result = EnvelopeResult(scene=params.name, title=params.title, key=vary.key,
+                                values=values, f1_window_Hz=[f1_lo, f1_hi], method=used,
+                                method_reason=reason,
+                                elements=params.discretisation.elements, ticks=ticks,
+                                fold_curves=curves, limit_curve=crossings,
+                                wall_s=time.perf_counter() - start,
+                                fold_curves_wall_s=fold_wall)
+    return comm.bcast(result, root=0)
+
+
+def report(result: EnvelopeResult) -> str:
+    s = result.summary
+    lines = [f"{result.title}: envelope in (f1, {result.key}) over {len(result.values)} "
+             f"values, {result.method} ({result.method_reason}), N = {result.elements}, "
+             f"in {result.wall_s:.1f} s"]
+    for t in s["ticks"]:
+        folds = ", ".join(f"{f['f1_Hz']:.4f}" for f in t["folds"]) or "none"
+        lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits, folds at "
+                     f"{folds} Hz")
+    for c in s["limit_curve"]:
+        lines.append(f"  first limit ({c['kind']}) {'reached' if c['entering'] else 'left'} at "
+                     f"f1 = {c['f1_Hz']:.4f} Hz (+- {c['f1_error_Hz']:.1e}) for "
+                     f"{result.key} = {c['value']:g}")
+    for c in s["fold_curves"]:
+        lines.append(f"  fold curve from {c['from_value']:g} to {c['to_value']:g}: "
+                     f"{len(c['points'])} points, {c['end']}")
+    worst = s["fold_check_max_Hz"]
+    if worst is not None:
+        flag = "" if worst <= FOLD_CHECK_HZ else f"  WARNING: above {FOLD_CHECK_HZ:g} Hz"
+        lines.append(f"  fold curves against the ticks' own folds: within {worst:.2e} Hz{flag}")
+    return "\n".join(lines)

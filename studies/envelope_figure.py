@@ -1,0 +1,88 @@
+"""The envelope's figure: f1 across, the varied key up; each value's branch drawn as a
+row coloured by what a designer needs (single stable response within the limits,
+coexisting responses, a limit exceeded, unstable), the fold curves bounding the band
+of coexistence and the first-limit boundary over them.  Plots take data (the summary)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from rawehelix.studies import writers
+
+COLOURS = {"single": "tab:green", "coexisting": "tab:orange", "limit": "tab:red",
+           "unstable": "0.55"}
+LABELS = {"single": "single stable response within limits", "coexisting":
+          "coexisting stable responses", "limit": "limit exceeded", "unstable": "unstable"}
+
+
+def classify(tick: dict) -> list[str]:
+    """Each branch point's class: unstable; a limit reached; stable inside the band of
+    two folds (coexisting); or the single stable response within the limits."""
+    folds = sorted(f["f1_Hz"] for f in tick["folds"])
+    band = (folds[0], folds[-1]) if len(folds) >= 2 else None
+    out = []
+    for p in tick["branch"]:
+        if not p["stable"]:
+            out.append("unstable")
+        elif p["first_limit"] is not None:
+            out.append("limit")
+        elif band and band[0] <= p["f1_Hz"] <= band[1]:
+            out.append("coexisting")
+        else:
+            out.append("single")
+    return out
+
+
+def envelope_png(path: Path, summary: dict, title: str) -> Path:
+    plt = writers._pyplot()
+    fig, ax = plt.subplots(figsize=(8, 5))
+    draw(ax, summary)
+    return writers._finish(fig, path, title)
+
+
+def panels_png(path: Path, summaries: list, titles: list, title: str, columns: int = 2) -> Path:
+    """Several envelopes side by side (the README's design maps)."""
+    plt = writers._pyplot()
+    rows = -(-len(summaries) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(6.5 * columns, 4.2 * rows), squeeze=False)
+    for ax, summary, name in zip(axes.flat, summaries, titles):
+        draw(ax, summary)
+        ax.set_title(name, fontsize=9)
+    for ax in list(axes.flat)[len(summaries):]:
+        ax.axis("off")
+    return writers._finish(fig, path, title)
+
+
+def draw(ax, summary: dict):
+    """One envelope on the axes ``ax``."""
+    values = summary["values"]
+    gap = (max(values) - min(values)) / max(len(values) - 1, 1)
+    seen = set()
+    for tick in summary["ticks"]:
+        f = np.array([p["f1_Hz"] for p in tick["branch"]])
+        classes = classify(tick)
+        # the branch as a short band about its value; the unstable part above it
+        for i in range(len(f) - 1):
+            kind = classes[i + 1] if classes[i] != classes[i + 1] else classes[i]
+            y = tick["value"] + (0.12 * gap if kind == "unstable" else 0.0)
+            ax.plot(f[i:i + 2], [y, y], color=COLOURS[kind], lw=6 if kind != "unstable" else 2,
+                    solid_capstyle="butt", label=None if kind in seen else LABELS[kind])
+            seen.add(kind)
+        for fold in tick["folds"]:
+            ax.plot(fold["f1_Hz"], tick["value"], "k|", ms=14)
+    for k, curve in enumerate(summary["fold_curves"]):
+        pts = curve["points"]
+        if pts:
+            ax.plot([p["f1_Hz"] for p in pts], [p["value"] for p in pts], "k-", lw=1.2,
+                    label=None if k else "fold curves (two-parameter continuation)")
+    limit = sorted(summary["limit_curve"], key=lambda c: c["value"])
+    if limit:
+        ax.plot([c["f1_Hz"] for c in limit], [c["value"] for c in limit], "rx--", lw=1,
+                label="first limit reached")
+    ax.set_xlabel("f1 [Hz]")
+    ax.set_ylabel(summary["key"])
+    ax.set_xlim(*summary["f1_window_Hz"])
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="best")

@@ -1,0 +1,59 @@
+"""Which periodic-orbit problem traces a scene's orbits (``--method``): shooting on
+the scheme's period map or harmonic balance (solvers/harmonic_balance.py), and
+the rule of ``auto``, stated once here and reported with every result
+(docs/explanation/harmonic_balance.md, "Where HB is the wrong tool")."""
+
+from __future__ import annotations
+
+from rawehelix.errors import SceneError
+from rawehelix.parameters import Parameters
+
+METHODS = ("shooting", "hb", "auto")
+
+
+def cannot(params: Parameters) -> str | None:
+    """Why harmonic balance cannot trace ``params``'s orbits (None: it can): an
+    internal variable or a free rotation breaks its unknowns."""
+    if params.discretisation.scheme != "fe":
+        return "the spline reference has a period map only (shooting)"
+    from rawehelix.solvers import harmonic_balance
+    return harmonic_balance.cannot(params)
+
+
+def wrong_tool(params: Parameters) -> str | None:
+    """Why harmonic balance is the wrong tool for ``params`` (None: it is not): what
+    :func:`cannot` says, or a non-smooth law that needs many harmonics (then ``hb``
+    runs when asked for, its H raised by the tail test, and ``auto`` shoots)."""
+    if params.model.section.active:
+        return ("the members' slack is a non-smooth law: past the first slack member the "
+                "orbits need many harmonics, where shooting's cost does not grow")
+    return cannot(params)
+
+
+def choose(params: Parameters, method: str) -> tuple[str, str]:
+    """(the method that runs, why): ``auto`` takes harmonic balance unless
+    :func:`wrong_tool` says otherwise; ``hb`` where it is the wrong tool is
+    refused (bad input)."""
+    if method not in METHODS:
+        raise SceneError("--method", method, f"must be one of {METHODS}")
+    why = wrong_tool(params)
+    if method == "hb" and cannot(params):
+        raise SceneError("--method", method, f"harmonic balance is the wrong tool here: "
+                         f"{cannot(params)}; use --method shooting (or auto)")
+    if method == "auto":
+        if why:
+            return "shooting", f"auto: shooting, as {why}"
+        return "hb", "auto: harmonic balance, as every law of the scene is smooth"
+    if method == "hb" and why:
+        return method, f"as asked; warning: {why}"
+    return method, "as asked"
+
+
+def problem(params: Parameters, method: str):
+    """The periodic-orbit problem of ``method`` (one of :func:`choose`'s answers)
+    on this rank."""
+    if method == "hb":
+        from rawehelix.solvers.harmonic_balance import HarmonicBalance
+        return HarmonicBalance(params)
+    from rawehelix.studies import schemes
+    return schemes.of(params).period_map(params)

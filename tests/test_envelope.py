@@ -1,0 +1,114 @@
+"""The operating envelope (issue 31): fold curves continued in a scene key end on the
+next value's own one-parameter folds, the first-limit boundary is where fixed-f1 orbits
+change their limit, ranks agree, a killed run resumes."""
+
+import json
+import types
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import rawehelix as rh
+from rawehelix.errors import SceneError
+from rawehelix.studies import envelope
+
+VARY, F1 = "helix.EI_Nm2=4381:4600:2", (11.9, 13.0)  # N = 2: folds near 12.01 and 12.74 Hz
+
+
+def _scene():
+    return rh.load_scene("mobile_end", elements=2, degree=3)
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    out = tmp_path_factory.mktemp("envelope")
+    result = rh.envelope(_scene(), VARY, *F1, outdir=out, comm=MPI.COMM_SELF)
+    result.write(out)
+    return result, out
+
+
+def test_fold_curves_end_on_the_next_values_own_folds(small):
+    """Each fold of EI = 4381 continued to 4600 by the minimally augmented system lands
+    on the fold that the one-parameter branch at 4600 finds within 1e-3 Hz, and starts on
+    its own branch's fold within that fold's error estimate."""
+    result, _ = small
+    s = result.summary
+    assert [len(t["folds"]) for t in s["ticks"]] == [2, 2]
+    curves = s["fold_curves"]
+    assert len(curves) == 2
+    for c in curves:
+        assert c["fold_check_Hz"] is not None and abs(c["fold_check_Hz"]) <= 1e-3, c
+        assert c["points"][-1]["value"] == 4600.0
+        own = next(f for f in s["ticks"][0]["folds"] if f["f1_Hz"] == c["tick_fold_Hz"])
+        assert abs(c["points"][0]["f1_Hz"] - own["f1_Hz"]) <= own["f1_error_Hz"] + 1e-4
+    assert s["fold_check_max_Hz"] <= envelope.FOLD_CHECK_HZ
+
+
+def test_the_summary_is_documented_and_the_map_drawn(small):
+    from tests.test_docs import undocumented
+    result, out = small
+    assert undocumented(json.loads((out / "summary.json").read_text())) == []
+    assert (out / "envelope.png").stat().st_size > 0
+    assert "fold curve from 4381 to 4600" in envelope.report(result)
+
+
+def test_a_killed_run_resumes(small, tmp_path):
+    """The last three stored points of the second value's branch removed (a run killed
+    there): a rerun computes just those again and ends with the same envelope."""
+    import shutil
+    result, out = small
+    again = tmp_path / "again"
+    shutil.copytree(out, again)
+    window = again / "tick1" / "window0"
+    stored = sorted(window.glob("p*.json"))
+    for p in stored[-3:]:
+        p.unlink()
+        p.with_suffix(".npz").unlink()
+    resumed = rh.envelope(_scene(), VARY, *F1, outdir=again, comm=MPI.COMM_SELF)
+    strip = lambda ticks: [{k: v for k, v in t.items() if k != "wall_s"} for t in ticks]  # noqa: E731
+    assert strip(resumed.summary["ticks"]) == strip(result.summary["ticks"])
+    assert resumed.summary["fold_curves"] == result.summary["fold_curves"]
+    log = (window / "computed.log").read_text().split("\n")[:-1]
+    assert len(log) == len(stored) + 3  # the first run's points, then the three again
+
+
+def test_the_limit_boundary_is_where_fixed_f1_orbits_change():
+    """The bisection of envelope._crossing on a stand-in problem whose limit is reached
+    above 12.3456 Hz: the boundary is located within its bracket, and the bracket is
+    below 1/256 of the points' spacing."""
+    orbit = lambda f1: types.SimpleNamespace(f1_Hz=f1, X=np.zeros(1), steps=3)  # noqa: E731
+    m = types.SimpleNamespace(orbit=lambda X, f1, steps=None: orbit(f1))
+    limits = types.SimpleNamespace(block=lambda o: {"first_limit": (
+        {"kind": "slack"} if o.f1_Hz > 12.3456 else None)})
+    c = envelope._crossing(m, limits, orbit(12.0), orbit(12.5), None, "slack", 1.0)
+    assert abs(c["f1_Hz"] - 12.3456) <= c["f1_error_Hz"] <= 0.5 / 256
+    assert c["kind"] == "slack" and c["entering"]
+
+
+def test_the_key_and_window_are_checked():
+    with pytest.raises(SceneError, match="not a scene key"):
+        rh.envelope(_scene(), "helix.no_such_key=1:2:2", *F1)
+    with pytest.raises(SceneError, match="COUNT >= 2"):
+        rh.envelope(_scene(), "helix.EI_Nm2=4000:5000:1", *F1)
+    with pytest.raises(SceneError, match="LO:HI"):
+        rh.envelope(_scene(), VARY, 13.0, 11.0)
+    with pytest.raises(SceneError):  # a value the scene's own checks refuse
+        rh.envelope(_scene(), "helix.EI_Nm2=-1:5000:2", *F1)
+
+
+@pytest.mark.mpi
+def test_one_and_two_ranks_agree():
+    """Under mpirun -n 2: each rank traces one value's branch; the envelope equals a
+    serial one (rank 0 alone)."""
+    comm = MPI.COMM_WORLD
+    if comm.size != 2:
+        pytest.skip("deals two values to two ranks: run under mpirun -n 2")
+    window = (12.8, 13.0)  # a few points of each branch
+    world = rh.envelope(_scene(), VARY, *window, comm=comm)
+    if comm.rank == 0:
+        serial = rh.envelope(_scene(), VARY, *window, comm=MPI.COMM_SELF)
+        assert world.summary["ticks"] == [dict(t, wall_s=w["wall_s"]) for t, w in
+                                          zip(serial.summary["ticks"], world.summary["ticks"])]
+        assert world.summary["fold_curves"] == serial.summary["fold_curves"]
+    comm.barrier()
