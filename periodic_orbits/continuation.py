@@ -57,6 +57,10 @@ log = logging.getLogger(__name__)
 NATURAL_STEP = 0.5  # a natural step moves f1 by at most this fraction of itself
 STOP_TOL = 1e-9  # relative: a point this near the window's end ends the trace
 SLOW = 6  # two correctors in a row of this many iterations turn to natural steps
+#: a corrector whose step is this small (relative to Y) with |G| within FLOOR_FACTOR of
+#: the tolerance is converged: |G| is at its round-off floor (harmonic balance at N = 32:
+#: the axial rows' scale grows like N^2, and so does |G|'s floor)
+FLOOR_STEP, FLOOR_FACTOR = 1e-12, 1e3
 
 
 class StepGuard:
@@ -192,7 +196,14 @@ class Branch:
             elif previous is not None:  # the secant of the last step
                 H.update(Y - previous[0], r - previous[1])
             previous = (Y, r)
-            Y = Y - H.solve(r)
+            step = H.solve(r)
+            Y = Y - step
+            if np.linalg.norm(step) <= FLOOR_STEP * max(1.0, np.linalg.norm(Y)) \
+                    and res <= FLOOR_FACTOR * self.tol:  # G at its round-off floor
+                X, f1 = Y[:n], float(Y[-1])
+                G, samples, _ = self.problem.residual(X, f1, resolution=steps)
+                return self.problem.settle(X, G), f1, its, self.problem.norm(G, X), samples, \
+                    refreshed
         return None
 
     def _natural(self, prev: Orbit, st: State, f1_stop: float) -> Orbit | None:

@@ -55,7 +55,8 @@ FINE = 256  # samples of T(0) per period for its extremes (a smooth signal's max
 SHIFTS = 2  # the least damped exponents of the averaged system used as Hill shifts
 BACKTRACK_MIN = 1.0 / 64  # the shortest fraction of a Newton step tried
 STEP_TOL = 1e-12  # a Newton correction this small (relative to X): converged at G's floor
-HOMOTOPY_MIN = 1.0 / 64  # the shortest step in the end's amplitude (HarmonicBalance._start)
+HOMOTOPY_MIN = 1.0 / 64
+START_RETRIES = 2  # the first orbit's search, H raised this many times where it fails  # the shortest step in the end's amplitude (HarmonicBalance._start)
 
 
 def cannot(params: Parameters) -> str | None:
@@ -262,12 +263,16 @@ class HarmonicBalance(PeriodicOrbitProblem):
         start = time.perf_counter()
         H = steps or self.H
         X = self.embed(X0, H)
+        retries = 0
         while True:
             try:
                 X, its, res = self._start(X, f1_Hz, H, tol, max_it)
-            except SolverError:
-                if steps or H >= self.H_max:  # else too few harmonics may hold no orbit
-                    raise
+            except SolverError as err:
+                retries += 1  # too few harmonics may hold no orbit: twice more, then say so
+                if steps or H >= self.H_max or retries > START_RETRIES:
+                    raise SolverError(f"{err} (tried H up to {H}: a non-smooth law, such as "
+                                      f"the members' slack, needs many harmonics; "
+                                      f"--method shooting)") from None
                 H = min(self.H_max, max(H + 2, math.ceil(1.5 * H)))
                 X = self.embed(X0, H)
                 continue

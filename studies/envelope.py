@@ -251,9 +251,9 @@ def report(result: EnvelopeResult) -> str:
              f"values, {result.method} ({result.method_reason}), N = {result.elements}, "
              f"in {result.wall_s:.1f} s"]
     for t in s["ticks"]:
-        folds = ", ".join(f"{f['f1_Hz']:.4f}" for f in t["folds"]) or "none"
-        lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits, folds at "
-                     f"{folds} Hz")
+        folds = ", ".join(f"{f['f1_Hz']:.4f}" for f in t["folds"])
+        lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits, "
+                     + (f"folds at {folds} Hz" if folds else "no fold in the window"))
     for c in s["limit_curve"]:
         lines.append(f"  first limit ({c['kind']}) {'reached' if c['entering'] else 'left'} at "
                      f"f1 = {c['f1_Hz']:.4f} Hz (+- {c['f1_error_Hz']:.1e}) for "

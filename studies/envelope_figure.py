@@ -60,18 +60,43 @@ def draw(ax, summary: dict):
     values = summary["values"]
     gap = (max(values) - min(values)) / max(len(values) - 1, 1)
     seen = set()
+    cuts = {}
+    for c in summary["limit_curve"]:
+        cuts.setdefault(c["value"], []).append(c["f1_Hz"])
+
+    def segment(f, kind, value):
+        y = value + (0.12 * gap if kind == "unstable" else 0.0)
+        ax.plot(f, [y, y], color=COLOURS[kind], lw=6 if kind != "unstable" else 2,
+                solid_capstyle="butt", label=None if kind in seen else LABELS[kind])
+        seen.add(kind)
+
     for tick in summary["ticks"]:
         f = np.array([p["f1_Hz"] for p in tick["branch"]])
         classes = classify(tick)
-        # the branch as a short band about its value; the unstable part above it
+        # the branch as a band at its value (the unstable part above it), split at the
+        # located first-limit crossings
         for i in range(len(f) - 1):
-            kind = classes[i + 1] if classes[i] != classes[i + 1] else classes[i]
-            y = tick["value"] + (0.12 * gap if kind == "unstable" else 0.0)
-            ax.plot(f[i:i + 2], [y, y], color=COLOURS[kind], lw=6 if kind != "unstable" else 2,
-                    solid_capstyle="butt", label=None if kind in seen else LABELS[kind])
-            seen.add(kind)
+            a, b = classes[i], classes[i + 1]
+            inside = [x for x in cuts.get(tick["value"], []) if min(f[i:i + 2]) < x < max(f[i:i + 2])]
+            if a != b and inside:
+                segment([f[i], inside[0]], a, tick["value"])
+                segment([inside[0], f[i + 1]], b, tick["value"])
+            else:
+                segment(f[i:i + 2], b if a != b else a, tick["value"])
         for fold in tick["folds"]:
             ax.plot(fold["f1_Hz"], tick["value"], "k|", ms=14)
+    by_start = {}
+    for curve in summary["fold_curves"]:
+        if curve["points"]:
+            by_start.setdefault(curve["from_value"], []).append(curve["points"])
+    band = False
+    for pair in by_start.values():  # two folds from one value: the band between them
+        if len(pair) == 2 and len(pair[0]) == len(pair[1]):
+            y = [p["value"] for p in pair[0]]
+            ax.fill_betweenx(y, [p["f1_Hz"] for p in pair[0]], [p["f1_Hz"] for p in pair[1]],
+                             color=COLOURS["coexisting"], alpha=0.35, lw=0,
+                             label=None if band else "two stable responses coexist")
+            band = True
     for k, curve in enumerate(summary["fold_curves"]):
         pts = curve["points"]
         if pts:
@@ -85,4 +110,6 @@ def draw(ax, summary: dict):
     ax.set_ylabel(summary["key"])
     ax.set_xlim(*summary["f1_window_Hz"])
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    lo, hi = min(values), max(values)
+    ax.set_ylim(lo - 0.4 * gap, hi + 1.3 * gap)  # room above the rows for the legend
+    ax.legend(fontsize=7, loc="upper left", ncol=2, framealpha=0.9)

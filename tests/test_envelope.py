@@ -53,6 +53,7 @@ def test_the_summary_is_documented_and_the_map_drawn(small):
     assert "fold curve from 4381 to 4600" in envelope.report(result)
 
 
+@pytest.mark.long  # ~15 s: make test-long (the orbits' own resume is in make test)
 def test_a_killed_run_resumes(small, tmp_path):
     """The last three stored points of the second value's branch removed (a run killed
     there): a rerun computes just those again and ends with the same envelope."""
