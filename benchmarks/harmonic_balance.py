@@ -117,7 +117,7 @@ def markdown(r: dict) -> list[str]:
         f"{c['hb_N8_points']} points, H {c['hb_N8_H']}) against the brute-force sweep, N = 8, "
         f"CPU of each command | {med(c['hb_N8_cpu_s'])} against {med(c['sweep_N8_cpu_s'])}: "
         f"ratio {c['ratio_hb_over_sweep_N8']:.2f} (shooting: 0.50, item 11) | <= 1/20 "
-        f"(issue 31): not met, Hill's method is 93 % of a point |",
+        f"(issue 31): not met, Hill's method is about 90 % of a point |",
         f"| 14. the same curve at N = 32 ({c['hb_N32_points']} points) | "
         f"{med(c['hb_N32_cpu_s'])}: x{c['ratio_N32_over_N8']:.1f} N = 8's | measured |",
         f"| 14. fold curves over EI x 4 (2500-10000 N m^2) at N = 8, {f['fold_curve_points']} "
