@@ -56,7 +56,8 @@ def test_doubling_the_samples_changes_nothing(hb):
     assert np.linalg.norm(b.X - a.X) <= 1e-9 * np.linalg.norm(a.X)
 
 
-@pytest.mark.parametrize("f1", [5.0, 10.0, 12.5])
+@pytest.mark.parametrize("f1", [pytest.param(5.0, marks=pytest.mark.long), 10.0,
+                                pytest.param(12.5, marks=pytest.mark.long)])  # make test: 10 Hz
 def test_convergence_in_H(hb, f1):
     """T max at H = 1..6 against H = 10: the error falls geometrically (the orbit is
     analytic in t) until round-off; the observed rate per harmonic is asserted."""
@@ -117,6 +118,7 @@ def test_auto_picks_by_the_stated_rule():
         orbit_method.choose(plain, "fourier")
 
 
+@pytest.mark.long  # ~7 s (make test-long)
 def test_a_point_past_the_tail_raises_H_for_the_rest(hb):
     """With tail_tol just above the first orbit's tail at H = 3 (9.0 Hz), the points
     toward 9.3 Hz, whose highest harmonic grows faster than the first (8.96e-14 of it at
