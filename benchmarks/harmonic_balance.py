@@ -15,23 +15,14 @@ session.  Not tests.
 from __future__ import annotations
 
 import json
-import resource
 import shutil
-import subprocess
 import time
 from pathlib import Path
 
 HERE = Path(__file__).parent
 
 
-def _cpu_of(cmd: list[str]) -> float:
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-
-
-def curves(rawehelix: str, stats, repeats: int = 1) -> dict:
+def curves(rawehelix: str, stats, cpu_of, repeats: int = 1) -> dict:
     out = HERE / "hb_runs"
     cases = {"hb_N8": ["orbits", "mobile_end", "--elements", "8", "--f1", "15:0.5",
                        "--method", "hb"],
@@ -42,7 +33,7 @@ def curves(rawehelix: str, stats, repeats: int = 1) -> dict:
     for _ in range(repeats):
         for key, args in cases.items():
             shutil.rmtree(out / key, ignore_errors=True)
-            cpu[key].append(_cpu_of([rawehelix, *args, "-o", str(out / key)]))
+            cpu[key].append(cpu_of([rawehelix, *args, "-o", str(out / key)]))
     got = {k: json.loads((out / k / "summary.json").read_text()) for k in ("hb_N8", "hb_N32")}
     shutil.rmtree(out, ignore_errors=True)
     result = {f"{k}_cpu_s": stats(v) for k, v in cpu.items()}
@@ -104,8 +95,9 @@ def parts(stats, elements=(8, 32), f1: float = 10.0, repeats: int = 3) -> dict:
     return out
 
 
-def bench_hb(rawehelix: str, stats, repeats: int = 1) -> dict:
-    return {"curves": curves(rawehelix, stats, repeats), "fold_curve": fold_curve(stats),
+def bench_hb(rawehelix: str, stats, cpu_of, repeats: int = 1) -> dict:
+    """``stats`` and ``cpu_of``: run.py's (a figure's median and spread, a command's CPU time)."""
+    return {"curves": curves(rawehelix, stats, cpu_of, repeats), "fold_curve": fold_curve(stats),
             "parts": parts(stats)}
 
 

@@ -685,7 +685,7 @@ def main():
                      ("study", lambda: study_bench.bench_study(repeats)),
                      ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
                      ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
-                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats))):
+                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of))):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -210,12 +210,16 @@ class HarmonicBalance(PeriodicOrbitProblem):
         self._tangents = data  # for Hill's method at this X (finish)
         return pattern.matrix(blocks)
 
+    def _more(self, H: int) -> int:
+        """The next H where H is too few: x 1.5, at least + 2, at most H_max."""
+        return min(self.H_max, max(H + 2, math.ceil(1.5 * H)))
+
     def refine(self, prev: Orbit, orbit: Orbit) -> Orbit | None:
         """H raised (x 1.5, at least + 2) where ``orbit``'s tail exceeds tail_tol, and
         ``prev`` solved again at it (the continuation redoes the step)."""
         if orbit.accuracy.get("tail", 0.0) <= self.tail_tol or orbit.steps >= self.H_max:
             return None
-        self.H = min(self.H_max, max(orbit.steps + 2, math.ceil(1.5 * orbit.steps)))
+        self.H = self._more(orbit.steps)
         return self.orbit(prev.X, prev.f1_Hz, steps=self.H)
 
     def resume_from(self, orbit: Orbit) -> None:
@@ -273,13 +277,13 @@ class HarmonicBalance(PeriodicOrbitProblem):
                     raise SolverError(f"{err} (tried H up to {H}: a non-smooth law, such as "
                                       f"the members' slack, needs many harmonics; "
                                       f"--method shooting)") from None
-                H = min(self.H_max, max(H + 2, math.ceil(1.5 * H)))
+                H = self._more(H)
                 X = self.embed(X0, H)
                 continue
             tail = self.basis(H).tail(self.coefficients(X, H))
             if steps or tail <= self.tail_tol or H >= self.H_max:
                 break
-            H = min(self.H_max, max(H + 2, math.ceil(1.5 * H)))  # as refine()
+            H = self._more(H)
             X = self.embed(X, H)
         if not steps:
             self.H = H
