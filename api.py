@@ -152,21 +152,23 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
 
 
 def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=None,
-             outdir=None, method: str = "hb", progress=None):
+             outdir=None, method: str = "hb", progress=None, f1_step_Hz: float | None = None):
     """The operating envelope of Sec. 5.3's forced helix in (f1, KEY): ``vary`` is
     "KEY=LO:HI[:COUNT]" (a dotted scene key, COUNT values, default 5); at each value the
     branch over [f1_lo, f1_hi] (``method``: "hb", "shooting" or "auto"), the f1 where the
-    first limit of the structure is reached, and the folds continued in KEY (the band of
-    two coexisting stable responses).  An
+    first limit of the structure is reached, the folds continued in KEY (the band of
+    two coexisting stable responses) and the period doublings and Neimark-Sackers
+    continued in KEY (the unstable bands).  An
     :class:`~rawehelix.studies.envelope.EnvelopeResult` (``summary``, ``write(outdir)``:
     summary.json and envelope.png).  The values are dealt to the ranks of ``comm``; with
-    ``outdir`` each value's branch is stored and a rerun resumes."""
+    ``outdir`` each value's branch is stored and a rerun resumes; ``f1_step_Hz``: the
+    most a branch steps in f1 (stability is judged at its points)."""
     from rawehelix.studies import envelope as study
     from rawehelix.studies.sampling import Variable, parse_vary
     _resources(scene, "orbits")
     vary = vary if isinstance(vary, Variable) else parse_vary(vary)
     return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=_world(comm), outdir=outdir,
-                         method=method, progress=progress)
+                         method=method, progress=progress, f1_step_Hz=f1_step_Hz)
 
 
 def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=None,

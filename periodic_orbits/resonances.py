@@ -172,6 +172,20 @@ def sites_for(frequencies_Hz, f1_lo: float, f1_hi: float,
     return out
 
 
+class MaxStep(StepGuard):
+    """A step moves f1 by at most ``f1_step_Hz`` (None: any): where stability is judged at
+    the branch's points, an unstable band narrower than their spacing falls between two
+    of them (the envelope's ticks)."""
+
+    def __init__(self, f1_step_Hz: float | None = None):
+        self.f1_step_Hz = f1_step_Hz
+
+    def cap(self, points, f1_s: float, ds: float, last_ds: float | None) -> float:
+        if self.f1_step_Hz is None or abs(f1_s) < 1e-12:
+            return ds
+        return min(ds, self.f1_step_Hz / abs(f1_s))
+
+
 class Sites(StepGuard):
     """The step closes in on the superharmonic ``sites`` (module docstring)."""
 

@@ -2,7 +2,7 @@
 extensible rod) in (f1, the end's elongation: the nominal tension) and (f1, EI), with the
 solid and the tensegrity section, by harmonic balance.  Writes docs/envelope/<map>/
 (summary.json, envelope.png) and docs/envelope/design_maps.png.  Usage:
-    python scripts/design_maps.py [solid|tensegrity|figure]"""
+    python scripts/design_maps.py [solid|tensegrity [elongation|EI]|figure]"""
 
 import json
 import sys
@@ -25,16 +25,28 @@ MAPS = {"elongation": ("ends.elongation=0.002:0.005:4", 2.0, 16.0, {}),
 #: they are taut at rest; without it (the scene's P0 = 0) they are slack at rest and
 #: neither HB (first orbit at 16 Hz not found in 30 min, H raised to 40) nor shooting
 #: (no period-1 orbit found at 13, 9 or 8 Hz) starts.  HB raises H where they slack.
-TENSEGRITY = {"elongation": ("ends.elongation=0.002:0.005:3", 2.0, 12.0,
-                             {"section.self_stress_N": 30.0, "section.bar_EA_N": 1e4})}
+#: With the members' law EI is the tethers' (n k R^2 cos^3(beta) / 2, 477 N m^2 at the
+#: default k = 4400 N), and helix.EI_Nm2 sets only the sections' rotational inertia: the
+#: (f1, EI) map of the tensegrity varies the members' stiffness k instead.
+_PRESTRESSED = {"section.self_stress_N": 30.0, "section.bar_EA_N": 1e4}
+TENSEGRITY = {"elongation": ("ends.elongation=0.002:0.005:3", 2.0, 12.0, _PRESTRESSED),
+              "EI": ("section.tether_EA_N=3000:9000:3", 2.0, 12.0, _PRESTRESSED)}
 
 
-def run(section: str):
+#: the most a branch steps in f1 [Hz]: 0.1 for the solid (a narrow unstable band between
+#: two points is then found); none for the tensegrity, whose slack kinks hold HB's
+#: branch poorly at small steps (at elongation 0.002 it turned back at a kink near 7.09 Hz)
+F1_STEP = {"solid": 0.1, "tensegrity": None}
+
+
+def run(section: str, only: str | None = None):
     maps = TENSEGRITY if section == "tensegrity" else MAPS
     for name, (vary, lo, hi, base) in maps.items():
+        if only and name != only:
+            continue
         params = rh.load_scene("mobile_end", elements=4, degree=3,
                                overrides={**SECTIONS[section], **base})
-        result = rh.envelope(params, vary, lo, hi, method="hb")
+        result = rh.envelope(params, vary, lo, hi, method="hb", f1_step_Hz=F1_STEP[section])
         result.write(OUT / f"{section}_{name}")
         print(envelope.report(result), flush=True)
 
@@ -51,4 +63,4 @@ def figure():
 
 if __name__ == "__main__":
     what = sys.argv[1] if len(sys.argv) > 1 else "figure"
-    run(what) if what in SECTIONS else figure()
+    run(what, *sys.argv[2:3]) if what in SECTIONS else figure()

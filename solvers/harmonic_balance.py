@@ -17,14 +17,13 @@ F_A at the samples (harmonics.BlockPattern); the Newton's linear solves are
 PETSc's (prefix ``rawehelix_hb_``, MUMPS LU by default: the continuation's
 bordered matrix has a zero pivot).
 
-H is chosen by accuracy (:meth:`HarmonicBalance.orbit` without a resolution):
-raised until the energy in the highest harmonic is below TAIL_TOL of the
-oscillation's (``Orbit.accuracy``).  The Floquet multipliers: Hill's method
-(:func:`rawehelix.periodic_orbits.hill.hill_exponents`) on the linearisation
-F_A x'' + F_V x' + F_U x = 0 about the orbit, its exponents sorted by the
-symmetry of their eigenvectors (Bentvelsen & Lazarus 2018), by shift-invert at
-0 (folds), i w/2 (period doubling) and the least damped exponents of the
-averaged system (:data:`SHIFTS`): the largest multiplier, not all of them.
+H is chosen by accuracy (:meth:`HarmonicBalance.orbit` without a resolution): raised
+until the energy in the highest harmonic is below TAIL_TOL of the oscillation's
+(``Orbit.accuracy``).  The Floquet multipliers: Hill's method (periodic_orbits/hill.py)
+on F_A x'' + F_V x' + F_U x = 0 from the tangents at the samples, its exponents sorted
+by their eigenvectors' symmetry (Bentvelsen & Lazarus 2018), by shift-invert at 0
+(folds), i w/2 (period doubling) and the least damped exponents of the averaged system
+(:data:`SHIFTS`): the largest multiplier, not all of them.
 
 Where harmonic balance is the wrong tool it refuses, naming the other method:
 the hysteretic torsion (a non-smooth internal variable) and no controller (a
@@ -55,8 +54,8 @@ FINE = 256  # samples of T(0) per period for its extremes (a smooth signal's max
 SHIFTS = 2  # the least damped exponents of the averaged system used as Hill shifts
 BACKTRACK_MIN = 1.0 / 64  # the shortest fraction of a Newton step tried
 STEP_TOL = 1e-12  # a Newton correction this small (relative to X): converged at G's floor
-HOMOTOPY_MIN = 1.0 / 64
-START_RETRIES = 2  # the first orbit's search, H raised this many times where it fails  # the shortest step in the end's amplitude (HarmonicBalance._start)
+HOMOTOPY_MIN = 1.0 / 64  # the shortest step in the end's amplitude (HarmonicBalance._start)
+START_RETRIES = 2  # the first orbit's search, H raised this many times where it fails
 
 
 def cannot(params: Parameters) -> str | None:
@@ -169,6 +168,12 @@ class HarmonicBalance(PeriodicOrbitProblem):
                  amplitude: float = 1.0):
         """(G, T(0) samples over the period (normalised, FINE of them), dG/dX or None);
         ``amplitude``: the end's oscillation scaled (the first orbit's homotopy)."""
+        G, tension, data = self.sampled(X, f1_Hz, jacobian, resolution, amplitude)
+        return G, tension, self._jacobian(data, f1_Hz, self._H(X, resolution)) if jacobian else None
+
+    def sampled(self, X, f1_Hz: float, tangents: bool = True, resolution: int | None = None,
+                amplitude: float = 1.0):
+        """(G, T(0) samples, the tangents (F_U, F_V, F_A) at the AFT's samples or None)."""
         H = self._H(X, resolution)
         basis, C = self.basis(H), self.coefficients(X, H)
         self.set_frequency(f1_Hz)
@@ -179,17 +184,17 @@ class HarmonicBalance(PeriodicOrbitProblem):
             op.set_time(theta / w)
             op.load(U[j], V[j], A[j])
             F[j] = op.residual()
-            if jacobian:
+            if tangents:
                 data.append([M.copy() for M in op.csr()])  # csr() reuses its matrices
         G = basis.analysis(F)
         g = self.boundary(f1_Hz, basis).copy()
         g[:, 1:] *= amplitude
         G[self.bc] = C[self.bc] - g
-        J = self._jacobian(basis, data, w) if jacobian else None
-        return G.ravel(), self.tension(C, f1_Hz), J
+        return G.ravel(), self.tension(C, f1_Hz), data if tangents else None
 
-    def _jacobian(self, basis, data, w):
+    def _jacobian(self, data, f1_Hz, H):
         """dG/dX (CSR) from the tangents at the samples, the Dirichlet rows unit rows."""
+        basis, w = self.basis(H), self.omega(f1_Hz)
         entry = self._cache[basis.H]
         if entry[1] is None:
             entry[1] = harmonics.BlockPattern(data[0][0], basis.P)
@@ -207,7 +212,6 @@ class HarmonicBalance(PeriodicOrbitProblem):
         diagonal = np.flatnonzero(in_bc & (rows == Fu.indices))
         for m in range(basis.P):
             blocks[m, m, diagonal] = 1.0
-        self._tangents = data  # for Hill's method at this X (finish)
         return pattern.matrix(blocks)
 
     def _more(self, H: int) -> int:
@@ -247,17 +251,14 @@ class HarmonicBalance(PeriodicOrbitProblem):
         """T(0) (normalised) at FINE angles over the period: Eq. (29) with r'(0) = D U."""
         op = self.op
         theta = 2 * math.pi * np.arange(FINE) / FINE
+        basis = self.basis((C.shape[1] - 1) // 2)
         if not self._linear_tension:  # the probe at each angle
-            H = (C.shape[1] - 1) // 2
-            U = self.states(C, f1_Hz, self.basis(H), theta)[0]
-            return np.array([op.probe_tension(u) for u in U])
-        DC = op._D @ C  # (3, P)
-        d = self.basis((C.shape[1] - 1) // 2).synthesis(DC, theta=theta)  # (FINE, 3); the secular twist does not enter r
+            return np.array([op.probe_tension(u) for u in self.states(C, f1_Hz, basis, theta)[0]])
+        d = basis.synthesis(op._D @ C, theta=theta)  # (FINE, 3); the secular twist is not in r
         return op._sigma * (np.linalg.norm(d, axis=1) - 1.0)
 
     def samples(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
-        H = self._H(X, resolution)
-        return self.tension(self.coefficients(X, H), f1_Hz)
+        return self.tension(self.coefficients(X, self._H(X, resolution)), f1_Hz)
 
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-9, max_it: int = 20, lead_in: int = 0,
               steps: int | None = None, linear: bool = False) -> Orbit:
@@ -357,10 +358,10 @@ class HarmonicBalance(PeriodicOrbitProblem):
 
     def finish(self, X, f1_Hz, iterations, residual, start, resolution=None) -> Orbit:
         H = self._H(X, resolution)
-        G, tension, J = self.residual(X, f1_Hz, jacobian=True, resolution=H)
-        floquet = self.hill(f1_Hz, H)
-        T = self.q.tension_N(tension)
         basis = self.basis(H)
+        G, tension, tangents = self.sampled(X, f1_Hz, resolution=H)
+        J, floquet = self._jacobian(tangents, f1_Hz, H), self.hill(f1_Hz, H, tangents)
+        T = self.q.tension_N(tension)
         return Orbit(f1_Hz=f1_Hz, X=X, delta=self.q_base.spin_target * 2 * math.pi /
                      self.omega(f1_Hz), tension_max_N=float(T.max()),
                      tension_min_N=float(T.min()), multipliers=floquet.multipliers,
@@ -372,17 +373,16 @@ class HarmonicBalance(PeriodicOrbitProblem):
                                f"i w / 2 and the {SHIFTS} least damped of the averaged "
                                f"system, not the whole spectrum"})
 
-    def hill(self, f1_Hz: float, H: int):
-        """Hill's exponents at the X of the last Jacobian (:meth:`_jacobian`'s tangents)."""
-        Fu, Fv, Fa = zip(*self._tangents)
+    def hill(self, f1_Hz: float, H: int, tangents):
+        """Hill's exponents from the tangents at the AFT's samples (:meth:`sampled`)."""
+        Fu, Fv, Fa = zip(*tangents)
         w = self.omega(f1_Hz)
         shifts = [0.0, 0.5j * w] + hill.averaged_exponents(Fa, Fv, Fu, self.free, SHIFTS)
         return hill.hill_exponents(Fa, Fv, Fu, w, H, free=self.free, shifts=shifts)
 
     def multipliers(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
         H = self._H(X, resolution)
-        self.residual(X, f1_Hz, jacobian=True, resolution=H)
-        return self.hill(f1_Hz, H).multipliers
+        return self.hill(f1_Hz, H, self.sampled(X, f1_Hz, resolution=H)[2]).multipliers
 
     def sections(self, X, f1_Hz: float, steps: int | None = None, samples: int = 128) -> list:
         """The section along s at ``samples`` times of the period: [(t, Probes.section())]."""

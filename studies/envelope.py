@@ -11,16 +11,19 @@ For COUNT values of the dotted scene key KEY (default DEFAULT_VALUES, the "ticks
    two branch points (FIRST_LIMIT_BISECTIONS orbits at fixed f1 and KEY, each with its
    limits over a period), reported with its bracket;
 3. the fold curves: each fold of a tick continued in KEY to the next tick by the
-   minimally augmented system (periodic_orbits/fold_curve.py), FOLD_SUBSTEPS natural
-   steps a tick; its end is checked against the next tick's own fold
-   (``fold_check_Hz``), and a fold that has no partner there ends at a cusp, said so.
-   Where the two folds of a resonance exist, two stable responses coexist between them.
+   minimally augmented system (periodic_orbits/fold_curve.py); its end is checked
+   against the next tick's own fold (``fold_check_Hz``), and a fold that has no partner
+   there ends at a cusp, said so.  Where the two folds of a resonance exist, two
+   stable responses coexist between them;
+4. the period-doubling and Neimark-Sacker curves: each tick's PD and NS where the orbit
+   loses or regains stability continued in KEY by the stability test function
+   (periodic_orbits/bifurcation_curve.py), forward and back where no curve reached them,
+   checked the same way (``check_Hz``).  Between two such curves the response is unstable.
 
-Period doublings and Neimark-Sackers are reported per tick (the branches'
-``bifurcations``), not continued in KEY.
+The curves: studies/envelope_curves.py.
 
-MPI: the ticks are dealt to the ranks (a rank's ticks, one branch each); the fold
-curves are traced on rank 0 from the gathered ticks.  Resumable (``outdir``): each
+MPI: the ticks are dealt to the ranks (a rank's ticks, one branch each); the curves
+are traced on rank 0 from the gathered ticks.  Resumable (``outdir``): each
 tick's branch is an orbits store (``tick<k>/``).
 """
 
@@ -35,14 +38,12 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import branch_limits, orbits, writers
+from rawehelix.periodic_orbits.bifurcations import critical, stability_changes
+from rawehelix.studies import branch_limits, envelope_curves, orbits, writers
 from rawehelix.studies.sampling import Variable
 
 DEFAULT_VALUES = 5  # ticks when --vary gives no COUNT
-FOLD_SUBSTEPS = 4  # natural steps in KEY from one tick's fold to the next tick
 FIRST_LIMIT_BISECTIONS = 8  # the limit's f1 to 1/256 of the branch's spacing
-FOLD_CHECK_HZ = 1e-3  # a fold curve's end and the next tick's fold agree within this
-FOLD_MATCH_HZ = 0.05  # the next tick's fold nearer than this is the same fold (checked)
 
 
 def values_of(vary: Variable) -> list[float]:
@@ -83,17 +84,19 @@ class EnvelopeResult:
     limit_curve: list
     wall_s: float
     fold_curves_wall_s: float = 0.0
+    bifurcation_curves: list = dataclasses.field(default_factory=list)
 
     @property
     def summary(self) -> dict:
-        checks = [abs(c["fold_check_Hz"]) for c in self.fold_curves
-                  if c.get("fold_check_Hz") is not None]
+        worst = envelope_curves.worst_check
         return {"scene": self.scene, "key": self.key, "values": self.values,
                 "f1_window_Hz": self.f1_window_Hz, "method": self.method,
                 "method_reason": self.method_reason, "elements": self.elements,
                 "ticks": self.ticks, "fold_curves": self.fold_curves,
                 "limit_curve": self.limit_curve,
-                "fold_check_max_Hz": max(checks) if checks else None,
+                "fold_check_max_Hz": worst(self.fold_curves, "fold_check_Hz"),
+                "bifurcation_curves": self.bifurcation_curves,
+                "bifurcation_check_max_Hz": worst(self.bifurcation_curves),
                 "fold_curves_wall_s": self.fold_curves_wall_s, "wall_s": self.wall_s}
 
     def write(self, outdir) -> Path:
@@ -105,13 +108,13 @@ class EnvelopeResult:
         return outdir
 
 
-def _tick(params, key, value, f1_window, method, outdir, progress):
-    """One value of KEY: its branch, limit crossings and fold starts."""
+def _tick(params, key, value, f1_window, method, outdir, progress, f1_step_Hz):
+    """One value of KEY: its branch, limit crossings, and its folds' and bifurcations' starts."""
     p = params_at(params, key, value)
     lo, hi = f1_window
     branch = orbits.compute(p, hi, lo, comm=MPI.COMM_SELF, method=method, superharmonics=(),
                             outdir=None if outdir is None else Path(outdir),
-                            progress=progress)
+                            progress=progress, f1_step_Hz=f1_step_Hz)
     points = branch.orbits
     m = orbits.period_map(p, branch.method)
     limits = branch_limits.OrbitLimits(m, p)
@@ -125,11 +128,23 @@ def _tick(params, key, value, f1_window, method, outdir, progress):
             if a.f1_Hz == fa and b.f1_Hz == fb:
                 starts.append({"f1_Hz": fold["f1_Hz"], "Xa": a.X, "Xb": b.X,
                                "resolution": a.steps})
+    bifurcation_starts = []  # where stability is lost or regained other than at a fold
+    for a, b in zip(points, points[1:]):
+        if stability_changes(a, b):
+            inside = [e for e in branch.bifurcations
+                      if min(a.f1_Hz, b.f1_Hz) <= e["f1_Hz"] <= max(a.f1_Hz, b.f1_Hz)]
+            worse = max((a, b), key=lambda o: critical(o.multipliers)[0])
+            kind = critical(worse.multipliers)[2]
+            bifurcation_starts.append({"bracket_Hz": (a.f1_Hz, b.f1_Hz), "X": a.X,
+                                       "resolution": a.steps, "kind": kind,
+                                       "f1_Hz": inside[0]["f1_Hz"] if inside else a.f1_Hz})
     tick = {"value": value, "branch": [
         {k: e.get(k) for k in ("f1_Hz", "tension_max_N", "stable", "first_limit")}
         for e in branch.branch], "folds": branch.folds, "bifurcations": branch.bifurcations,
+        "f1_gap_max_Hz": max((abs(b.f1_Hz - a.f1_Hz) for a, b in zip(points, points[1:])),
+                             default=0.0),
         "wall_s": branch.wall_s}
-    return tick, crossings, starts, branch.method, branch.method_reason
+    return tick, crossings, (starts, bifurcation_starts), branch.method, branch.method_reason
 
 
 def _crossing(m, limits, a, b, ka, kb, value) -> dict:
@@ -154,55 +169,15 @@ def _crossing(m, limits, a, b, ka, kb, value) -> dict:
             "kind": kind if isinstance(kind, str) else None, "entering": not side_a}
 
 
-def _fold_curves(params, key, values, ticks, starts, method, substeps):
-    """Each tick's folds continued to the next tick (rank 0)."""
-    from rawehelix.periodic_orbits import fold_curve
-    curves = []
-    problems = {}
-
-    def problem_at(v):
-        if v not in problems:
-            problems.clear()  # one at a time: each holds a rod
-            problems[v] = orbits.period_map(params_at(params, key, v), method)
-        return problems[v]
-
-    for k in range(len(values) - 1):
-        v0, v1 = values[k], values[k + 1]
-        for s in starts[k]:
-            m = problem_at(v0)
-            d = s["Xb"] - s["Xa"]
-            d /= max(np.linalg.norm(d), 1e-300)
-            curve = {"from_value": v0, "to_value": v1, "points": [], "end": None,
-                     "fold_check_Hz": None}
-            try:
-                first = fold_curve.locate(m, 0.5 * (s["Xa"] + s["Xb"]), s["f1_Hz"],
-                                          s["resolution"], d, d, p=v0)
-            except SolverError as err:
-                curve["end"] = f"not located at the tick: {err}"
-                curves.append(curve)
-                continue
-            curve["tick_fold_Hz"] = s["f1_Hz"]
-            folds, why = fold_curve.trace(problem_at, first, v1, (v1 - v0) / substeps)
-            curve["points"] = [{"value": f.p, "f1_Hz": f.f1_Hz} for f in folds]
-            curve["end"] = why
-            end = folds[-1].f1_Hz
-            partners = [f["f1_Hz"] for f in ticks[k + 1]["folds"]]
-            near = min(partners, key=lambda f: abs(f - end)) if partners else None
-            if folds[-1].p != v1:
-                pass
-            elif near is not None and abs(near - end) <= FOLD_MATCH_HZ:
-                curve["fold_check_Hz"] = end - near
-            else:  # the next tick's branch has no fold here: it left the window there
-                curve["end"] += (f"; the branch at {key} = {v1:g} has no fold near "
-                                 f"{end:.4f} Hz (outside the f1 window, or not traced)")
-            curves.append(curve)
-    return curves
-
-
 def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
             comm=MPI.COMM_WORLD, outdir=None, method: str = "hb", progress=None,
-            substeps: int = FOLD_SUBSTEPS) -> EnvelopeResult:
-    """The envelope (module docstring); ``progress(value, orbit)`` at every branch point."""
+            substeps: int = envelope_curves.SUBSTEPS,
+            f1_step_Hz: float | None = None) -> EnvelopeResult:
+    """The envelope (module docstring); ``progress(value, orbit)`` at every branch point;
+    ``f1_step_Hz``: the most a branch steps in f1 (None: as its step control takes it).
+    Stability is judged at the branches' points, so an unstable band narrower than
+    their spacing (each tick's ``f1_gap_max_Hz``) may fall between two of them: the
+    curves from other ticks still cross it."""
     if not (0 < f1_lo < f1_hi):
         raise SceneError("--f1", f"{f1_lo}:{f1_hi}", "must be LO:HI with 0 < LO < HI [Hz]")
     values = values_of(vary)
@@ -215,7 +190,7 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         each = None if progress is None else (lambda o, v=values[k]: progress(v, o))
         try:
             mine.append((k, _tick(params, vary.key, values[k], (f1_lo, f1_hi), method,
-                                  tick_dir, each)))
+                                  tick_dir, each, f1_step_Hz)))
         except Exception as err:  # noqa: BLE001 - raised on every rank below
             if comm.size == 1:
                 raise
@@ -230,18 +205,24 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         pieces = dict(kv for part in gathered for kv in part)
         ticks = [pieces[k][0] for k in range(len(values))]
         crossings = [c for k in range(len(values)) for c in pieces[k][1]]
-        starts = [pieces[k][2] for k in range(len(values))]
+        folds_at = [pieces[k][2][0] for k in range(len(values))]
+        bifurcations_at = [pieces[k][2][1] for k in range(len(values))]
         used, reason = pieces[0][3], pieces[0][4]
+        problem_at = envelope_curves.Problems(
+            lambda v: orbits.period_map(params_at(params, vary.key, v), used))
         clock = time.perf_counter()
-        curves = _fold_curves(params, vary.key, values, ticks, starts, used, substeps)
+        curves = envelope_curves.fold_curves(problem_at, vary.key, values, ticks, folds_at,
+                                             substeps)
         fold_wall = time.perf_counter() - clock
+        others = envelope_curves.bifurcation_curves(problem_at, vary.key, values, ticks,
+                                                    bifurcations_at, substeps)
         result = EnvelopeResult(scene=params.name, title=params.title, key=vary.key,
                                 values=values, f1_window_Hz=[f1_lo, f1_hi], method=used,
                                 method_reason=reason,
                                 elements=params.discretisation.elements, ticks=ticks,
                                 fold_curves=curves, limit_curve=crossings,
                                 wall_s=time.perf_counter() - start,
-                                fold_curves_wall_s=fold_wall)
+                                fold_curves_wall_s=fold_wall, bifurcation_curves=others)
     return comm.bcast(result, root=0)
 
 
@@ -252,7 +233,8 @@ def report(result: EnvelopeResult) -> str:
              f"in {result.wall_s:.1f} s"]
     for t in s["ticks"]:
         folds = ", ".join(f"{f['f1_Hz']:.4f}" for f in t["folds"])
-        lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits, "
+        lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits "
+                     f"(stability at their points, at most {t['f1_gap_max_Hz']:.3g} Hz apart), "
                      + (f"folds at {folds} Hz" if folds else "no fold in the window"))
     for c in s["limit_curve"]:
         lines.append(f"  first limit ({c['kind']}) {'reached' if c['entering'] else 'left'} at "
@@ -261,8 +243,14 @@ def report(result: EnvelopeResult) -> str:
     for c in s["fold_curves"]:
         lines.append(f"  fold curve from {c['from_value']:g} to {c['to_value']:g}: "
                      f"{len(c['points'])} points, {c['end']}")
-    worst = s["fold_check_max_Hz"]
-    if worst is not None:
-        flag = "" if worst <= FOLD_CHECK_HZ else f"  WARNING: above {FOLD_CHECK_HZ:g} Hz"
-        lines.append(f"  fold curves against the ticks' own folds: within {worst:.2e} Hz{flag}")
+    for c in s["bifurcation_curves"]:
+        lines.append(f"  {c['kind'].replace('_', '-')} curve from {c['from_value']:g} toward "
+                     f"{c['to_value']:g}: {len(c['points'])} points, {c['end']}")
+    for what, worst in (("fold curves", s["fold_check_max_Hz"]),
+                        ("period-doubling and Neimark-Sacker curves",
+                         s["bifurcation_check_max_Hz"])):
+        if worst is not None:
+            limit = envelope_curves.CHECK_HZ
+            flag = "" if worst <= limit else f"  WARNING: above {limit:g} Hz"
+            lines.append(f"  {what} against the ticks' own: within {worst:.2e} Hz{flag}")
     return "\n".join(lines)

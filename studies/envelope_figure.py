@@ -1,7 +1,8 @@
 """The envelope's figure: f1 across, the varied key up; each value's branch drawn as a
 row coloured by what a designer needs (single stable response within the limits,
 coexisting responses, a limit exceeded, unstable), the fold curves bounding the band
-of coexistence and the first-limit boundary over them.  Plots take data (the summary)."""
+of coexistence, the period-doubling and Neimark-Sacker curves bounding the unstable
+bands and the first-limit boundary over them.  Plots take data (the summary)."""
 
 from __future__ import annotations
 
@@ -15,6 +16,45 @@ COLOURS = {"single": "tab:green", "coexisting": "tab:orange", "limit": "tab:red"
            "unstable": "0.55"}
 LABELS = {"single": "single stable response within limits", "coexisting":
           "coexisting stable responses", "limit": "limit exceeded", "unstable": "unstable"}
+
+
+STYLES = {"period_doubling": "m--", "neimark_sacker": "b-."}
+CURVE_LABELS = {"period_doubling": "period-doubling curves",
+                "neimark_sacker": "Neimark-Sacker curves"}
+
+
+def _bands(ax, curves, colour, label):
+    """The region between two curves traced from one value to the same other value (the
+    two folds of a resonance, or a band's two stability boundaries), filled over the
+    values both reach; a curve that comes back to its own value (round a band's tip)
+    encloses its region alone."""
+    pairs = {}
+    for c in curves:
+        if len(c["points"]) >= 2:
+            pairs.setdefault((c["from_value"], c["to_value"]), []).append(c)
+    labelled = False
+    for (v0, v1), group in pairs.items():
+        if v0 == v1:
+            for c in group:
+                ax.fill([p["f1_Hz"] for p in c["points"]], [p["value"] for p in c["points"]],
+                        color=colour, alpha=0.35, lw=0, label=None if labelled else label)
+                labelled = True
+            continue
+        if len(group) != 2:
+            continue
+        (a, b) = ([(p["value"], p["f1_Hz"]) for p in c["points"]] for c in group)
+        if any(np.any(np.diff([v for v, _ in x]) * (v1 - v0) <= 0) for x in (a, b)):
+            continue  # a curve that turns in the key: no single f1 per value to fill between
+        a, b = sorted(a), sorted(b)
+        lo, hi = max(a[0][0], b[0][0]), min(a[-1][0], b[-1][0])
+        y = np.array(sorted({v for v, _ in a + b if lo <= v <= hi}))
+        if y.size < 2:
+            continue
+        xa = np.interp(y, *zip(*a))
+        xb = np.interp(y, *zip(*b))
+        ax.fill_betweenx(y, xa, xb, color=colour, alpha=0.35, lw=0,
+                         label=None if labelled else label)
+        labelled = True
 
 
 def classify(tick: dict) -> list[str]:
@@ -85,23 +125,21 @@ def draw(ax, summary: dict):
                 segment(f[i:i + 2], b if a != b else a, tick["value"])
         for fold in tick["folds"]:
             ax.plot(fold["f1_Hz"], tick["value"], "k|", ms=14)
-    by_start = {}
-    for curve in summary["fold_curves"]:
-        if curve["points"]:
-            by_start.setdefault(curve["from_value"], []).append(curve["points"])
-    band = False
-    for pair in by_start.values():  # two folds from one value: the band between them
-        if len(pair) == 2 and len(pair[0]) == len(pair[1]):
-            y = [p["value"] for p in pair[0]]
-            ax.fill_betweenx(y, [p["f1_Hz"] for p in pair[0]], [p["f1_Hz"] for p in pair[1]],
-                             color=COLOURS["coexisting"], alpha=0.35, lw=0,
-                             label=None if band else "two stable responses coexist")
-            band = True
+    _bands(ax, summary["fold_curves"], COLOURS["coexisting"], "two stable responses coexist")
+    _bands(ax, summary.get("bifurcation_curves", []), COLOURS["unstable"],
+           "unstable between PD / NS curves")
     for k, curve in enumerate(summary["fold_curves"]):
         pts = curve["points"]
         if pts:
             ax.plot([p["f1_Hz"] for p in pts], [p["value"] for p in pts], "k-", lw=1.2,
                     label=None if k else "fold curves (two-parameter continuation)")
+    drawn = set()
+    for curve in summary.get("bifurcation_curves", []):
+        pts, kind = curve["points"], curve["kind"]
+        if pts:
+            ax.plot([p["f1_Hz"] for p in pts], [p["value"] for p in pts], STYLES[kind],
+                    lw=1.2, label=None if kind in drawn else CURVE_LABELS[kind])
+            drawn.add(kind)
     limit = sorted(summary["limit_curve"], key=lambda c: c["value"])
     if limit:
         ax.plot([c["f1_Hz"] for c in limit], [c["value"] for c in limit], "rx--", lw=1,

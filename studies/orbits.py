@@ -204,21 +204,23 @@ def tension_max(m):
                       lambda orbit: orbit.tension_max_N)
 
 
-def branch(m, tension_step: float | None = None, sites=(), **options):
+def branch(m, tension_step: float | None = None, sites=(), f1_step_Hz=None, **options):
     """The continuation of the periodic-orbit problem ``m`` with this study's
     observable (T max) and step guards: T max's relative step (``tension_step``,
-    default TENSION_STEP) and its peaks, then the superharmonic ``sites``
-    (periodic_orbits/resonances.py); ``options``: Branch's (ds, ds_min, ds_max, tol, max_it)."""
+    default TENSION_STEP) and its peaks, the superharmonic ``sites`` and the most a
+    step moves f1 (periodic_orbits/resonances.py); ``options``: Branch's (ds, ds_min,
+    ds_max, tol, max_it)."""
     from rawehelix.periodic_orbits.continuation import Branch
-    from rawehelix.periodic_orbits.resonances import TENSION_STEP, Peaks, Sites
+    from rawehelix.periodic_orbits.resonances import TENSION_STEP, MaxStep, Peaks, Sites
     observable = tension_max(m)
     step = TENSION_STEP if tension_step is None else tension_step
-    return Branch(m, observable=observable, guards=(Peaks(observable, step), Sites(sites)),
+    return Branch(m, observable=observable,
+                  guards=(Peaks(observable, step), Sites(sites), MaxStep(f1_step_Hz)),
                   **options)
 
 
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
-                  superharmonics=(), method="shooting"):
+                  superharmonics=(), method="shooting", f1_step_Hz=None):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
     from rawehelix.periodic_orbits.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
@@ -237,7 +239,7 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
         else:
             sites = sites_for(f_n, lo, hi, superharmonics, tension_N=T0)
             about["sites"] = [{"f1_Hz": x.f1_Hz, "f_n_Hz": x.f_n_Hz, "order": x.k} for x in sites]
-    traced = branch(m, tension_step, sites)
+    traced = branch(m, tension_step, sites, f1_step_Hz)
     stored = store.load() if store else None
     if stored:
         traced.resume(*stored)
@@ -264,12 +266,14 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
             progress=None, outdir=None, tension_step: float | None = None,
-            max_points: int = 400, superharmonics=None, method: str = "shooting") -> OrbitsResult:
+            max_points: int = 400, superharmonics=None, method: str = "shooting",
+            f1_step_Hz: float | None = None) -> OrbitsResult:
     """The branch from f1_start to f1_stop (either order), one window per rank
     of ``comm``; with ``outdir``, stored point by point and resumed from it.
     ``superharmonics``: the orders k of the k:1 sites the step closes in on
     (default SUPERHARMONIC_ORDERS; () for none); ``method``: "shooting", "hb" or
-    "auto" (studies/orbit_method.py)."""
+    "auto" (studies/orbit_method.py); ``f1_step_Hz``: the most a step moves f1 (None: as
+    the step control takes it)."""
     from rawehelix.studies import orbit_method
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
@@ -290,7 +294,8 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
         from rawehelix.studies.sweep_store import fingerprint
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
                   "tension_step": tension_step, "superharmonics": list(superharmonics),
-                  **({"method": method} if method != "shooting" else {})}
+                  **({"method": method} if method != "shooting" else {}),
+                  **({"f1_step_Hz": f1_step_Hz} if f1_step_Hz else {})}
         store = WindowStore.open(Path(outdir), header, comm)
 
     def stop():  # another rank failed: stop here too
@@ -300,7 +305,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     error, sent, piece = None, [], None
     try:
         piece = _trace_window(params, cuts[comm.rank], tension_step, max_points, store,
-                              progress, stop, superharmonics, method)
+                              progress, stop, superharmonics, method, f1_step_Hz)
     except _Stopped:
         error = (False, f"rank {comm.rank}: stopped")
     except Exception as err:  # noqa: BLE001 - reported on every rank below

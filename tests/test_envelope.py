@@ -11,7 +11,7 @@ from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.errors import SceneError
-from rawehelix.studies import envelope
+from rawehelix.studies import envelope, envelope_curves
 
 VARY, F1 = "helix.EI_Nm2=4381:4600:2", (11.9, 13.0)  # N = 2: folds near 12.01 and 12.74 Hz
 
@@ -42,7 +42,7 @@ def test_fold_curves_end_on_the_next_values_own_folds(small):
         assert c["points"][-1]["value"] == 4600.0
         own = next(f for f in s["ticks"][0]["folds"] if f["f1_Hz"] == c["tick_fold_Hz"])
         assert abs(c["points"][0]["f1_Hz"] - own["f1_Hz"]) <= own["f1_error_Hz"] + 1e-4
-    assert s["fold_check_max_Hz"] <= envelope.FOLD_CHECK_HZ
+    assert s["fold_check_max_Hz"] <= envelope_curves.CHECK_HZ
 
 
 def test_the_summary_is_documented_and_the_map_drawn(small):
@@ -113,3 +113,50 @@ def test_one_and_two_ranks_agree():
                                           zip(serial.summary["ticks"], world.summary["ticks"])]
         assert world.summary["fold_curves"] == serial.summary["fold_curves"]
     comm.barrier()
+
+
+@pytest.mark.long  # ~4 min: two tensegrity branches by HB, the curves, 12 shooting orbits
+def test_the_tensegritys_unstable_band_is_the_shootings():
+    """The Sec. 5.3 helix with the members' law (self-stress 30 N, bars EA 1e4 N, N = 4)
+    has a narrow unstable band that moves up in f1 with the tension: 9.34-9.59 Hz at
+    elongation 0.002 (a complex pair near -1 leaves the unit circle, turns real, and a real
+    multiplier comes back through -1), 10.98-11.03 Hz at 0.005 (complex throughout).  The
+    envelope over 0.002-0.005 finds both boundaries on each branch and traces the two
+    from 0.002 to 0.005, where they end on that branch's own within 1e-3 Hz.  At each
+    curve's ends and middle the shooting (generalised-alpha, dt = 0.1 ms; the monodromy's
+    multipliers) changes stability within 2e-3 Hz of it at that elongation."""
+    from rawehelix.periodic_orbits.bifurcations import critical
+    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.solvers.orbits import AlphaMap
+
+    sets = {"model.kinematics": "extensible", "section.law": "tensegrity",
+            "section.self_stress_N": 30.0, "section.bar_EA_N": 1e4}
+    params = rh.load_scene("mobile_end", elements=4, degree=3, overrides=sets)
+    result = rh.envelope(params, "ends.elongation=0.002:0.005:2", 9.0, 11.3,
+                         comm=MPI.COMM_SELF)
+    s = result.summary
+    curves = s["bifurcation_curves"]
+    assert len(curves) == 2, curves
+    for c in curves:
+        assert (c["from_value"], c["to_value"]) == (0.002, 0.005)
+        assert c["end"] == "reached the end of the window" and abs(c["check_Hz"]) <= 1e-3
+    assert s["bifurcation_check_max_Hz"] <= envelope_curves.CHECK_HZ
+    ends = sorted(c["points"][0]["f1_Hz"] for c in curves)
+    assert ends[0] == pytest.approx(9.34, abs=0.01) and ends[1] == pytest.approx(9.585, abs=0.01)
+    for c in curves:
+        pts = c["points"]
+        for point in (pts[0], pts[len(pts) // 2], pts[-1]):
+            p = params_at(point["value"], sets)
+            hb, shoot = HarmonicBalance(p), AlphaMap(p.replace(time={"dt_s": 1e-4}),
+                                                     rho_inf=0.9)
+            g = []
+            for f in (point["f1_Hz"] - 2e-3, point["f1_Hz"] + 2e-3):
+                o = hb.orbit(hb.X_stationary, f)
+                mu = shoot.orbit(hb.state(o.X, f), f, tol=1e-5).multipliers
+                g.append(critical(mu)[0] - 1.0)
+            assert g[0] * g[1] < 0, (point, g)
+
+
+def params_at(elongation, sets):
+    return rh.load_scene("mobile_end", elements=4, degree=3,
+                         overrides={**sets, "ends.elongation": elongation})

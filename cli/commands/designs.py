@@ -103,7 +103,7 @@ def _envelope_arguments(p):
                         "default 5), e.g. helix.EI_Nm2=2000:8000:5 or ends.elongation")
     p.add_argument("--f1", required=True, metavar="LO:HI", help="the f1 window in Hz")
     p.add_argument("--method", default="hb", choices=("hb", "shooting", "auto"),
-                   help="the periodic-orbit problem of the branches and the fold curves "
+                   help="the periodic-orbit problem of the branches and the curves "
                         "(default hb)")
 
 
@@ -128,7 +128,7 @@ COMMANDS = [
             _converge, kept="runs/*.json"),
     Command("study", "named quantities over a design of scene keys, on MPI ranks",
             _study_arguments, _study, kept="points/*.json"),
-    Command("envelope", "design map in (f1, a scene key): folds, first limits, stability",
+    Command("envelope", "design map in (f1, a scene key): folds, PD / NS, first limits",
             _envelope_arguments, _envelope, kept="tick*/window*/p*.json"),
     Command("calibrate", "fit scene keys to target quantities (least squares)",
             _calibrate_arguments, _calibrate, kept="points/*.json"),
