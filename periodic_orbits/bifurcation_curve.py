@@ -138,10 +138,11 @@ def _root(g_of, x0: float, rising: float | None, step: float, reach: float, tol:
     raise SolverError(f"regula falsi did not reach {tol:g} in {max_it} iterations")
 
 
-def _crossing(line, x, its) -> Crossing:
+def _crossing(line, x, its, side: float) -> Crossing:
+    """The crossing at x on ``line`` from its probe there; ``side``: the sign of dg/df1."""
     _, _, o, mu, kind = min(line.probes, key=lambda q: abs(q[0] - x))
     f1, p = line.at(x)
-    return Crossing(kind, p, float(f1), o.X, complex(mu), line.resolution, its, 0.0)
+    return Crossing(kind, p, float(f1), o.X, complex(mu), line.resolution, its, side)
 
 
 def locate(problem, X, f1_Hz: float, resolution: int, p: float = 0.0,
@@ -160,9 +161,7 @@ def locate(problem, X, f1_Hz: float, resolution: int, p: float = 0.0,
     if side is not None and rising != side:
         raise SolverError(f"stability boundary at p = {p:g}: the crossing at {f1:.5f} Hz is "
                           f"the band's other boundary")
-    c = _crossing(line, f1, its)
-    c.side = rising
-    return c
+    return _crossing(line, f1, its, rising)
 
 
 def _first_tangent(problem_at, first: Crossing, s_p: float, to_stop: float):
@@ -226,7 +225,7 @@ def trace(problem_at, first: Crossing, p_stop: float, step: float,
         try:
             x, rising, its = _root(line, guess[k], float(np.sign(normal[k])) or None,
                                    BRACKET_HZ / s_f, 2 * h + JUMP_HZ / s_f, SECANT_HZ / s_f)
-            got = _crossing(line, x, its)
+            got = _crossing(line, x, its, float(np.sign(normal[0])))  # g rises along normal
             if rising != np.sign(normal[k]) or np.linalg.norm(u(got) - u(last)) > REACH * h:
                 raise SolverError("another boundary, or one beyond the step's reach")
             if (got.p - first.p) * to_stop < 0 or (got.p - p_stop) * to_stop > 0:
@@ -238,7 +237,6 @@ def trace(problem_at, first: Crossing, p_stop: float, step: float,
                                 f"corrector found no crossing within {2 * h * s_p:.3g} in p "
                                 f"or {2 * h * s_f:.3g} Hz beyond it")
             continue
-        got.side = rising if fixed_p else float(np.sign(normal[0]))
         points.append(got)
         if got.p == p_stop:
             return points, "reached the end of the window"

@@ -214,7 +214,7 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         curves = envelope_curves.fold_curves(problem_at, vary.key, values, ticks, folds_at,
                                              substeps)
         fold_wall = time.perf_counter() - clock
-        others = envelope_curves.bifurcation_curves(problem_at, vary.key, values, ticks,
+        others = envelope_curves.bifurcation_curves(problem_at, vary.key, values,
                                                     bifurcations_at, substeps)
         result = EnvelopeResult(scene=params.name, title=params.title, key=vary.key,
                                 values=values, f1_window_Hz=[f1_lo, f1_hi], method=used,

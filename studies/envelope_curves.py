@@ -128,7 +128,7 @@ def _trace_crossing(problem_at, first, path, substeps, key) -> dict:
     return curve
 
 
-def bifurcation_curves(problem_at, key, values, ticks, starts, substeps=SUBSTEPS) -> list:
+def bifurcation_curves(problem_at, key, values, starts, substeps=SUBSTEPS) -> list:
     """Each tick's stability boundaries other than folds (``starts``: the brackets
     between branch points) located, then continued forward, and back where no curve
     reached them, each to the nearest tick that has it (:func:`_trace_crossing`)."""

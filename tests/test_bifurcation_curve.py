@@ -162,19 +162,17 @@ def test_the_other_boundary_is_refused():
 
 def _envelope_curves(values, with_crossings):
     """studies/envelope_curves.py on the Mathieu tongue: ticks at ``values`` of eps, those
-    in ``with_crossings`` reporting its two PD boundaries (brentq on the monodromy) with
-    a bracket around each, as the envelope's branches would."""
+    in ``with_crossings`` starting from its two PD boundaries (brentq on the monodromy)
+    with a bracket around each, as the envelope's branches would."""
     from rawehelix.studies import envelope_curves
 
     freqs, B, _ = SCENES["period_doubling"]
     found = {e: [_boundary("period_doubling", e, side) for side in (-1, 1)]
              for e in with_crossings}
-    ticks = [{"bifurcations": [{"kind": "period_doubling", "f1_Hz": f} for f in found.get(e, [])]}
-             for e in values]
     starts = [[{"kind": "period_doubling", "f1_Hz": f, "X": np.zeros(2), "resolution": None,
                 "bracket_Hz": (f - 0.01, f + 0.02)} for f in found.get(e, [])] for e in values]
     return envelope_curves.bifurcation_curves(lambda e: LinearPeriodic(freqs, B, e), "eps",
-                                              values, ticks, starts)
+                                              values, starts)
 
 
 def test_the_envelope_traces_each_crossing_forward_and_back_where_it_is_new():
