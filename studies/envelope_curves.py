@@ -26,6 +26,7 @@ from rawehelix.errors import SolverError
 SUBSTEPS = 4  # natural steps in KEY from one tick to the next
 CHECK_HZ = 1e-3  # a curve's end and the next tick's own event agree within this
 MATCH_HZ = 0.05  # the next tick's event nearer than this is the same one (checked)
+SAME_HZ = 1e-5  # two boundaries of one tick this close are one (located to 1e-6 Hz)
 
 
 class Problems:
@@ -85,17 +86,21 @@ def fold_curves(problem_at, key, values, ticks, starts, substeps=SUBSTEPS) -> li
 
 
 def _boundaries(problem_at, value, starts) -> list:
-    """The tick's stability boundaries (other than folds): each located by regula falsi
-    between the two branch points whose stability differs (a Crossing, or the error)."""
+    """The tick's stability boundaries (other than folds), as (start, Crossing or the
+    error): each located by regula falsi between the two branch points whose stability
+    differs; one the branch met before (it passes a band twice, as an S-curve through it
+    does) is kept once."""
     from rawehelix.periodic_orbits import bifurcation_curve
     out = []
     for s in starts:
         try:
-            out.append(bifurcation_curve.locate(problem_at(value), s["X"], s["f1_Hz"],
-                                                s["resolution"], p=value,
-                                                bracket=s["bracket_Hz"]))
+            c = bifurcation_curve.locate(problem_at(value), s["X"], s["f1_Hz"],
+                                         s["resolution"], p=value, bracket=s["bracket_Hz"])
         except SolverError as err:
-            out.append(f"not located at the tick: {err}")
+            out.append((s, f"not located at the tick: {err}"))
+            continue
+        if not any(not isinstance(o, str) and abs(o.f1_Hz - c.f1_Hz) <= SAME_HZ for _, o in out):
+            out.append((s, c))
     return out
 
 
@@ -132,11 +137,12 @@ def bifurcation_curves(problem_at, key, values, starts, substeps=SUBSTEPS) -> li
     """Each tick's stability boundaries other than folds (``starts``: the brackets
     between branch points) located, then continued forward, and back where no curve
     reached them, each to the nearest tick that has it (:func:`_trace_crossing`)."""
-    located = [_boundaries(problem_at, v, row) for v, row in zip(values, starts)]
+    pairs = [_boundaries(problem_at, v, row) for v, row in zip(values, starts)]
+    located = [[c for _, c in row] for row in pairs]
     found = [[c.f1_Hz for c in row if not isinstance(c, str)] for row in located]
     curves = [{"kind": s["kind"], "from_value": values[k], "to_value": values[k],
                "tick_Hz": s["f1_Hz"], "points": [], "end": c, "check_Hz": None}
-              for k, row in enumerate(located) for s, c in zip(starts[k], row) if isinstance(c, str)]
+              for k, row in enumerate(pairs) for s, c in row if isinstance(c, str)]
 
     def reached(k, c, loops_only):
         """Whether a curve ended on the crossing c of tick k (checked against it)."""

@@ -160,17 +160,19 @@ def test_the_other_boundary_is_refused():
         pytest.approx(upper, abs=1e-5)
 
 
-def _envelope_curves(values, with_crossings):
+def _envelope_curves(values, with_crossings, twice=False):
     """studies/envelope_curves.py on the Mathieu tongue: ticks at ``values`` of eps, those
     in ``with_crossings`` starting from its two PD boundaries (brentq on the monodromy)
-    with a bracket around each, as the envelope's branches would."""
+    with a bracket around each, as the envelope's branches would (``twice``: each
+    boundary met twice, as by a branch that passes the band twice)."""
     from rawehelix.studies import envelope_curves
 
     freqs, B, _ = SCENES["period_doubling"]
     found = {e: [_boundary("period_doubling", e, side) for side in (-1, 1)]
              for e in with_crossings}
     starts = [[{"kind": "period_doubling", "f1_Hz": f, "X": np.zeros(2), "resolution": None,
-                "bracket_Hz": (f - 0.01, f + 0.02)} for f in found.get(e, [])] for e in values]
+                "bracket_Hz": (f - 0.01, f + 0.02)} for f in found.get(e, [])] * (1 + twice)
+              for e in values]
     return envelope_curves.bifurcation_curves(lambda e: LinearPeriodic(freqs, B, e), "eps",
                                               values, starts)
 
@@ -202,6 +204,8 @@ def test_a_tick_that_stepped_over_the_band_is_passed_through():
     crossings go on through 0.125 to 0.15's own (within 1e-5 Hz), saying so."""
     curves = _envelope_curves([0.10, 0.125, 0.15], with_crossings=(0.10, 0.15))
     assert len(curves) == 2
+    twice = _envelope_curves([0.10, 0.125, 0.15], with_crossings=(0.10, 0.15), twice=True)
+    assert [c["points"] for c in twice] == [c["points"] for c in curves]  # traced once each
     for c in curves:
         assert (c["from_value"], c["to_value"]) == (0.10, 0.15)
         assert abs(c["check_Hz"]) <= 1e-5
