@@ -121,7 +121,8 @@ def test_the_tensegritys_unstable_band_is_the_shootings():
     has a narrow unstable band that moves up in f1 with the tension: 9.34-9.59 Hz at
     elongation 0.002 (a complex pair near -1 leaves the unit circle, turns real, and a real
     multiplier comes back through -1), 10.98-11.03 Hz at 0.005 (complex throughout).  The
-    envelope over 0.002-0.005 finds both boundaries on each branch and traces the two
+    envelope over 0.002-0.005, its branches stepping at most 0.1 Hz, finds both
+    boundaries on each branch and traces the two
     from 0.002 to 0.005, where they end on that branch's own within 1e-3 Hz.  At each
     curve's ends and middle the shooting (generalised-alpha, dt = 0.1 ms; the monodromy's
     multipliers) changes stability within 2e-3 Hz of it at that elongation."""
@@ -133,7 +134,7 @@ def test_the_tensegritys_unstable_band_is_the_shootings():
             "section.self_stress_N": 30.0, "section.bar_EA_N": 1e4}
     params = rh.load_scene("mobile_end", elements=4, degree=3, overrides=sets)
     result = rh.envelope(params, "ends.elongation=0.002:0.005:2", 9.0, 11.3,
-                         comm=MPI.COMM_SELF)
+                         comm=MPI.COMM_SELF, f1_step_Hz=0.1)  # the branches land in the band
     s = result.summary
     curves = s["bifurcation_curves"]
     assert len(curves) == 2, curves
