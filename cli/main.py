@@ -24,9 +24,10 @@ unknown ``--option``.  ``-v`` shows more (``-vv`` everything).  Bad input
 exits with status 2 and one message naming file, key and what is allowed;
 nothing is written (the output folder, the memory and the disk a run needs
 are checked before it starts: studies/outdir.py, studies/resources.py).  A
-failed solve exits with status 1.  A study with failed points, or a
-calibration that missed a target by more than its tolerance, writes its
-results and exits with status 3.  Ctrl-C exits with 130, saying what was kept
+failed solve exits with status 1.  A study with failed points, a
+calibration that missed a target by more than its tolerance, or a fit
+(calibrate, labtest --fit) whose data could not determine its parameters,
+writes its results and exits with status 3.  Ctrl-C exits with 130, saying what was kept
 and how to resume.
 """
 

@@ -39,9 +39,26 @@ _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "boo
                "EILaw | None": "an inline table {a_Nm2_per_N = .., b_Nm2 = ..}"}
 
 
+def value_type(type_name: str) -> str:
+    """The type a scene value of a field of this annotation has: an optional number
+    (``float | None``, ``int | None``: absent is None, as TOML has no null) is a number
+    when a scene sets it.  The one place that reads an optional key's annotation."""
+    base, _, none = type_name.partition(" | ")
+    return base if none == "None" and base in ("float", "int") else type_name
+
+
+def key_type(key: str) -> str:
+    """The dotted scene key's value type ('float', 'int', 'str', ...; an optional
+    number's too, :func:`value_type`), or 'float' if unknown (the loader then names
+    the key)."""
+    section, _, name = key.partition(".")
+    cls = SECTIONS.get(section)
+    types = {f.name: f.type for f in dataclasses.fields(cls)} if cls else {}
+    return value_type(types.get(name, "float"))
+
+
 def _check_type(path, key: str, value, type_name: str):
-    if type_name == "float | None":  # an optional number: absent is None (TOML has no null)
-        type_name = "float"
+    type_name = value_type(type_name)
     ok = {
         "float": isinstance(value, (int, float)) and not isinstance(value, bool),
         "int": isinstance(value, int) and not isinstance(value, bool),
