@@ -1,5 +1,6 @@
 """The `rawehelix` command line: a thin layer over the Python API (:mod:`rawehelix.api`).
 
+    rawehelix section SCENE [--set KEY=VALUE] [-o DIR]
     rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
     rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]

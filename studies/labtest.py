@@ -55,6 +55,7 @@ TESTS = ("axial", "bending", "torsion")
 LAB_LENGTH_M = 6.76  # L0 of the lab segment, Sec. 4
 LAB_ELEMENTS = 8  # N of the segment unless the caller sets it (smooth: N = 8, p = 3 to ~1e-6)
 EQ64 = (52.4, 2290.0)  # Eq. (64): EI [N m^2] = 52.4 T_e [N] + 2290
+LAB_EA_N = 3.64e4  # Eq. (62)'s regression over the axial test (Sec. 4, Fig. 3; Table 2)
 PAPER_BENDING_TENSIONS_N = (90.0, 181.0, 259.0)  # Sec. 4, Fig. 4
 DEFAULT_TENSIONS_N = {"axial": (50.0, 100.0, 150.0, 200.0, 250.0),
                       "bending": PAPER_BENDING_TENSIONS_N,

@@ -22,6 +22,7 @@ from pathlib import Path
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
 from rawehelix.parameters import (Controller, Discretisation, Ends, Environment, Helix, Model,
                                   ParameterError, Parameters, Sweep, Time, Torque, components)
+from rawehelix.parameters.sections import STIFFNESS_KEYS
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
@@ -93,7 +94,27 @@ def _section(path, name: str, table) -> object:
     try:
         return cls(**values)
     except ParameterError as err:
-        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+        raise _scene_error(path, err) from None
+
+
+def _scene_error(path, err: ParameterError) -> SceneError:
+    """A dataclass's refusal as the scene's: ``key: value what is allowed`` (an absent
+    key, value None: ``key: what is allowed``)."""
+    said = err.allowed if err.value is None else f"{err.value!r} {err.allowed}"
+    return SceneError(path, err.key, said)
+
+
+def _stiffness_given_twice(path, helix) -> None:
+    """helix.stiffness = "from_section" takes EA_N, EI_Nm2 and GJ_Nm2 from [section]:
+    a scene (or --set) that gives one of them too is refused, naming it."""
+    if not isinstance(helix, dict) or helix.get("stiffness") != "from_section":
+        return
+    for name in STIFFNESS_KEYS:
+        if name in helix:
+            raise SceneError(path, f"helix.{name}",
+                             "is given, but helix.stiffness = 'from_section' takes EA_N, "
+                             "EI_Nm2 and GJ_Nm2 from the [section]'s members: remove it, or "
+                             "set helix.stiffness = 'given'")
 
 
 def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) -> Parameters:
@@ -107,6 +128,7 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
     for name_ in REQUIRED:
         if name_ not in data:
             raise SceneError(path, name_, f"the section [{name_}] is required")
+    _stiffness_given_twice(path, data["helix"])
     sections = {s: _section(path, s, data[s]) for s in SECTIONS if s in data}
     for nested, holder in NESTED.items():  # [damping] -> Model.damping, ...
         if nested in sections:
@@ -116,7 +138,7 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
     try:
         return Parameters(**sections, name=label, title=data.get("title", label))
     except ParameterError as err:
-        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+        raise _scene_error(path, err) from None
 
 
 def apply_overrides(data: dict, overrides: dict, path="<scene>") -> dict:

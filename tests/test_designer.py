@@ -157,3 +157,173 @@ def test_an_integer_grid_of_integers_is_kept_as_integers():
     from rawehelix.studies import study
     assert [study.cast("discretisation.elements", v) for v in np.linspace(2, 8, 4)] == [2, 4, 6, 8]
     assert isinstance(study.cast("helix.EI_Nm2", 3), float)
+
+
+# -- section.rings: the number of rings instead of their spacing -------------------------
+
+def test_rings_and_their_spacing_give_identical_limits():
+    """section.rings = 9 on the 16.12 m helix is ring_spacing_m = 16.12 / 8: the same
+    members, and the same limits block of a solved stationary state."""
+    import rawehelix as rh
+    L0 = rh.load_scene("stationary_table2").helix.length_m
+    by_rings = rh.load_scene("stationary_table2", elements=4, overrides={"section.rings": 9})
+    by_spacing = rh.load_scene("stationary_table2", elements=4,
+                               overrides={"section.ring_spacing_m": L0 / 8})
+    m = by_rings.model.section.members(by_rings.helix)
+    assert m == by_spacing.model.section.members(by_spacing.helix)
+    assert m.ring_spacing_m == L0 / 8 and np.isfinite(m.critical_twist())
+    a, b = rh.stationary(by_rings).summary["limits"], rh.stationary(by_spacing).summary["limits"]
+    assert a == b and a["criteria"]["torsional_collapse"] is not None
+    off = rh.stationary(rh.load_scene("stationary_table2", elements=4)).summary["limits"]
+    assert off["criteria"]["torsional_collapse"] is None  # neither: the check is off
+
+
+@pytest.mark.parametrize("sets,message", [
+    (["section.rings=8", "section.ring_spacing_m=0.5"],
+     "section.rings: 8 and section.ring_spacing_m = 0.5 both set the rings' spacing"),
+    (["section.rings=1"], "section.rings: 1 must be an integer >= 2"),
+    (["section.rings=-3"], "section.rings: -3 must be an integer >= 2"),
+    (["section.rings=2.5"], "section.rings: must be an integer, got 2.5"),
+])
+def test_bad_rings_are_refused_in_one_line(tmp_path, sets, message):
+    argv = ["stationary", "stationary_table2"]
+    for item in sets:
+        argv += ["--set", item]
+    _refused(tmp_path, argv, message)
+
+
+# -- helix.stiffness = "from_section" and `rawehelix section` ---------------------------
+
+OWN = """
+[helix]
+length_m = 30.0
+mass_kg = 3.0
+radius_m = 0.5
+stiffness = "from_section"
+[ends]
+elongation = 0.005
+elevation_deg = 30.0
+[section]
+tethers = {n}
+tether_EA_N = {k}
+lay_angle_deg = {lay}
+self_stress_N = {P0}
+bar_EA_N = {bars}
+rings = 8
+"""
+
+
+def _closed_forms(n, k, R, lay_deg, P0, bars):
+    """EA, EI, GJ of n tethers of stiffness k at radius R laid at beta, each carrying
+    P0 at zero strain, bars EA_b on the axis, written out here (not members.py): a
+    tether's axial share is k cos^3 beta (its strain cos(beta) x the axial strain, its
+    force's axial part cos(beta) again, its length 1/cos(beta) per unit rod length ...
+    and P0's geometric share P0 cos beta sin^2 beta); the ring's second moment is
+    sum cos^2(phi_m) R^2 = n R^2 / 2; the lay's torsion k sin^2 beta cos beta R^2 and
+    the tension's P0 cos^3 beta R^2 per tether."""
+    b = np.radians(lay_deg)
+    axial = n * (k * np.cos(b) ** 3 + P0 * np.cos(b) * np.sin(b) ** 2)
+    second_moment = sum(np.cos(2 * np.pi * j / n) ** 2 for j in range(n)) * R**2
+    return {"EA_N": axial + bars, "EI_Nm2": axial * second_moment / n,
+            "GJ_Nm2": n * np.cos(b) * R**2 * (k * np.sin(b) ** 2 + P0 * np.cos(b) ** 2)}
+
+
+SECTIONS = [  # n, k [N], lay [deg], P0 [N], bars EA_b [N]
+    (6, 20000.0, 0.0, 50.0, 1e4),  # no lay: GJ = n P0 R^2, EA = n k + EA_b, EI = n k R^2 / 2
+    (6, 20000.0, 5.0, 0.0, 0.0),
+    (3, 1234.5, 30.0, 0.0, 0.0),
+    (8, 5e5, 12.0, 100.0, 2e5),
+]
+
+
+@pytest.mark.parametrize("n,k,lay,P0,bars", SECTIONS)
+def test_from_section_puts_the_members_closed_forms_in_the_rod(tmp_path, n, k, lay, P0, bars):
+    import rawehelix as rh
+    path = tmp_path / "own.toml"
+    path.write_text(OWN.format(n=n, k=k, lay=lay, P0=P0, bars=bars))
+    p = rh.load_scene(path)
+    want = _closed_forms(n, k, 0.5, lay, P0, bars)
+    if lay == 0:
+        assert want["EA_N"] == pytest.approx(n * k + bars, rel=1e-14)
+        assert want["EI_Nm2"] == pytest.approx(n * k * 0.25 / 2, rel=1e-14)
+        assert want["GJ_Nm2"] == pytest.approx(n * P0 * 0.25, rel=1e-14)
+    for key, value in want.items():
+        assert getattr(p.helix, key) == pytest.approx(value, rel=1e-12), key
+    # the scene's other spellings follow: the section changed through replace() ...
+    q = p.replace(section={"tether_EA_N": 2 * k})
+    assert q.helix.EA_N == pytest.approx(_closed_forms(n, 2 * k, 0.5, lay, P0, bars)["EA_N"])
+    # ... and `rawehelix section` prints and stores the same numbers
+    run = _run(tmp_path, "section", str(path), "-o", "SEC")
+    assert run.returncode == 0, run.stderr
+    s = json.loads((tmp_path / "SEC" / "summary.json").read_text())
+    for key, value in want.items():
+        assert s["taut_moduli"][key] == pytest.approx(value, rel=1e-12)
+        assert s["helix"][key] == pytest.approx(value, rel=1e-12)
+    assert s["members"]["ring_spacing_m"] == pytest.approx(30.0 / 7)
+    assert f"= {want['EA_N']:.6g} N" in run.stdout and f"= {want['GJ_Nm2']:.6g} N m^2" in run.stdout
+    # under the chord's tension T, the tethers' share T_t (the bars carry the rest)
+    # adds T_t R^2 to GJ without a lay (to the strain's order)
+    T = s["at_tension"]["tension_N"]
+    assert T == pytest.approx(want["EA_N"] * 0.005)
+    T_t = T * (want["EA_N"] - bars) / want["EA_N"]
+    if lay == 0:
+        assert s["at_tension"]["GJ_Nm2"] - want["GJ_Nm2"] == pytest.approx(T_t * 0.25, rel=0.01)
+
+
+def test_section_prints_the_lab_tests_values_for_a_given_scene(tmp_path):
+    """A scene with given stiffness: the section's tether stiffness is derived from
+    helix.EA_N, and the lab tests' values (Sec. 4) are the alternative printed."""
+    run = _run(tmp_path, "section", "stationary_table2", "-o", "SEC")
+    assert run.returncode == 0, run.stderr
+    s = json.loads((tmp_path / "SEC" / "summary.json").read_text())
+    assert s["helix"]["EA_N"] == 3.64e4 and s["taut_moduli"]["EA_N"] == pytest.approx(3.64e4)
+    assert s["members"]["tether_EA_from"].startswith("derived")
+    lab = s["lab_tests"]
+    assert (lab["EA_N"], lab["EI_law"], lab["GJ_Nm2"], lab["GJ_at_tension_N"]) == (
+        3.64e4, {"a_Nm2_per_N": 52.4, "b_Nm2": 2290.0}, 140.0, 200.0)
+    T = s["at_tension"]["tension_N"]
+    assert lab["EI_at_tension_Nm2"] == pytest.approx(52.4 * T + 2290.0)
+    assert "EI = 52.4 T + 2290 N m^2 (Eq. 64" in run.stdout
+
+
+@pytest.mark.parametrize("sets,message", [
+    (["helix.EA_N=1e5"], "helix.EA_N: is given, but helix.stiffness = 'from_section' takes"),
+    (["helix.GJ_Nm2=100"], "helix.GJ_Nm2: is given, but helix.stiffness = 'from_section'"),
+    (["section.tether_EA_N=nan"], "section.tether_EA_N"),
+    (["section.lay_angle_deg=0"], "section.lay_angle_deg: 0.0 gives no torsional stiffness"),
+    (["helix.stiffness=\"members\""], "helix.stiffness: 'members' must be one of"),
+])
+def test_from_section_refuses_too_much_or_too_little(tmp_path, sets, message):
+    (tmp_path / "in").mkdir()
+    path = tmp_path / "in" / "own.toml"
+    path.write_text(OWN.format(n=6, k=2e4, lay=5.0, P0=0.0, bars=0.0))
+    argv = ["stationary", str(path)]
+    for item in sets:
+        argv += ["--set", item]
+    run = _run(tmp_path, *argv, "-o", str(tmp_path / "OUT"))
+    assert run.returncode == 2 and len(run.stderr.splitlines()) == 1, run.stderr
+    assert message in run.stderr and not (tmp_path / "OUT").exists()
+
+
+def test_from_section_names_a_missing_tether_stiffness_and_given_names_a_missing_EA(tmp_path):
+    import rawehelix as rh
+    path = tmp_path / "own.toml"
+    path.write_text(OWN.format(n=6, k=2e4, lay=5.0, P0=0.0, bars=0.0)
+                    .replace("tether_EA_N = 20000.0\n", ""))
+    with pytest.raises(rh.SceneError, match="section.tether_EA_N: is required by "
+                                            "helix.stiffness = 'from_section'"):
+        rh.load_scene(path)
+    path.write_text(path.read_text().replace('stiffness = "from_section"', ""))
+    with pytest.raises(rh.SceneError, match=r"helix.EA_N: is required \(or set helix.stiffness"):
+        rh.load_scene(path)
+
+
+def test_the_new_keys_at_their_defaults_keep_stored_fingerprints():
+    import rawehelix as rh
+    for name in ("stationary_table2", "nominal_operation"):
+        data = rh.load_scene(name).as_dict()
+        assert "stiffness" not in data["helix"]
+        assert "rings" not in data["model"].get("section", {})
+    tensegrity = rh.load_scene("stationary_table2", overrides={"section.law": "tensegrity",
+                                                                "model.kinematics": "extensible"})
+    assert "rings" not in tensegrity.as_dict()["model"]["section"]

@@ -1,4 +1,4 @@
-"""The single-run commands: stationary, modes, simulate, sweep, response, orbits."""
+"""The single-run commands: section (no solve), stationary, modes, simulate, sweep, response, orbits."""
 
 from __future__ import annotations
 
@@ -13,6 +13,14 @@ def _written(comm, result, text: str, outdir, before: str = "\n  ") -> int:
     """A run's files (``result.write``) and its report with where they are."""
     result.write(outdir)
     say(comm, text + f"{before}wrote {outdir}/")
+    return 0
+
+
+def _section(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import section_moduli
+    result = rh.section(params)
+    result.write(outdir, comm.rank)
+    say(comm, section_moduli.report(result) + f"\n  wrote {outdir}/")
     return 0
 
 
@@ -147,6 +155,8 @@ def _none(p):
 
 
 COMMANDS = [
+    Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
+            _none, _section),
     Command("stationary", "stationary state with fixed ends (Sec. 5.1)", _none, _stationary),
     Command("modes", "natural modes about the stationary state (Table 3)", _modes_arguments,
             _modes),
