@@ -49,16 +49,20 @@ def _finite(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
-def chord_tension(params: Parameters) -> float:
-    """T = EA eps0 [N]: the straight chord's tension (ends.elongation, Eq. 66)."""
-    return params.helix.EA_N * params.ends.elongation
+def chord_tension(params: Parameters) -> tuple[float, str]:
+    """(T [N], its source): the scene's tension where it gives one (ends.tension_N),
+    else the straight chord's T = EA eps0 (ends.elongation, Eq. 66)."""
+    given = getattr(params.ends, "tension_N", None)
+    if given is not None:
+        return float(given), "ends.tension_N"
+    return params.helix.EA_N * params.ends.elongation, "helix.EA_N x ends.elongation"
 
 
 def compute(params: Parameters) -> SectionResult:
     """The moduli of ``params``'s section (see the module doc)."""
     section, helix = params.model.section, params.helix
     m = section.members(helix, width=0.0)
-    T = chord_tension(params)
+    T, source = chord_tension(params)
     eps = T / m.taut_moduli()["EA"]
     lab_EI = float(labtest.eq64(T))
     GJ_lab, T_GJ = labfit.GJ_TARGET
@@ -80,7 +84,7 @@ def compute(params: Parameters) -> SectionResult:
         "taut_moduli_meaning": "members.py's closed forms at zero strain, every tether "
                                "taut: what helix.stiffness = 'from_section' puts in the rod",
         "formulas": FORMULAS,
-        "at_tension": {"tension_N": T, "tension_from": "helix.EA_N x ends.elongation",
+        "at_tension": {"tension_N": T, "tension_from": source,
                        "tethers_tension_N": T * (1 - m.EA_b / m.taut_moduli()["EA"]),
                        **_moduli(m.tangent(eps)),
                        "meaning": "the members' tangent moduli at the stretch of that "
@@ -123,7 +127,7 @@ def report(result: SectionResult) -> str:
     lines.append("  the members' taut moduli at zero strain (members.py):")
     for key, unit in (("EA_N", "N"), ("EI_Nm2", "N m^2"), ("GJ_Nm2", "N m^2")):
         lines.append(f"    {key[:2]} = {FORMULAS[key]:52s} = {taut[key]:.6g} {unit}")
-    lines.append(f"  under the chord's tension T = {at['tension_N']:.6g} N ({at['tension_from']}):"
+    lines.append(f"  under the tension T = {at['tension_N']:.6g} N ({at['tension_from']}):"
                  f" EA = {at['EA_N']:.6g} N, EI = {at['EI_Nm2']:.6g} N m^2, GJ = "
                  f"{at['GJ_Nm2']:.6g} N m^2 (without a lay the tethers' tension T_t adds "
                  f"T_t R^2 = {at['tethers_tension_N'] * m['radius_m'] ** 2:.4g} to GJ)")
