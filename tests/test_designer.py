@@ -157,6 +157,10 @@ def test_an_integer_grid_of_integers_is_kept_as_integers():
     from rawehelix.studies import study
     assert [study.cast("discretisation.elements", v) for v in np.linspace(2, 8, 4)] == [2, 4, 6, 8]
     assert isinstance(study.cast("helix.EI_Nm2", 3), float)
+    # an optional integer key (int | None) is an integer key too: section.rings = 8,
+    # not 8.0 (which the loader would refuse); an optional number is a number
+    assert study.cast("section.rings", 8.0) == 8 and isinstance(study.cast("section.rings", 8.0), int)
+    assert study.key_type("helix.GA_N") == "float" and study.key_type("helix.EI_law") != "float"
 
 
 # -- section.rings: the number of rings instead of their spacing -------------------------
