@@ -26,7 +26,10 @@ class Helix:
     ``stiffness = "from_section"`` takes EA_N, EI_Nm2 and GJ_Nm2 from the members of
     ``[section]`` (their taut moduli at zero strain, members.py: n tethers of stiffness
     section.tether_EA_N at the radius, laid at the lay angle, with the self-stress and
-    the bars); :class:`~rawehelix.parameters.Parameters` fills them in.
+    the bars); :class:`~rawehelix.parameters.Parameters` fills them in, again after
+    every ``replace`` (so they follow the section).  A scene file or ``--set`` that
+    gives one of them too is refused (studies/scene.py); values passed to this
+    dataclass directly are replaced.
 
     ``EI_law`` (None: off) makes the bending stiffness a function of the local
     tension (:class:`EILaw`; a scene's ``EI_law = {a_Nm2_per_N = .., b_Nm2 = ..}``).

@@ -268,7 +268,9 @@ def _cross_section_rules() -> list[tuple[str, str]]:
               {"model": {"kinematics": "extensible"}, **ip_only},
               {"helix": {"EI_law": PAPER_EI_LAW}},
               {"damping": {"axial_s": 1e-3}, **ip_only},
-              {"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 1.0}, **ip_only}]
+              {"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 1.0}, **ip_only},
+              {"helix": {"stiffness": "from_section"}},
+              {"helix": {"stiffness": "from_section"}, "section": {"tether_EA_N": 6e3}}]
     found = []
     for trial in trials:
         try:
