@@ -331,3 +331,20 @@ def test_the_new_keys_at_their_defaults_keep_stored_fingerprints():
     tensegrity = rh.load_scene("stationary_table2", overrides={"section.law": "tensegrity",
                                                                 "model.kinematics": "extensible"})
     assert "rings" not in tensegrity.as_dict()["model"]["section"]
+
+
+def test_a_lab_fit_its_data_could_not_determine_exits_3_and_says_so():
+    """labtest's result: exit status 3 (EXIT_UNMET) with the reason in its report
+    when labfit.fit returned ``undetermined``; 0 otherwise."""
+    from rawehelix.studies import labtest, study
+    summary = {"test": "bending", "scene": "s", "length_m": 6.76, "elements": 8, "degree": 3,
+               "gravity": True, "fit": True, "tension_N": [90.0, 181.0],
+               "intrinsic_EI_Nm2": [1.0, 2.0], "apparent_EI_Nm2": [1.0, 2.0],
+               "eq64_EI_Nm2": [1.0, 2.0], "relative_error": [0.0, 0.0],
+               "law": {"a_Nm2_per_N": 1.0, "b_Nm2": 2.0},
+               "undetermined": "the design has rank 1 for 2 parameters"}
+    bad = labtest.LabTest(None, "bending", [], summary)
+    assert bad.exit_status == study.EXIT_UNMET == 3
+    assert "is not determined: the design has rank 1 for 2 parameters" in labtest._report(bad)
+    good = labtest.LabTest(None, "bending", [], {**summary, "undetermined": None})
+    assert good.exit_status == 0 and "reproduces Eq. (64) within" in labtest._report(good)
