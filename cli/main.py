@@ -1,11 +1,11 @@
 """The `rawehelix` command line: a thin layer over the Python API (:mod:`rawehelix.api`).
 
-    rawehelix section SCENE [--set KEY=VALUE] [-o DIR]
     rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
     rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
     rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
+    rawehelix section SCENE [--set KEY=VALUE] [-o DIR]
     rawehelix converge SCENE --quantity Q [-o DIR]
     rawehelix extremes [CASE ...] [-o DIR]
     rawehelix labtest axial|bending|torsion [--tension T1,T2,...] [--loads X1,...] [--fit]

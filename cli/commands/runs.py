@@ -1,4 +1,5 @@
-"""The single-run commands: section (no solve), stationary, modes, simulate, sweep, response, orbits."""
+"""The single-run commands: stationary, modes, simulate, sweep, response, orbits, and
+section (closed forms, no solve)."""
 
 from __future__ import annotations
 
@@ -155,8 +156,6 @@ def _none(p):
 
 
 COMMANDS = [
-    Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
-            _none, _section),
     Command("stationary", "stationary state with fixed ends (Sec. 5.1)", _none, _stationary),
     Command("modes", "natural modes about the stationary state (Table 3)", _modes_arguments,
             _modes),
@@ -168,4 +167,6 @@ COMMANDS = [
             _f1_grid_arguments, _response, f1_grid=True),
     Command("orbits", "periodic orbits over f1 with Floquet stability, through folds",
             _orbits_arguments, _orbits, kept="window*/p*.json"),
+    Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
+            _none, _section),
 ]
