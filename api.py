@@ -22,7 +22,7 @@ from __future__ import annotations
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
-__all__ = ["load_scene", "stationary", "modes", "response", "simulate", "sweep", "orbits",
+__all__ = ["load_scene", "section", "stationary", "modes", "response", "simulate", "sweep", "orbits",
            "envelope",
            "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters"]
 
@@ -54,6 +54,14 @@ def load_scene(name_or_path, elements: int | None = None, degree: int | None = N
     from rawehelix.studies import scene
     return scene.load(name_or_path, elements=elements, degree=degree, scheme=scheme,
                       overrides=overrides)
+
+
+def section(scene: Parameters):
+    """EA, EI and GJ of the scene's section's members (closed forms, no solve), what
+    they come from, and the lab tests' values: :mod:`rawehelix.studies.section_moduli`
+    (``rawehelix section``).  ``result.summary``, ``result.write(outdir)``."""
+    from rawehelix.studies import section_moduli
+    return section_moduli.compute(scene)
 
 
 def stationary(scene: Parameters, comm=None):

@@ -54,6 +54,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rawehelix import fits
+
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
 import study as study_bench  # benchmarks/study.py
 
@@ -64,6 +66,10 @@ FE_SWEEP = {"elements": 8, "degree": 3}  # converged within 1 % (README, Sec. 5.
 SWEEP_F1 = [0.5 * k for k in range(1, 31)]  # Fig. 8: 30 points, 0.5-15 Hz
 SWEEP_FEW_F1 = [9.0, 9.5, 10.0]  # a few Fig. 8 points near the resonance
 TENSION_MAX_REF_N = 244.4777456315  # T max at 10 Hz, FE p = 4, N = 16 (docs/converge/tension_max)
+
+
+def _exponent(x) -> str:
+    return "not determined (fewer than 2 distinct N >= 100)" if x is None else f"{x:.2f}"
 
 
 def stats(values):
@@ -166,7 +172,9 @@ def bench_step_cost(repeats: int, ladder):
     Ns = np.array(ladder, dtype=float)
     t = np.array([rows[N]["median"] for N in ladder])
     big = Ns >= 100
-    slope = float(np.polyfit(np.log(Ns[big]), np.log(t[big]), 1)[0])
+    # the exponent needs two distinct N >= 100 (a --ladder of fewer: not determined, None)
+    determined = fits.undetermined(fits.polynomial(np.log(Ns[big]), 1), 2) is None
+    slope = float(np.polyfit(np.log(Ns[big]), np.log(t[big]), 1)[0]) if determined else None
     return {"per_N": {str(N): rows[N] for N in ladder}, "fitted_exponent_N>=100": slope}
 
 
@@ -567,7 +575,7 @@ def markdown(r: dict) -> str:
         lines.append(
             f"| 2. one Newton iteration of a step against N (median of "
             f"{next(iter(st['per_N'].values()))['runs']}) | {per}; fitted exponent "
-            f"{st['fitted_exponent_N>=100']:.2f} (N >= 100) | {TARGETS['step_cost']} |")
+            f"{_exponent(st['fitted_exponent_N>=100'])} (N >= 100) | {TARGETS['step_cost']} |")
     if md:
         lines.append(f"| 4. modal solve, 20 eigenpairs, N = 2000, p = 3 | "
                      f"{_spread(md['pep_solve_s'], '.2f')} | {TARGETS['modal']} |")

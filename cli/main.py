@@ -5,6 +5,7 @@
     rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
     rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
+    rawehelix section SCENE [--set KEY=VALUE] [-o DIR]
     rawehelix converge SCENE --quantity Q [-o DIR]
     rawehelix extremes [CASE ...] [-o DIR]
     rawehelix labtest axial|bending|torsion [--tension T1,T2,...] [--loads X1,...] [--fit]
@@ -24,9 +25,10 @@ unknown ``--option``.  ``-v`` shows more (``-vv`` everything).  Bad input
 exits with status 2 and one message naming file, key and what is allowed;
 nothing is written (the output folder, the memory and the disk a run needs
 are checked before it starts: studies/outdir.py, studies/resources.py).  A
-failed solve exits with status 1.  A study with failed points, or a
-calibration that missed a target by more than its tolerance, writes its
-results and exits with status 3.  Ctrl-C exits with 130, saying what was kept
+failed solve exits with status 1.  A study with failed points, a
+calibration that missed a target by more than its tolerance, or a fit
+(calibrate, labtest --fit) whose data could not determine its parameters,
+writes its results and exits with status 3.  Ctrl-C exits with 130, saying what was kept
 and how to resume.
 """
 

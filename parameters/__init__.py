@@ -27,11 +27,11 @@ from rawehelix.parameters.normalised import RPM, Normalised
 from rawehelix.parameters.numerics import (BENDINGS, MESHES, PENALTY_MAX, SCHEMES,
                                            Discretisation, Sweep, Time)
 from rawehelix.parameters.scene import GROUP_KEYS, Parameters
-from rawehelix.parameters.sections import (GAMMA_TREATMENTS, KINEMATICS, Controller,
+from rawehelix.parameters.sections import (GAMMA_TREATMENTS, KINEMATICS, STIFFNESS, Controller,
                                            Ends, Environment, Helix, Model, Torque)
 
 __all__ = ["ParameterError", "Damping", "PAPER_EI_LAW", "EILaw", "LATER_HELIX_SWITCHES",
            "LATER_MODEL_SWITCHES", "TorsionHysteresis", "RPM", "Normalised", "BENDINGS", "MESHES",
            "PENALTY_MAX", "SCHEMES", "Discretisation", "Sweep", "Time", "GROUP_KEYS", "Parameters",
-           "GAMMA_TREATMENTS", "KINEMATICS", "Controller", "Ends", "Environment", "Helix", "Model",
+           "GAMMA_TREATMENTS", "KINEMATICS", "STIFFNESS", "Controller", "Ends", "Environment", "Helix", "Model",
            "Torque"]

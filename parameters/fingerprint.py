@@ -11,8 +11,10 @@ from rawehelix.parameters.sections import Helix, Model
 #: every component's section (parameters/components.py)
 LATER_MODEL_SWITCHES = {"kinematics": "paper", "rotary_inertia": True,
                         **components.later_switches("model", Model)}
-#: the same for the helix section (the EI law)
-LATER_HELIX_SWITCHES = components.later_switches("helix", Helix)
+#: the same for the helix section (the EI law, where its stiffness comes from)
+LATER_HELIX_SWITCHES = {**components.later_switches("helix", Helix), "stiffness": "given"}
+#: keys of the model's [section] added after results with a [section] were stored
+LATER_SECTION_KEYS = {"rings": None}
 
 
 def drop_later_switches(data: dict) -> dict:
@@ -22,4 +24,8 @@ def drop_later_switches(data: dict) -> dict:
         for key, default in switches.items():  # fingerprints stored before them
             if data[section][key] == default:
                 data[section].pop(key)
+    stored = data["model"].get("section")  # absent: dropped above at its default
+    for key, default in LATER_SECTION_KEYS.items():
+        if stored is not None and stored.get(key, default) == default:
+            stored.pop(key, None)
     return data

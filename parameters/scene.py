@@ -10,6 +10,7 @@ from rawehelix.parameters import components, sections
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.fingerprint import drop_later_switches
 from rawehelix.parameters.normalised import Normalised
+from rawehelix.parameters.section import helix_stiffness as section_stiffness
 from rawehelix.parameters.numerics import Discretisation, Sweep, Time
 from rawehelix.parameters.sections import Controller, Ends, Environment, Helix, Model, Torque
 
@@ -31,6 +32,9 @@ class Parameters:
     title: str = ""  # the scene's title, for figures
 
     def __post_init__(self):
+        if self.helix.stiffness == "from_section":  # EA, EI, GJ of the section's members
+            stiffness = section_stiffness(self.model.section, self.helix)
+            object.__setattr__(self, "helix", dataclasses.replace(self.helix, **stiffness))
         if not self.model.twist:
             # model.twist = false removes the twist field: alpha = 0 everywhere
             if self.torque.top_Nm != 0 or self.controller.active:

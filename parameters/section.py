@@ -44,6 +44,10 @@ class Section:
     bar_EA_N: float = 0.0  # EA_b, the bars' axial stiffness, on the axis [N]; > 0 with P0 > 0
     breaking_force_N: float | None = None  # F_b, a tether's breaking force [N]; None: not set
     ring_spacing_m: float | None = None  # l, between adjacent rings (torsional collapse); None: off [m]
+    # the number of rings along the helix, both end rings included: l = helix.length_m /
+    # (rings - 1), the unstretched spacing; instead of ring_spacing_m (one of them, or
+    # neither), it switches on the torsional collapse check as that does; None: off
+    rings: int | None = None
     slack_width: float = 1.0e-5  # w, the strain over which a tether goes slack (regularisation) [-]
     torsion: str = "helix"  # the twist's moment: "helix" (GJ_Nm2) or "members" (their torque)
     ring: str = "worst"  # the ring's phase: "worst" (a member on the bending plane) or "turning" (with alpha)
@@ -73,6 +77,15 @@ class Section:
         for name in ("radius_m", "tether_EA_N", "breaking_force_N", "ring_spacing_m"):
             if getattr(self, name) is not None:
                 _positive("section", self, name)
+        if self.rings is not None:
+            if isinstance(self.rings, bool) or not isinstance(self.rings, int) or self.rings < 2:
+                raise ParameterError("section.rings", self.rings,
+                                     "must be an integer >= 2 (the rings along the helix, both "
+                                     "end rings included)")
+            if self.ring_spacing_m is not None:
+                raise ParameterError("section.rings", self.rings,
+                                     f"and section.ring_spacing_m = {self.ring_spacing_m!r} "
+                                     "both set the rings' spacing: give one of them")
         if self.self_stress_N > 0 and self.bar_EA_N <= 0:
             raise ParameterError("section.self_stress_N", self.self_stress_N,
                                  "a self-stress needs bars to balance it: set section.bar_EA_N > 0")
@@ -99,13 +112,57 @@ class Section:
                                      f"leaves the tethers no stiffness: it must be below "
                                      f"helix.EA_N = {helix.EA_N:g} N, or set section.tether_EA_N")
         return Members(n=n, R=self.radius_m or helix.radius_m, beta=beta, k=k, P0=P0, EA_b=EA_b,
-                       breaking_N=self.breaking_force_N, ring_spacing_m=self.ring_spacing_m,
+                       breaking_N=self.breaking_force_N, ring_spacing_m=self.spacing(helix),
                        width=self.slack_width if width is None else width)
+
+    def spacing(self, helix) -> float | None:
+        """l [m], between adjacent rings: ring_spacing_m, or L0 / (rings - 1) (rings
+        counts both end rings); None: neither given (no torsional collapse check)."""
+        if self.rings is not None:
+            return helix.length_m / (self.rings - 1)
+        return self.ring_spacing_m
 
     def describe(self) -> str:
         return (f"section: {self.law}, torsion by the {self.torsion}, {self.tethers} tethers, "
                 f"lay {self.lay_angle_deg:g} deg, ring {self.ring}, "
                 f"self-stress {self.self_stress_N:g} N, slack width {self.slack_width:g}")
+
+
+def helix_stiffness(section: Section, helix) -> dict:
+    """helix.stiffness = "from_section": {EA_N, EI_Nm2, GJ_Nm2} of the members' taut
+    moduli at zero strain (members.py's closed forms: K = n (k cos^3 beta + P0 cos beta
+    sin^2 beta), EA = K + EA_b, EI = K R^2 / 2, GJ = n cos beta R^2 (k sin^2 beta + P0
+    cos^2 beta)).  ParameterError naming what the section lacks to give them."""
+    if section.tether_EA_N is None:
+        raise ParameterError("section.tether_EA_N", None,
+                             "is required by helix.stiffness = 'from_section' (one tether's "
+                             "axial stiffness [N]: the section's EA, EI and GJ follow from it)")
+    if section.lay_angle_deg == 0 and section.self_stress_N == 0:
+        raise ParameterError("section.lay_angle_deg", section.lay_angle_deg,
+                             "gives no torsional stiffness with section.self_stress_N = 0, so "
+                             "helix.stiffness = 'from_section' has no GJ: set "
+                             "section.lay_angle_deg > 0, or section.self_stress_N > 0 with "
+                             "section.bar_EA_N > 0 (tethers at the tension P0 give GJ = "
+                             "n P0 R^2)")
+    try:
+        taut = section.members(helix, width=0.0).taut_moduli()
+    except OverflowError:  # R^2 past a float
+        taut = {"EA": math.inf, "EI": math.inf, "GJ": math.inf}
+    out = {"EA_N": taut["EA"], "EI_Nm2": taut["EI"], "GJ_Nm2": taut["GJ"]}
+    if not all(math.isfinite(v) and v > 0 for v in out.values()):
+        # out of a float's range: named, the input of the most extreme size
+        inputs = {"section.tether_EA_N": section.tether_EA_N,
+                  "section.radius_m" if section.radius_m else "helix.radius_m":
+                      section.radius_m or helix.radius_m,
+                  "section.lay_angle_deg": section.lay_angle_deg,
+                  "section.self_stress_N": section.self_stress_N,
+                  "section.bar_EA_N": section.bar_EA_N}
+        key = max((k for k, v in inputs.items() if v), key=lambda k: abs(math.log10(inputs[k])))
+        raise ParameterError(key, inputs[key],
+                             "makes helix.stiffness = 'from_section''s EA, EI or GJ "
+                             f"{', '.join(f'{k} = {v:.3g}' for k, v in out.items())}: out of "
+                             "a float's range (1e-308 to 1e308)")
+    return out
 
 
 #: no groups for parameters/scene.py's range check: the members' groups are 0 while the

@@ -13,9 +13,23 @@ from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 from rawehelix.parameters.eilaw import EILaw
 
 
+#: where the helix's EA, EI and GJ come from (Helix.stiffness; Parameters fills them
+#: from the section's members for "from_section": parameters/section.py::helix_stiffness)
+STIFFNESS = ("given", "from_section")
+STIFFNESS_KEYS = ("EA_N", "EI_Nm2", "GJ_Nm2")
+
+
 @dataclass(frozen=True)
 class Helix:
     """The rod: Tables 1, 2 and 4 of the paper.
+
+    ``stiffness = "from_section"`` takes EA_N, EI_Nm2 and GJ_Nm2 from the members of
+    ``[section]`` (their taut moduli at zero strain, members.py: n tethers of stiffness
+    section.tether_EA_N at the radius, laid at the lay angle, with the self-stress and
+    the bars); :class:`~rawehelix.parameters.Parameters` fills them in, again after
+    every ``replace`` (so they follow the section).  A scene file or ``--set`` that
+    gives one of them too is refused (studies/scene.py); values passed to this
+    dataclass directly are replaced.
 
     ``EI_law`` (None: off) makes the bending stiffness a function of the local
     tension (:class:`EILaw`; a scene's ``EI_law = {a_Nm2_per_N = .., b_Nm2 = ..}``).
@@ -25,21 +39,36 @@ class Helix:
 
     length_m: float  # L0, unstretched length [m]
     mass_kg: float  # M, total mass [kg]
-    EA_N: float  # axial stiffness [N]
-    EI_Nm2: float  # bending stiffness [N m^2]
-    GJ_Nm2: float  # torsional stiffness [N m^2]
-    radius_m: float = 0.19  # R, helix radius [m]: drawing only (delta uses Eq. 27)
+    EA_N: float | None = None  # axial stiffness [N]; required unless stiffness = "from_section"
+    EI_Nm2: float | None = None  # bending stiffness [N m^2]; required unless stiffness = "from_section"
+    GJ_Nm2: float | None = None  # torsional stiffness [N m^2]; required unless stiffness = "from_section"
+    # R, the helix radius: the tethers' radius (section.radius_m unless that is given),
+    # which the members' moduli, their forces and every limit use, and the drawings';
+    # the solid's torsional inertia does not (delta, Eq. 27) [m]
+    radius_m: float = 0.19
     drag_length_m: float = 0.012  # l_a, sum of the bar diameters [m], Eq. (14)
     drag_coefficient: float = 1.0  # C_D, Eq. (14)
     EI_law: EILaw | None = None  # EI = a T + b (Eq. 64); None: EI = EI_Nm2
     GA_N: float | None = None  # GA, the shear stiffness [N] (the shearable rod); None: none
+    # where EA_N, EI_Nm2 and GJ_Nm2 come from: "given" (these keys, the paper's) or
+    # "from_section" (the section table's members' taut moduli, members.py, with
+    # section.tether_EA_N and a lay angle or a self-stress; then give none of the three)
+    stiffness: str = "given"
 
     def __post_init__(self):
-        _positive("helix", self, "length_m", "mass_kg", "EA_N", "EI_Nm2", "GJ_Nm2", "radius_m")
+        if self.stiffness not in STIFFNESS:
+            raise ParameterError("helix.stiffness", self.stiffness, f"must be one of {list(STIFFNESS)}")
+        missing = [name for name in STIFFNESS_KEYS if getattr(self, name) is None]
+        if missing and self.stiffness == "given":
+            raise ParameterError(f"helix.{missing[0]}", None,
+                                 "is required (or set helix.stiffness = 'from_section': the "
+                                 "[section]'s members give EA_N, EI_Nm2 and GJ_Nm2)")
+        _positive("helix", self, "length_m", "mass_kg", "radius_m",
+                  *(name for name in STIFFNESS_KEYS if name not in missing))
         _non_negative("helix", self, "drag_length_m", "drag_coefficient")
         if self.GA_N is not None:
             _positive("helix", self, "GA_N")
-        if self.EI_Nm2 / self.EA_N / self.length_m > self.length_m:
+        if not missing and self.EI_Nm2 / self.EA_N / self.length_m > self.length_m:
             # a rod (Eqs. 30-34) is slender: the radius of gyration sqrt(EI/EA) of its
             # sections is far below its length (Table 2: 0.6 m of 16 m); past L0 no
             # rod model holds, and the solves fail (EI = 1e20: the Newton step's

@@ -44,6 +44,7 @@ import dataclasses
 
 import numpy as np
 
+from rawehelix import fits
 from rawehelix.errors import SolverError
 from rawehelix.periodic_orbits.continuation import StepGuard
 from rawehelix.periodic_orbits.problem import Observable, Orbit
@@ -102,6 +103,8 @@ class Peaks(StepGuard):
         best, probes, located = pts[1], 0, "point"
         while probes < PEAK_PROBES:
             x, y = np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+            if fits.undetermined(fits.polynomial(x, 2), 3):  # two of the three at one s
+                break
             c2, c1, _ = np.polyfit(x, y, 2)
             if not c2 < 0:
                 break

@@ -27,7 +27,11 @@ and ``active_bounds`` the fitted keys that ended on a bound.  Exit status:
 summary is written); 2 bad input, before any evaluation (an unknown key, a
 bound outside the key's allowed range, which the scene loader checks at
 both ends of each bound, a negative target of a quantity that cannot be
-negative); 1 a scene of the fit failed to solve.
+negative, fewer targets than fitted keys); 1 a scene of the fit failed to solve.
+A fit whose scaled Jacobian at the end has a rank below the number of keys (a key
+no target sees, or two the targets see alike: :mod:`rawehelix.fits`) is not a
+result, whatever its residuals: status "keys not determined", ``undetermined``
+says why, exit 3.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix import fits
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.studies import pool, quantities, writers
 from rawehelix.studies.study import EXIT_UNMET, Source, key_type
@@ -101,7 +106,8 @@ class CalibrationResult:
 
     @property
     def exit_status(self) -> int:
-        """0: every target met; EXIT_UNMET: ran, but missed a target."""
+        """0: every target met by determined keys; EXIT_UNMET: ran, but missed a target
+        or could not determine the keys."""
         return 0 if self.summary["success"] else EXIT_UNMET
 
     def write(self, outdir) -> Path:
@@ -226,6 +232,11 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
         raise SceneError("--uncertainty", uncertainty, "must be > 0")
     if not (0 < tolerance < 1 and math.isfinite(tolerance)):
         raise SceneError("--tolerance", tolerance, "must be a relative tolerance in (0, 1)")
+    if len(targets) < len(fit):  # each target one equation: known before any work
+        raise SceneError("--fit", ",".join(fit),
+                         f"{len(fit)} keys cannot be determined by {len(targets)} "
+                         f"target{'s' * (len(targets) != 1)}: give at least as many --target "
+                         "quantities as --fit keys")
     params = source.load()
     resources.check_quantities(params, list(targets), copies=comm.size)
     p0 = []
@@ -235,9 +246,15 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
         except AttributeError:  # an unknown key: the loader's message
             source.load({key: 1.0})
             raise SceneError("--fit", key, "is not a scene key") from None
-        if key_type(key) != "float" or value == 0:
-            raise SceneError("--fit", key, "must be a real-valued key with a scene value != 0 "
-                             f"(the unknowns are scaled by it); it is {value!r}")
+        if key_type(key) != "float":
+            raise SceneError("--fit", key, "must be a real-valued key (a number); it is "
+                             f"{key_type(key)}")
+        if value is None:  # an optional key the scene leaves absent
+            raise SceneError("--fit", key, "is not set by the scene (absent): the fit starts "
+                             f"from the scene's value, so set one, e.g. --set {key}=VALUE")
+        if value == 0:
+            raise SceneError("--fit", key, "must have a scene value != 0 (the unknowns are "
+                             "scaled by it); it is 0")
         p0.append(float(value))
     p0 = np.array(p0)
     check_bounds(source, bounds)
@@ -259,7 +276,8 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
     J = ev.jac(res.x, lower, upper, fd_step)
     E = J * res.x[None, :] / (1 + r)[:, None]  # d ln Q_j / d ln p_i
     sv = np.linalg.svd(E, compute_uv=False)
-    cond = float(sv[0] / sv[-1]) if len(sv) == len(fit) and sv[-1] > 0 else math.inf
+    undetermined = fits.undetermined(E, len(fit), rtol=fits.DIFFERENCES_RTOL)
+    cond = float(sv[0] / sv[-1]) if not undetermined else math.inf
     fitted = {k: float(p * x) for k, p, x in zip(fit, p0, res.x)}
     if math.isfinite(cond):
         cov_ln = uncertainty**2 * np.linalg.inv(E.T @ E)
@@ -278,15 +296,18 @@ def compute(source: Source, fit: list[str], targets: dict, outdir, bounds: dict 
                "fitted": fitted, "values": values, "residuals": residuals,
                "tolerance": tolerance,
                "tolerance_meaning": "a target is met when |Q / target - 1| <= tolerance",
-               "status": "targets missed" if missed else "targets met",
+               "status": ("keys not determined" if undetermined else
+                          "targets missed" if missed else "targets met"),
                "missed": missed, "active_bounds": active,
+               "undetermined": (f"d ln Q / d ln p, {undetermined}" if undetermined
+                                else None),
                "scaled_jacobian": E.tolist(),
                "scaled_jacobian_meaning": "d ln Q_j / d ln p_i (rows: quantities, columns: "
                                           "fitted keys), forward differences",
                "condition_number": cond,
                "target_uncertainty": uncertainty, "confidence": confidence,
                "confidence_meaning": "linearised 1-sigma: Cov(ln p) = u^2 (E^T E)^-1",
-               "fd_step": fd_step, "success": not missed,
+               "fd_step": fd_step, "success": not missed and not undetermined,
                "optimizer_success": bool(res.success), "message": res.message,
                "nfev": int(res.nfev), "njev": int(res.njev or 0),
                "evaluations_now": ev.evaluations, "ranks": comm.size,
@@ -319,6 +340,10 @@ def report(result: CalibrationResult) -> str:
         lo, hi = s["bounds"][k]
         lines.append(f"  bound active: {k} = {s['fitted'][k]:.6g} ended on the {side} end of "
                      f"the scaled range, bounds [{lo:g}, {hi:g}]")
-    lines.append(f"  status: {s['status']}" + (f" (exit status {EXIT_UNMET})" if s["missed"]
+    if s.get("undetermined"):
+        lines.append(f"  not determined: {s['undetermined']}: the targets cannot fix "
+                     f"{', '.join(s['fitted'])}; fit fewer keys or add targets that see them")
+    lines.append(f"  status: {s['status']}" + (f" (exit status {EXIT_UNMET})"
+                                                if not s["success"]
                                                 else f" within {s['tolerance']:g}"))
     return "\n".join(lines)

@@ -41,11 +41,13 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix import fits
 from rawehelix.errors import SolverError
 from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.solvers import analytic
 from rawehelix.studies import labfit, labmembers, writers
 from rawehelix.studies.scene import SceneError
+from rawehelix.studies.study import EXIT_UNMET
 
 log = logging.getLogger("rawehelix")
 
@@ -53,6 +55,7 @@ TESTS = ("axial", "bending", "torsion")
 LAB_LENGTH_M = 6.76  # L0 of the lab segment, Sec. 4
 LAB_ELEMENTS = 8  # N of the segment unless the caller sets it (smooth: N = 8, p = 3 to ~1e-6)
 EQ64 = (52.4, 2290.0)  # Eq. (64): EI [N m^2] = 52.4 T_e [N] + 2290
+LAB_EA_N = 3.64e4  # Eq. (62)'s regression over the axial test (Sec. 4, Fig. 3; Table 2)
 PAPER_BENDING_TENSIONS_N = (90.0, 181.0, 259.0)  # Sec. 4, Fig. 4
 DEFAULT_TENSIONS_N = {"axial": (50.0, 100.0, 150.0, 200.0, 250.0),
                       "bending": PAPER_BENDING_TENSIONS_N,
@@ -158,6 +161,12 @@ class LabTest:
     summary: dict = field(default_factory=dict)
     rank: int = 0
 
+    @property
+    def exit_status(self) -> int:
+        """0; EXIT_UNMET if its fit ran into data that could not determine the law
+        (summary "undetermined": labfit.fit)."""
+        return EXIT_UNMET if self.summary.get("undetermined") else 0
+
     def write(self, outdir) -> Path:
         """summary.json and labtest.png (the paper's Figs. 3-5 axes) into ``outdir``."""
         return writers.summary_and_figure(outdir, self.rank, self.summary,
@@ -237,6 +246,8 @@ def compute(helix_scene: Parameters, test: str, tensions_N=None, loads=None, fit
         block["rod"] = rod_check(helix_scene, block, elements, degree, gravity, comm)
         summary["section_fit"] = block
     summary["wall_s"] = time.perf_counter() - start
+    summary["status"] = ("fit not determined" if fit and summary.get("undetermined")
+                         else "done")
     log.debug("labtest %s: %.2f s", test, summary["wall_s"])
     return LabTest(params, test, rows, summary, comm.rank)
 
@@ -300,6 +311,12 @@ def _check(test, tensions, loads, fit, rod_EI):
                 np.isfinite(v) and v >= low for v in values)):
             raise SceneError(f"labtest {name}", values,
                              f"must be a list of finite numbers {'>= 0' if low == 0 else '> 0'}")
+    if fit and test == "bending":  # EI = a T + b: known before any work (exit 2)
+        why = fits.undetermined(fits.polynomial(tensions or DEFAULT_TENSIONS_N[test], 1), 2)
+        if why:
+            raise SceneError("labtest --tension", ",".join(f"{t:g}" for t in tensions),
+                             f"cannot determine the fit's law EI = a T + b: {why}; give at "
+                             "least 2 distinct tensions, e.g. --tension 90,181,259")
     if loads is not None and test == "axial":
         raise SceneError("labtest --loads", loads, "the axial test's loads are its --tension list")
     if rod_EI is not None and not (np.isfinite(rod_EI) and rod_EI > 0):
@@ -332,9 +349,13 @@ def _report(result: LabTest) -> str:
         lines.append(f"  {T:8.1f}   {EI:14.1f}   {app:20.1f}   {e64:8.1f}   {app / e64:14.4f}")
     if s.get("fit"):
         law = s["law"]
-        lines.append(f"  intrinsic law EI = {law['a_Nm2_per_N']:.3f} T + {law['b_Nm2']:.1f} N m^2 "
-                     f"(Eq. 64: {EQ64[0]} T + {EQ64[1]:.0f}); reproduces Eq. (64) within "
-                     f"{100 * max(abs(e) for e in s['relative_error']):.3f} %")
+        if s.get("undetermined"):
+            lines.append(f"  the law EI = a T + b is not determined: {s['undetermined']} "
+                         f"(exit status {EXIT_UNMET}); give more distinct tensions")
+        else:
+            lines.append(f"  intrinsic law EI = {law['a_Nm2_per_N']:.3f} T + {law['b_Nm2']:.1f} "
+                         f"N m^2 (Eq. 64: {EQ64[0]} T + {EQ64[1]:.0f}); reproduces Eq. (64) "
+                         f"within {100 * max(abs(e) for e in s['relative_error']):.3f} %")
     return "\n".join(lines)
 
 

@@ -42,7 +42,8 @@ BYTES_PER_DOF = {"stationary": 1.5e3, "dynamics": 1.5e3, "modes": 22e3}
 #: the step that sets each command's (and each study stage's) memory
 HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dynamics",
             "spin_up": "dynamics", "sweep": "dynamics", "converge": "modes",
-            "modes": "modes", "response": "modes", "orbits": "modes"}
+            "modes": "modes", "response": "modes", "orbits": "modes",
+            "section": "stationary"}  # section: closed forms, no FE (the smallest estimate)
 SPLINE_BYTES_PER_N2 = 4.5e3  # the spline scheme's dense matrices: bytes per N^2
 BYTES_PER_POINT = 2e3  # a sweep's, response's or study's record of one point
 SECONDS_PER_POINT = 0.01  # the least a point costs (a stationary solve at N = 2)

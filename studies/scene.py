@@ -22,6 +22,7 @@ from pathlib import Path
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
 from rawehelix.parameters import (Controller, Discretisation, Ends, Environment, Helix, Model,
                                   ParameterError, Parameters, Sweep, Time, Torque, components)
+from rawehelix.parameters.sections import STIFFNESS_KEYS
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
@@ -39,9 +40,26 @@ _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "boo
                "EILaw | None": "an inline table {a_Nm2_per_N = .., b_Nm2 = ..}"}
 
 
+def value_type(type_name: str) -> str:
+    """The type a scene value of a field of this annotation has: an optional number
+    (``float | None``, ``int | None``: absent is None, as TOML has no null) is a number
+    when a scene sets it.  The one place that reads an optional key's annotation."""
+    base, _, none = type_name.partition(" | ")
+    return base if none == "None" and base in ("float", "int") else type_name
+
+
+def key_type(key: str) -> str:
+    """The dotted scene key's value type ('float', 'int', 'str', ...; an optional
+    number's too, :func:`value_type`), or 'float' if unknown (the loader then names
+    the key)."""
+    section, _, name = key.partition(".")
+    cls = SECTIONS.get(section)
+    types = {f.name: f.type for f in dataclasses.fields(cls)} if cls else {}
+    return value_type(types.get(name, "float"))
+
+
 def _check_type(path, key: str, value, type_name: str):
-    if type_name == "float | None":  # an optional number: absent is None (TOML has no null)
-        type_name = "float"
+    type_name = value_type(type_name)
     ok = {
         "float": isinstance(value, (int, float)) and not isinstance(value, bool),
         "int": isinstance(value, int) and not isinstance(value, bool),
@@ -76,7 +94,27 @@ def _section(path, name: str, table) -> object:
     try:
         return cls(**values)
     except ParameterError as err:
-        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+        raise _scene_error(path, err) from None
+
+
+def _scene_error(path, err: ParameterError) -> SceneError:
+    """A dataclass's refusal as the scene's: ``key: value what is allowed`` (an absent
+    key, value None: ``key: what is allowed``)."""
+    said = err.allowed if err.value is None else f"{err.value!r} {err.allowed}"
+    return SceneError(path, err.key, said)
+
+
+def _stiffness_given_twice(path, helix) -> None:
+    """helix.stiffness = "from_section" takes EA_N, EI_Nm2 and GJ_Nm2 from [section]:
+    a scene (or --set) that gives one of them too is refused, naming it."""
+    if not isinstance(helix, dict) or helix.get("stiffness") != "from_section":
+        return
+    for name in STIFFNESS_KEYS:
+        if name in helix:
+            raise SceneError(path, f"helix.{name}",
+                             "is given, but helix.stiffness = 'from_section' takes EA_N, "
+                             "EI_Nm2 and GJ_Nm2 from the [section]'s members: remove it, or "
+                             "set helix.stiffness = 'given'")
 
 
 def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) -> Parameters:
@@ -90,6 +128,7 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
     for name_ in REQUIRED:
         if name_ not in data:
             raise SceneError(path, name_, f"the section [{name_}] is required")
+    _stiffness_given_twice(path, data["helix"])
     sections = {s: _section(path, s, data[s]) for s in SECTIONS if s in data}
     for nested, holder in NESTED.items():  # [damping] -> Model.damping, ...
         if nested in sections:
@@ -99,7 +138,7 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
     try:
         return Parameters(**sections, name=label, title=data.get("title", label))
     except ParameterError as err:
-        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+        raise _scene_error(path, err) from None
 
 
 def apply_overrides(data: dict, overrides: dict, path="<scene>") -> dict:

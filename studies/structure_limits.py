@@ -13,7 +13,7 @@ the extremes and the first limit reached; :meth:`Tracker.block` is the block:
 * ``twist_per_length_max``: the largest |tau| [rad/m];
 * ``first_limit``: the first criterion reached (members.py::CRITERIA), its kind, s and
   t, or None; ``criteria`` gives each criterion's threshold, None where a scene key
-  leaves it off (section.breaking_force_N, section.ring_spacing_m).
+  leaves it off (section.breaking_force_N, section.ring_spacing_m or section.rings).
 
 The members' forces: with the solid section, the forces of a tensegrity of the
 scene's ``[section]`` members carrying the solid's resultants (members.py::

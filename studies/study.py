@@ -67,7 +67,8 @@ from rawehelix.studies.sampling import (SAMPLES, SEED, Variable, design, design_
 
 FD_STEP = 1e-2  # relative step of the central differences at the base point
 #: exit status of a study or a calibration that ran to its end but did not do all it
-#: was asked: failed points ("done with failures"), missed targets (calibrate)
+#: was asked: failed points ("done with failures"), missed targets (calibrate), a fit
+#: whose data could not determine its parameters (calibrate, labtest --fit: fits.py)
 EXIT_UNMET = 3
 STATUS = {False: "all done", True: "done with failures"}
 
@@ -88,18 +89,21 @@ class Source:
                           scheme=self.scheme, overrides={**self.overrides, **(extra or {})})
 
 
-def key_type(key: str) -> str:
-    """The scene key's type name ('float', 'int', ...), or 'float' if unknown
-    (the loader then names the key)."""
-    section, _, name = key.partition(".")
-    cls = scene.SECTIONS.get(section)
-    types = {f.name: f.type for f in dataclasses.fields(cls)} if cls else {}
-    return types.get(name, "float")
+key_type = scene.key_type  # the key's value type; an optional number's is the number's
 
 
 def cast(key: str, value: float):
-    """A design value for the key: an integer key gets the nearest integer."""
-    return int(round(value)) if key_type(key) == "int" else float(value)
+    """A design value for the key: a float, or for an integer key the integer it is
+    (SceneError on --vary if it is not one: a grid of an integer key is refused, never
+    rounded)."""
+    if key_type(key) != "int":
+        return float(value)
+    nearest = round(value)
+    if abs(value - nearest) > 1e-9 * max(1.0, abs(value)):
+        raise SceneError("--vary", key, f"is an integer key, and its range gives it {value:g}: "
+                         "choose START, STOP and COUNT whose values are integers (STOP - START "
+                         f"a multiple of COUNT - 1), e.g. {key}=2:4:3")
+    return int(nearest)
 
 
 def fd_points(base: dict, fd_step: float) -> tuple[list, dict]:
@@ -126,6 +130,10 @@ def make_tasks(source: Source, variables: list[Variable], sample: str, points, f
     keys = [v.key for v in variables]
     if len(set(keys)) != len(keys):
         raise SceneError("--vary", ", ".join(keys), "each key once")
+    integers = [v.key for v in variables if key_type(v.key) == "int"]
+    if integers and sample != "grid":
+        raise SceneError("--sample", sample, f"{integers[0]} is an integer key, and {sample} "
+                         "samples real values: use --sample grid with integer values")
     base_params = source.load()
     base = {}
     for v in variables:

@@ -30,7 +30,7 @@ def test_readme_example_runs(tmp_path, monkeypatch, capsys):
 
 @pytest.mark.parametrize("kwargs,words", [
     ({"overrides": {"helix.EI_Nm2": -1.0}}, "helix.EI_Nm2"),
-    ({"overrides": {"helix.stiffness": 1.0}}, "unknown key"),
+    ({"overrides": {"helix.stiffnes": 1.0}}, "unknown key"),  # (helix.stiffness is a key)
     ({"elements": 0}, "discretisation.elements"),
     ({"scheme": "hermite"}, "discretisation.scheme"),
 ])

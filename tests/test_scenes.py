@@ -66,15 +66,18 @@ def test_example_documents_every_key_with_its_default():
         assert isinstance(table, dict), f"[{name}] is missing"
         fields = [f for f in dataclasses.fields(scene.SECTIONS[name])
                   if f.name not in scene.NESTED]
-        # a key whose default is None (absent: TOML has no null) is shown commented out
-        absent = {f.name for f in fields if f.default is None}
+        # a key whose default is None (absent: TOML has no null) is shown commented out,
+        # unless another key makes it required (helix.EA_N, EI_Nm2, GJ_Nm2: required
+        # unless helix.stiffness = "from_section")
+        given = {f"helix.{k}" for k in parameters.sections.STIFFNESS_KEYS}
+        absent = {f.name for f in fields if f.default is None and f"{name}.{f.name}" not in given}
         assert set(table) == {f.name for f in fields} - absent, f"[{name}]: keys differ"
         for f in fields:
             key = f"{name}.{f.name}"
             if f.name in absent:
                 assert re.search(rf"^# {f.name} = ", path.read_text(), re.M), f"{key} not shown"
                 continue
-            if f.default is dataclasses.MISSING:
+            if f.default is dataclasses.MISSING or key in given:
                 required.add(key)
             elif key not in EXAMPLE_NOT_DEFAULT:
                 assert table[f.name] == f.default and type(table[f.name]) is type(f.default), \

@@ -3,7 +3,8 @@ lists them: name -> :class:`~rawehelix.cli.commands.base.Command` (its help
 line, its options, its runner).  Adding a command is one entry in one of the
 family modules:
 
-- :mod:`.runs`: one scene, one run (stationary, modes, simulate, sweep, response, orbits);
+- :mod:`.runs`: one scene, one run (stationary, modes, simulate, sweep, response, orbits,
+  section);
 - :mod:`.designs`: one scene, many runs (converge, study, calibrate);
 - :mod:`.benches`: commands that build their own scenes (extremes, labtest).
 """

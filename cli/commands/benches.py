@@ -77,7 +77,7 @@ def _labtest(rh, args, comm) -> int:
                             gravity=not args.no_gravity, comm=comm)
         result.write(outdir)
     say(comm, labtest.report(result) + f"\n  wrote {outdir}/")
-    return 0
+    return result.exit_status  # 3: a fit its data could not determine (fits.py)
 
 
 COMMANDS = [

@@ -1,4 +1,5 @@
-"""The single-run commands: stationary, modes, simulate, sweep, response, orbits."""
+"""The single-run commands: stationary, modes, simulate, sweep, response, orbits, and
+section (closed forms, no solve)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,14 @@ def _written(comm, result, text: str, outdir, before: str = "\n  ") -> int:
     """A run's files (``result.write``) and its report with where they are."""
     result.write(outdir)
     say(comm, text + f"{before}wrote {outdir}/")
+    return 0
+
+
+def _section(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import section_moduli
+    result = rh.section(params)
+    result.write(outdir, comm.rank)
+    say(comm, section_moduli.report(result) + f"\n  wrote {outdir}/")
     return 0
 
 
@@ -158,4 +167,6 @@ COMMANDS = [
             _f1_grid_arguments, _response, f1_grid=True),
     Command("orbits", "periodic orbits over f1 with Floquet stability, through folds",
             _orbits_arguments, _orbits, kept="window*/p*.json"),
+    Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
+            _none, _section),
 ]

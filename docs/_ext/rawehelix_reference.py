@@ -72,7 +72,7 @@ SUFFIX_UNITS = {"_m": "m", "_kg": "kg", "_N": "N", "_Nm": "N m", "_Nm2": "N m^2"
                 "_Hz": "Hz", "_deg": "deg", "_rpm": "rpm", "_m_s": "m/s", "_m_s2": "m/s^2",
                 "_kg_m3": "kg/m^3", "_m_n": "(m/rad)^n"}
 _TYPE_WORDS = {"float": "number", "int": "integer", "str": "string", "bool": "true/false",
-               "EILaw | None": "inline table"}
+               "EILaw | None": "inline table", "int | None": "integer"}
 
 
 def field_comments(cls) -> dict[str, str]:
@@ -120,7 +120,7 @@ def _probes(type_name: str):
     """Values to offer a field to learn, from its validation, what it refuses."""
     if type_name in ("float", "float | None"):
         return [0.5, 2.0, 1.0, 0.0, -1.0, 1e-300, 1e300, -1e300, math.nan, math.inf, -math.inf]
-    if type_name == "int":
+    if type_name in ("int", "int | None"):
         return [-10**6, -1, 0, 1, 2, 10**6]
     if type_name == "str":
         return ["?"]
@@ -268,7 +268,9 @@ def _cross_section_rules() -> list[tuple[str, str]]:
               {"model": {"kinematics": "extensible"}, **ip_only},
               {"helix": {"EI_law": PAPER_EI_LAW}},
               {"damping": {"axial_s": 1e-3}, **ip_only},
-              {"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 1.0}, **ip_only}]
+              {"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 1.0}, **ip_only},
+              {"helix": {"stiffness": "from_section"}},
+              {"helix": {"stiffness": "from_section"}, "section": {"tether_EA_N": 6e3}}]
     found = []
     for trial in trials:
         try:
