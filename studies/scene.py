@@ -14,6 +14,7 @@ output is written.
 from __future__ import annotations
 
 import dataclasses
+import json
 import re
 import sys
 import tomllib
@@ -37,6 +38,15 @@ SCENE_DIR = Path(__file__).parent / "scenes"
 
 _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "bool": "true or false",
                "EILaw | None": "an inline table {a_Nm2_per_N = .., b_Nm2 = ..}"}
+
+
+def toml_value(value) -> str:
+    """A value as a scene file spells it (``false``, ``"ip"``, ``1e-05``), for messages."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
 
 
 def _check_type(path, key: str, value, type_name: str):
@@ -76,7 +86,7 @@ def _section(path, name: str, table) -> object:
     try:
         return cls(**values)
     except ParameterError as err:
-        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+        raise SceneError(path, err.key, f"{toml_value(err.value)} {err.allowed}") from None
 
 
 def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) -> Parameters:
@@ -99,7 +109,7 @@ def parameters_from_dict(data: dict, path="<scene>", name: str | None = None) ->
     try:
         return Parameters(**sections, name=label, title=data.get("title", label))
     except ParameterError as err:
-        raise SceneError(path, err.key, f"{err.value!r} {err.allowed}") from None
+        raise SceneError(path, err.key, f"{toml_value(err.value)} {err.allowed}") from None
 
 
 def apply_overrides(data: dict, overrides: dict, path="<scene>") -> dict:

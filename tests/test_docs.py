@@ -184,6 +184,33 @@ def test_allowed_comes_from_the_validation():
         assert rows[key]["allowed"].split("; ")[0] in str(err.value)
 
 
+def test_allowed_is_short_and_names_no_probe_value():
+    """A bound computed from other keys (EI <= EA L0^2, Wen's |gamma| <= beta) is
+    stated once, as the rule, not once per probe value of the other keys; no
+    cell quotes the generator's probes (1e-300, 1e300) or grows to a wall of text."""
+    rows = {f"{r['section']}.{r['key']}": r for r in reference.scene_key_rows()}
+    for r in rows.values():
+        assert "e-300" not in r["allowed"] and "e+300" not in r["allowed"], r
+        assert len(r["allowed"]) < 250, r
+    ei = rows["helix.EI_Nm2"]["allowed"]
+    assert "must be at most helix.EA_N x helix.length_m^2 (a slender rod" in ei
+    assert ei.count("at most") == 1
+    gamma = rows["torsion_hysteresis.gamma_m_n"]["allowed"]
+    assert "rho < 1" in gamma and gamma.count("needs") == 1
+
+
+def test_a_switch_rule_names_the_value_it_is_about():
+    """`model.twist = false` needs a torque-free scene, not `model.twist`: the
+    reference and the loader's message spell the value as the scene file does."""
+    rules = dict(reference._cross_section_rules())
+    assert "model.twist = false" in rules and "model.twist" not in rules
+    assert 'model.kinematics = "extensible"' in rules
+    with pytest.raises(scene.SceneError) as err:
+        scene.load("nominal_operation", overrides={"model.twist": False})
+    assert "model.twist: false needs a torque-free scene" in str(err.value)
+    assert "False" not in str(err.value)
+
+
 # -- summary.json fields --------------------------------------------------------
 
 PLACEHOLDERS = {"<KEY>": r"[a-z_]+\.[A-Za-z0-9_]+", "<Q>": r"[A-Za-z0-9_@.]+",
