@@ -69,7 +69,7 @@ st.write(OUT / "stationary")            # summary.json, stationary.png, centre_l
 # quadratic eigenproblem with SLEPc.  The paper computed Table 3 with its
 # cubic-spline Galerkin scheme at N = 2; rawehelix keeps that scheme as an
 # independent reference (`scheme="spline"`), so both can be set beside the
-# paper's values (eigenvalues normalised by sqrt(L0/g), Eq. 25).
+# paper's values (eigenvalues normalised by $\sqrt{L_0/g}$, Eq. 25).
 
 # %%
 fe = rh.modes(scene)
@@ -98,7 +98,8 @@ for row in paper.TABLE3:
 
 # %%
 for mode in fe:
-    print(f"{mode.family:22s} {mode.frequency_Hz:8.3f} Hz, decay {mode.decay_per_s:.4f} 1/s")
+    decay = round(mode.decay_per_s, 4) + 0.0  # + 0.0: a decay of -1e-12 prints 0.0000
+    print(f"{mode.family:22s} {mode.frequency_Hz:8.3f} Hz, decay {decay:.4f} 1/s")
 periods = np.array([m.period_s for m in fe if m.period_s is not None])
 assert np.all(periods > 0)
 fe.write(OUT / "modes")  # summary.json, modes.png, modes.xdmf (+ GIFs with pyvista)
