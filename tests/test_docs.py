@@ -109,6 +109,27 @@ def test_api_page_has_every_function(site):
             assert f'id="rawehelix.api.{name}"' in page, name
 
 
+def test_api_page_example_is_code_and_every_parameter_has_words(site):
+    """The module example renders as a code block, and no parameter's entry is
+    only its name and type (autodoc's typehints with no description)."""
+    page = (site / "reference" / "api.html").read_text()
+    assert re.search(r'<pre>.*rh\.load_scene\(', page, re.S)
+    assert not re.search(r"<strong>\w+</strong> \([^)]*\)</p>", page)  # a parameter, no words
+    assert "<strong>scene</strong>" in page
+
+
+#: user-facing pages: every page of the site but the fault table (its rows cite
+#: the issues their faults were filed in) and the README
+USER_PAGES = [p for p in DOCS.rglob("*.md") if "_build" not in p.parts
+              and p.name != "faults.md"] + [ROOT / "README.md"]
+
+
+def test_user_pages_name_what_a_feature_is_not_its_issue():
+    for page in USER_PAGES:
+        found = re.search(r"\bissues? \d+", page.read_text(), re.I)
+        assert not found, f"{page.relative_to(ROOT)}: {found.group(0)}"
+
+
 # -- the README -----------------------------------------------------------------
 
 LINK = re.compile(r"\]\(([^)\s]+)\)")
