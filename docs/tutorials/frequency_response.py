@@ -13,7 +13,7 @@
 # history leads to.  Two other tools see more:
 #
 # - `rh.response`: the *linear* response to the end's circle, the steady
-#   harmonic solution of (K - w^2 M + i w C) X = 0 about the stationary state.
+#   harmonic solution of $(K - \omega^2 M + i \omega C)\,X = 0$ about the stationary state.
 #   It is cheap (one LU per f1) and its peaks are the natural frequencies.
 # - `rh.orbits`: the *nonlinear* periodic orbits, found by shooting on the
 #   period map of the time integrator, with their Floquet multipliers

@@ -10,7 +10,7 @@
 # # Spin-up under the rotor torque (Sec. 5.2, Fig. 6)
 #
 # In nominal operation the rotor at the upper end applies a torque M_N that
-# rises over t0 = 2 sqrt(L0/g); the ground generator holds the lower end with
+# rises over $t_0 = 2\sqrt{L_0/g}$; the ground generator holds the lower end with
 # the PD controller of Eq. (40), whose set point turns at 120 rpm.  The helix
 # carries the torque down and the whole machine spins up.  We integrate the
 # FE model in time from its stationary state (PETSc TS, generalised-alpha
