@@ -101,6 +101,19 @@ def test_scene_page_has_every_key(site):
                 assert f"{section}.{f.name}" in page
 
 
+def test_scene_tables_and_code_fit_the_page(site):
+    """The scene-key tables sit in the container the site's CSS fits to the
+    page's width (their long cells wrap), and code blocks wrap long lines."""
+    page = (site / "reference" / "scene.html").read_text()
+    tables = page.count("<table")
+    assert tables >= len(scene.SECTIONS)
+    assert page.count('class="scene-keys docutils container"') == tables
+    css = (site / "_static" / "custom.css").read_text()
+    assert re.search(r"\.scene-keys table\.docutils \{[^}]*width: 100%", css)
+    assert re.search(r"\.scene-keys td:nth-child\(n\+5\) \{ overflow-wrap: anywhere", css)
+    assert re.search(r"div\.highlight pre \{ white-space: pre-wrap", css)
+
+
 def test_api_page_has_every_function(site):
     import rawehelix.api
     page = (site / "reference" / "api.html").read_text()

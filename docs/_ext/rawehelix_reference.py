@@ -259,13 +259,15 @@ def scene_keys() -> str:
         doc = docs[section].split("\n\n")[0].replace("\n", " ")
         if doc and not doc.startswith(scene.SECTIONS[section].__name__ + "("):
             out += [doc, ""]
-        out += ["| key | type | unit | default | allowed | meaning |",
+        # in a container: docs/_static/custom.css wraps its long cells to the page's width
+        out += [":::{container} scene-keys", "",
+                "| key | type | unit | default | allowed | meaning |",
                 "| --- | --- | --- | --- | --- | --- |"]
         for r in (r for r in rows if r["section"] == section):
             out.append("| " + " | ".join(_cell(x) for x in (
                 f"`{section}.{r['key']}`", r["type"], r["unit"], r["default"], r["allowed"],
                 r["meaning"])) + " |")
-        out.append("")
+        out += ["", ":::", ""]
     out += ["## Rules between sections", "",
             "Checked when the whole scene is built (`Parameters`), whatever the sections' "
             "own ranges allow:", ""]
