@@ -246,6 +246,12 @@ def test_a_switch_rule_names_the_value_it_is_about():
     assert "False" not in str(err.value)
 
 
+@pytest.mark.parametrize("value", [False, True, "ip", 'a "quoted" word', 1e-05, 3, -2.5, 1e300])
+def test_messages_spell_values_as_a_scene_file_does(value):
+    """What a message quotes can be pasted into a scene file (or --set) as is."""
+    assert tomllib.loads(f"v = {scene.toml_value(value)}")["v"] == value
+
+
 # -- summary.json fields --------------------------------------------------------
 
 PLACEHOLDERS = {"<KEY>": r"[a-z_]+\.[A-Za-z0-9_]+", "<Q>": r"[A-Za-z0-9_@.]+",
