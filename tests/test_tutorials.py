@@ -109,6 +109,9 @@ def test_tutorial_page_has_outputs_and_figures_that_exist(script):
     for figure in figures:
         assert (TUTORIALS / figure).is_file(), figure
     assert "literalinclude" not in page
+    from rawehelix.cli.text import printable
+    for output in re.findall(r"^```text\n(.*?)^```$", page, re.M | re.S):
+        assert printable(output) == output, f"{script.stem} prints a negative zero: {output}"
 
 
 def test_the_stale_check_fails_on_an_edited_script():
