@@ -24,6 +24,8 @@ def test_readme_example_runs(tmp_path, monkeypatch, capsys):
     assert re.search(r"T\(0\) = 202\.\d\d N", out)  # Table 2: 202.9 N (shooting 202.885 N)
     assert "torsional" in out and "lateral_in_plane" in out
     assert re.search(r"f1 = 10\.0 Hz: T max \d+\.\d N", out)
+    from rawehelix.cli.text import printable
+    assert printable(out) == out, "the README's example prints a negative zero"
     assert (tmp_path / "results" / "api_example" / "summary.json").is_file()
     assert (tmp_path / "results" / "api_example" / "time_series.csv").is_file()
 
