@@ -114,6 +114,18 @@ def test_tutorial_page_has_outputs_and_figures_that_exist(script):
         assert printable(output) == output, f"{script.stem} prints a negative zero: {output}"
 
 
+#: the characters a code line of the site shows in a 1280 px window before its
+#: CSS wraps it (docs/_static/custom.css): a wrapped line of Python reads badly
+CODE_WIDTH = 84
+
+
+@pytest.mark.parametrize("script", SCRIPTS, ids=[s.stem for s in SCRIPTS])
+def test_tutorial_code_lines_fit_the_page(script):
+    long = [line for cell in _renderer().cells(script.read_text()) if cell.kind == "code"
+            for line in cell.text.splitlines() if len(line) > CODE_WIDTH]
+    assert not long, f"{script.name}: lines over {CODE_WIDTH} characters: {long}"
+
+
 def test_the_stale_check_fails_on_an_edited_script():
     """The check above can fail: one changed code line is found."""
     render = _renderer()

@@ -39,7 +39,8 @@ import rawehelix as rh
 from rawehelix.studies import calibrate, study
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
-OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials")) / "parameter_study"
+OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
+OUT = OUT / "parameter_study"
 N = 4 if SMALL else 16
 COUNT = 4 if SMALL else 12  # grid points in EI
 
@@ -54,7 +55,8 @@ COUNT = 4 if SMALL else 12  # grid points in EI
 # %%
 source = study.Source("mobile_end", elements=N)
 ei = study.parse_vary(f"helix.EI_Nm2=500:6000:{COUNT}")
-result = study.compute(source, [ei], ["lateral_frequency_Hz", "tension_s0_N"], OUT / "study")
+result = study.compute(source, [ei], ["lateral_frequency_Hz", "tension_s0_N"],
+                       OUT / "study")
 for EI, f, T in zip(result.keys_of()[:, 0], result.column("lateral_frequency_Hz"),
                     result.column("tension_s0_N")):
     print(f"EI = {EI:7.1f} N m^2: lateral {f:6.3f} Hz, T(0) = {T:.2f} N")
@@ -101,6 +103,7 @@ T = rh.modes(fitted_scene).info["mean_tension_N"]
 h = fitted_scene.helix
 k, m, omega = math.pi / h.length_m, h.mass_kg / h.length_m, 2 * math.pi * 5.0
 closed = (m * omega**2 - T * k**2) / k**4
-print(f"fitted EI = {EI:.3f} N m^2, closed form {closed:.3f} N m^2 ({EI / closed - 1:+.1e})")
+print(f"fitted EI = {EI:.3f} N m^2, closed form {closed:.3f} N m^2 "
+      f"({EI / closed - 1:+.1e})")
 assert abs(EI / closed - 1) < 1e-2
 print("written:", OUT)
