@@ -1,5 +1,7 @@
 """The public Python API of rawehelix: compose a run in a few lines.
 
+Example::
+
     import rawehelix as rh
 
     scene = rh.load_scene("nominal_operation", elements=8)
@@ -48,9 +50,17 @@ def load_scene(name_or_path, elements: int | None = None, degree: int | None = N
     """The validated scene: a TOML file, or the name of a shipped scene
     (``stationary_table2``, ``nominal_operation``, ``mobile_end``).
 
-    ``elements`` (N), ``degree`` (p) and ``scheme`` ("fe" or "spline") set the
-    discretisation; ``overrides`` sets any dotted scene key, e.g.
-    ``{"helix.EI_Nm2": 9000.0, "time.dt_s": 5e-4}``, validated like the file."""
+    Args:
+        name_or_path: a shipped scene's name or the path of a TOML scene file.
+        elements: the number of elements N (default: the scene's
+            ``discretisation.elements``).
+        degree: the polynomial degree p of the FE scheme (default: the scene's).
+        scheme: "fe" (finite elements) or "spline" (the paper's scheme).
+        overrides: dotted scene keys and their values, e.g.
+            ``{"helix.EI_Nm2": 9000.0, "time.dt_s": 5e-4}``, validated like the file.
+
+    Raises:
+        SceneError: a key or value the scene does not allow."""
     from rawehelix.studies import scene
     return scene.load(name_or_path, elements=elements, degree=degree, scheme=scheme,
                       overrides=overrides)
@@ -68,7 +78,11 @@ def stationary(scene: Parameters, comm=None):
     """The stationary state with fixed ends (Sec. 5.1), checked against the
     shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
     with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``
-    (``summary["limits"]``: the structure's limits in that state, issue 29)."""
+    (``summary["limits"]``: the structure's limits in that state).
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
     _resources(scene, "stationary")
     from rawehelix.studies import stationary as study
     return study.compute(scene, _world(comm))
@@ -84,7 +98,12 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
     rotation, and the slowest real eigenvalues of a damped spectrum, if found,
     as family ``overdamped`` (a decay rate, no period; listed last); ``count``:
     the ``count`` slowest modes.  ``scene.discretisation.scheme`` picks FE
-    (SLEPc) or the paper's spline scheme."""
+    (SLEPc) or the paper's spline scheme.
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        count: how many of the slowest modes to compute (default: the list above).
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
     _resources(scene, "modes")
     from rawehelix.studies import modes as study
     return study.compute(scene, count=count, comm=_world(comm))
@@ -99,7 +118,12 @@ def response(scene: Parameters, f1_Hz=None, comm=None):
     ellipse), ``tension_amplitude_N`` (at s = 0), ``peaks`` (``peaks_Hz``) with
     the nearest natural mode, ``natural`` (the modes of the same
     linearisation) and ``summary``.  One f1's complex response vector:
-    :class:`rawehelix.solvers.response.HarmonicResponse`."""
+    :class:`rawehelix.solvers.response.HarmonicResponse`.
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        f1_Hz: the forcing frequencies [Hz] (default: the scene's ``[sweep]`` list).
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
     _resources(scene, "response", f1_Hz)
     from rawehelix.studies import response as study
     return study.compute(scene, f1_Hz, comm=_world(comm))
@@ -112,9 +136,17 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
     with ``t_s``, ``spin_rpm`` (n x 3: s = 0, ~L0/2, L0), ``ground_torque_Nm``,
     ``tension_s0_N``, ``tension_s1_N``, ``lateral_mid_m``, ``final_state``,
     ``limits_history`` (t, smallest and largest member force) and ``summary``
-    (``summary["limits"]``: the structure's limits over the run, issue 29; also in a
-    failed run's ``SimulationError.partial``).  ``options``: PETSc options of the integrator without the
-    prefix, e.g. ``{"ts_type": "cn"}``."""
+    (``summary["limits"]``: the structure's limits over the run; also in a
+    failed run's ``SimulationError.partial``).
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        until_s: the end time [s] (default: the scene's ``time.until_s``).
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``).
+        options: PETSc options of the integrator without the prefix, e.g.
+            ``{"ts_type": "cn"}``.
+        progress: print a progress line now and then (default: when stdout is
+            a terminal)."""
     _resources(scene, "simulate")
     from rawehelix.studies import simulate as study
     return study.compute(scene, until_s=until_s, comm=_world(comm), options=options,
@@ -128,7 +160,14 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
     ``points`` (``f1_Hz``, ``tension_max_N``, ``tension_min_N``,
     ``tension_mean_N``, ``periods``, ``periodic``) and ``summary``.
     ``checkpoint``: a directory that keeps finished points, so that the same
-    call resumes a stopped sweep."""
+    call resumes a stopped sweep.
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        f1_Hz: the forcing frequencies [Hz], in the order they are swept
+            (default: the scene's ``[sweep]`` list).
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``).
+        checkpoint: a directory that keeps finished points (default: none)."""
     _resources(scene, "sweep", f1_Hz)
     from rawehelix.studies import sweep as study
     return study.compute(scene, f1_Hz, comm=_world(comm), checkpoint=checkpoint)
@@ -151,7 +190,21 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     ``outdir`` every point is stored as found and a rerun resumes after the last.
     ``method``: "shooting" (above), "hb" (harmonic balance, Hill's method for the
     multipliers, H chosen by accuracy and reported per point) or "auto" (the rule
-    of :func:`rawehelix.studies.orbit_method.choose`)."""
+    of :func:`rawehelix.studies.orbit_method.choose`).
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        f1_start_Hz: the forcing frequency [Hz] the branch starts from.
+        f1_stop_Hz: the forcing frequency [Hz] it is continued towards.
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``).
+        progress: a callable called with each orbit as it is found (default: none).
+        outdir: a directory that keeps every point, so that a rerun resumes.
+        tension_step: the largest relative change of T max between two points
+            (default: the method's own).
+        max_points: the most points the branch may have.
+        superharmonics: the orders k of the k:1 superharmonic sites to close in
+            on (default (2, 3); () for none).
+        method: "shooting", "hb" or "auto"."""
     _resources(scene, "orbits")
     from rawehelix.studies import orbits as study
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
@@ -170,7 +223,19 @@ def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=Non
     :class:`~rawehelix.studies.envelope.EnvelopeResult` (``summary``, ``write(outdir)``:
     summary.json and envelope.png).  The values are dealt to the ranks of ``comm``; with
     ``outdir`` each value's branch is stored and a rerun resumes; ``f1_step_Hz``: the
-    most a branch steps in f1 (stability is judged at its points)."""
+    most a branch steps in f1 (stability is judged at its points).
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        vary: the scene key varied and its values, "KEY=LO:HI[:COUNT]" (or a
+            :class:`~rawehelix.studies.sampling.Variable`).
+        f1_lo_Hz: the lowest forcing frequency [Hz] of each branch.
+        f1_hi_Hz: the highest forcing frequency [Hz] of each branch.
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``).
+        outdir: a directory that keeps each value's branch, so that a rerun resumes.
+        method: how each branch is traced: "hb", "shooting" or "auto".
+        progress: a callable called as the branches are traced (default: none).
+        f1_step_Hz: the most a branch steps in f1 [Hz] (default: the method's own)."""
     from rawehelix.studies import envelope as study
     from rawehelix.studies.sampling import Variable, parse_vary
     _resources(scene, "orbits")
@@ -190,7 +255,21 @@ def labtest(test: str, scene: Parameters | None = None, tensions_N=None, loads=N
     has the apparent EA, EI or GJ that Eqs. (62), (63), (65) infer.
     ``fit`` (bending): the intrinsic law EI = a T + b whose simulated test
     reproduces Eq. (64) (``summary["law"]``); ``rod_EI_Nm2``: the rod's constant
-    EI (default Eq. (64) at each T_e)."""
+    EI (default Eq. (64) at each T_e).
+
+    Args:
+        test: "axial", "bending" or "torsion".
+        scene: the scene whose helix is tested (default ``stationary_table2``).
+        tensions_N: the tensions T_e [N] of the test (default: the paper's).
+        loads: the loads F_N [N] (bending) or M_t [Nm] (torsion) at each tension
+            (default: the paper's).
+        fit: fit the intrinsic law EI = a T + b (bending only).
+        rod_EI_Nm2: the rod's constant EI [N m^2] (default: Eq. (64) at each T_e
+            in the bending test, the scene's EI in the others).
+        elements: the segment's number of elements (default: the lab test's own).
+        degree: the polynomial degree p (default: the scene's).
+        gravity: whether the segment's weight acts.
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
     from rawehelix.studies import labtest as study, resources
     scene = scene if scene is not None else load_scene("stationary_table2")
     resources.check(study.lab_parameters(scene, elements, degree), "labtest")
@@ -207,7 +286,16 @@ def torsion_loop(law: dict, period_s: float = 20.0, cycles: int = 4, steps_per_c
     degrees and back ``cycles`` times in ``period_s`` [s] each, with the Bouc-Wen
     law ``law`` (the scene's ``[torsion_hysteresis]`` keys).  A dict of arrays:
     ``t_s``, ``theta_rad``, ``moment_Nm`` (the FE rod's end moment) and
-    ``reference_moment_Nm`` (the Bouc-Wen ODE of the same twist history, scipy)."""
+    ``reference_moment_Nm`` (the Bouc-Wen ODE of the same twist history, scipy).
+
+    Args:
+        law: the Bouc-Wen law's keys and values, as in a scene's
+            ``[torsion_hysteresis]`` section.
+        period_s: the period [s] of one twist cycle.
+        cycles: the number of cycles.
+        steps_per_cycle: the time steps of one cycle.
+        elements: the segment's number of elements.
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
     from rawehelix.parameters import TorsionHysteresis
     from rawehelix.studies import torsion_loop as study
     law = TorsionHysteresis(**law)

@@ -1,4 +1,4 @@
-"""The `rawehelix` command line: a thin layer over the Python API (:mod:`rawehelix.api`).
+"""The rawehelix command line: a thin layer over the Python API (:mod:`rawehelix.api`).
 
     rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
     rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
@@ -44,6 +44,7 @@ from pathlib import Path
 from rawehelix import errors
 from rawehelix.cli.commands import COMMANDS
 from rawehelix.cli.commands.base import overrides, scene_arguments
+from rawehelix.cli.text import plain, printable
 from rawehelix.parameters import SCHEMES
 from rawehelix.studies.scene import SceneError
 
@@ -53,15 +54,47 @@ log = logging.getLogger("rawehelix")
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with its refusals on one line, as every other bad input."""
+    """argparse with its refusals on one line, as every other bad input, and
+    its help in plain text (the descriptions reuse the modules' docstrings)."""
 
     def error(self, message):
         self.exit(BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+    def format_help(self):
+        return plain(super().format_help())
+
+    def format_usage(self):
+        return plain(super().format_usage())
+
+
+class _Version(argparse.Action):
+    """``--version``: rawehelix's version and the DOLFINx and PETSc it runs on."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                 help="print rawehelix's version and those of DOLFINx and PETSc, and exit"):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version_text())
+        parser.exit(0)
+
+
+def version_text() -> str:
+    import dolfinx
+    import petsc4py
+    petsc4py.init([])
+    from petsc4py import PETSc
+
+    import rawehelix
+    petsc = ".".join(str(x) for x in PETSc.Sys.getVersion())
+    return (f"rawehelix {rawehelix.__version__} (DOLFINx {dolfinx.__version__}, "
+            f"PETSc {petsc}, petsc4py {petsc4py.__version__}, Python {sys.version.split()[0]})")
 
 
 def _parser() -> argparse.ArgumentParser:
     """The parser of every command of the registry (:mod:`rawehelix.cli.commands`)."""
     parser = _Parser(prog="rawehelix", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     for command in COMMANDS.values():
         p = sub.add_parser(command.name, help=command.help)
@@ -72,7 +105,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _fail(message: str) -> int:
-    print(f"rawehelix: error: {message}", file=sys.stderr)
+    print(printable(f"rawehelix: error: {message}"), file=sys.stderr)
     return BAD_INPUT
 
 
@@ -134,11 +167,11 @@ def main(argv: list[str] | None = None) -> int:
     except SceneError as err:
         return _fail(str(err))
     except outdir_lock.OutputFault as err:  # a full disk: one line, exit 1 (outdir_lock.py)
-        print(f"rawehelix: error: {err}", file=sys.stderr)
+        print(printable(f"rawehelix: error: {err}"), file=sys.stderr)
         _abort_other_ranks(comm, 1)
         return 1
     except rh.SolverError as err:
-        print(f"rawehelix: {err}", file=sys.stderr)
+        print(printable(f"rawehelix: {err}"), file=sys.stderr)
         _abort_other_ranks(comm, FAILED)
         return FAILED
     except KeyboardInterrupt:

@@ -46,7 +46,7 @@ from rawehelix.errors import SolverError
 from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.solvers import analytic
 from rawehelix.studies import labfit, labmembers, writers
-from rawehelix.studies.scene import SceneError
+from rawehelix.studies.scene import SceneError, toml_value
 from rawehelix.studies.study import EXIT_UNMET
 
 log = logging.getLogger("rawehelix")
@@ -91,7 +91,7 @@ def lab_parameters(helix_scene: Parameters, elements: int | None = None,
                                    model=model, discretisation=disc, name=f"{helix_scene.name}_lab")
     except ParameterError as err:
         raise SceneError(f"labtest ({helix_scene.name})", err.key,
-                         f"{err.value!r} {err.allowed}") from None
+                         f"{toml_value(err.value)} {err.allowed}") from None
 
 
 slope = labfit.slope  # the least-squares line through the origin, y = slope x

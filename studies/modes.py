@@ -246,10 +246,14 @@ def compute(params: Parameters, count: int | None = None, comm=None,
     return result
 
 
+#: the eigenvalue column's header: lambda [1/s] times the time scale sqrt(L0/g) of Eq. (25)
+EIGENVALUE_HEADER = "Eigenvalue x sqrt(L0/g)"
+
+
 def format_table(result) -> str:
-    """Table 3 layout: eigenvalue (normalised), dominant components, mode,
-    period and frequency (SI)."""
-    head = (f"{'Eigenvalue':>24}  {'Dominant components':<34} {'Mode':<15} {'Period (s)':>10} "
+    """Table 3 layout: eigenvalue (normalised, its header says how), dominant
+    components, mode, period and frequency (SI)."""
+    head = (f"{EIGENVALUE_HEADER:>24}  {'Dominant components':<34} {'Mode':<15} {'Period (s)':>10} "
             f"{'f (Hz)':>9} {'Decay (1/s)':>11}")
     lines = [head, "-" * len(head)]
     for m in result:

@@ -30,6 +30,7 @@ import pickle
 import subprocess
 import sys
 import tempfile
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -208,6 +209,19 @@ class View:
                 f"chord horizontal, seen from {side}")
 
 
+#: the most characters a line of the colour bar's title has: VTK centres the title
+#: over the bar, near the window's right edge, and clips what passes it (an 800 px
+#: GIF holds 13 characters there: "tension T (N)")
+BAR_TITLE_CHARS = 13
+
+
+def bar_title(title: str | None) -> str | None:
+    """The colour bar's title in lines short enough to stay in the window."""
+    if title is None:
+        return None
+    return textwrap.fill(title, BAR_TITLE_CHARS, break_long_words=False)
+
+
 class _Drawing:
     """One off-screen plotter with the helix actors; :meth:`show` moves them in place."""
 
@@ -257,7 +271,7 @@ class _Drawing:
         p.add_mesh(self.meshes["spokes"], color="#d62728", line_width=lw + 1)
         p.add_mesh(self.meshes["markers"], color="#d62728", point_size=5 * lw + 2,
                    render_points_as_spheres=True)
-        bar = dict(title=self.scalar_title, vertical=True, position_x=0.9 if self.big else 0.88,
+        bar = dict(title=bar_title(self.scalar_title), vertical=True, position_x=0.9 if self.big else 0.88,
                    position_y=0.2,
                    height=0.6, width=0.03, n_labels=5, fmt="%.4g", color="black",
                    title_font_size=int(20 * self.font), label_font_size=int(18 * self.font),

@@ -14,6 +14,7 @@ output is written.
 from __future__ import annotations
 
 import dataclasses
+import json
 import re
 import sys
 import tomllib
@@ -58,6 +59,15 @@ def key_type(key: str) -> str:
     return value_type(types.get(name, "float"))
 
 
+def toml_value(value) -> str:
+    """A value as a scene file spells it (``false``, ``"ip"``, ``1e-05``), for messages."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
+
+
 def _check_type(path, key: str, value, type_name: str):
     type_name = value_type(type_name)
     ok = {
@@ -100,7 +110,7 @@ def _section(path, name: str, table) -> object:
 def _scene_error(path, err: ParameterError) -> SceneError:
     """A dataclass's refusal as the scene's: ``key: value what is allowed`` (an absent
     key, value None: ``key: what is allowed``)."""
-    said = err.allowed if err.value is None else f"{err.value!r} {err.allowed}"
+    said = err.allowed if err.value is None else f"{toml_value(err.value)} {err.allowed}"
     return SceneError(path, err.key, said)
 
 

@@ -23,7 +23,7 @@ caller names a ``checkpoint`` directory, which makes the sweep resumable:
 The same call again skips finished points; a checkpoint of another scene or
 discretisation is refused.  :meth:`SweepResult.write` writes summary.json
 (points, resonance_Hz, elements, degree, ranks, wall_s) and sweep.png (Fig. 8,
-inset T(t) near 10 Hz).
+with T(t) near 10 Hz in a panel of its own).
 """
 
 from __future__ import annotations
@@ -257,7 +257,24 @@ def write_series(outdir: Path, series: dict):
 
 
 def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz: float = 10.0):
-    """Fig. 8: maximum tension at s = 0 against f1; the inset shows T(t) near 10 Hz."""
+    """Fig. 8 (:func:`sweep_figure`) written to ``path``; None without a finished point."""
+    fig = sweep_figure(points, series, title, inset_Hz)
+    if fig is None:
+        return None
+    fig.savefig(path, dpi=120)
+    writers._pyplot().close(fig)
+    return path
+
+
+def _legend_beside(ax, **kw):
+    """A legend right of the axes, never on the data."""
+    return ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, **kw)
+
+
+def sweep_figure(points: list[dict], series: dict, title: str, inset_Hz: float = 10.0):
+    """Fig. 8: maximum tension at s = 0 against f1, the section's moment ratio
+    below it, and T(t) near ``inset_Hz`` in a panel of its own; the legends
+    stand beside the axes, so nothing is drawn over the data."""
     failed = [p["f1_Hz"] for p in points if p.get("tension_max_N") is None]
     points = [p for p in points if p.get("tension_max_N") is not None]
     if not points:
@@ -267,8 +284,11 @@ def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz
     tmax = np.array([p["tension_max_N"] for p in points])
     tmin = np.array([p["tension_min_N"] for p in points])
     ok = np.array([p["periodic"] for p in points])
-    fig, (ax, ax_m) = plt.subplots(2, 1, figsize=(8, 8), sharex=True,
-                                   gridspec_kw={"height_ratios": [3, 2]})
+    rows = [3, 2, 1.6] if series else [3, 2]
+    fig = plt.figure(figsize=(10, 8 + 2.4 * bool(series)))
+    grid = fig.add_gridspec(len(rows), 1, height_ratios=rows)
+    ax = fig.add_subplot(grid[0])
+    ax_m = fig.add_subplot(grid[1], sharex=ax)
     ax.fill_between(f, tmin, tmax, color="C0", alpha=0.15, label="min-max over the last periods")
     ax.plot(f, tmax, "-", color="C0")
     ax.plot(f[ok], tmax[ok], "o", color="C0", label="T max (periodic)")
@@ -279,23 +299,23 @@ def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz
     ax.set_ylabel("tension at s = 0 [N]")
     ax.set_title(f"{title}: maximum tension against f1 (Fig. 8)")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left")
+    ax.tick_params(labelbottom=False)
+    _legend_beside(ax, fontsize=9)
+    branch_limits.moment_ratio_panel(ax_m, points)
+    _legend_beside(ax_m, fontsize=8)
+    ax_m.set_title("the section: max |M| / (N R) over the recorded periods (limits block)",
+                   fontsize=9)
     if series:
         near = min(series, key=lambda f1: abs(f1 - inset_Hz))
         t, T = series[near]
-        ins = ax.inset_axes([0.1, 0.36, 0.38, 0.3])  # above the flat low-f1 part
-        ins.plot(t - t[0], T, "-", lw=1)
-        ins.set_title(f"T(t) at f1 = {near:g} Hz", fontsize=8)
-        ins.set_xlabel("t [s]", fontsize=8)
-        ins.set_ylabel("T [N]", fontsize=8)
-        ins.tick_params(labelsize=7)
-    branch_limits.moment_ratio_panel(ax_m, points)
-    ax_m.set_title("the section: max |M| / (N R) over the recorded periods (limits block)",
-                   fontsize=9)
+        ax_t = fig.add_subplot(grid[2])
+        ax_t.plot(t - t[0], T, "-", lw=1)
+        ax_t.set_title(f"T(t) at s = 0, f1 = {near:g} Hz", fontsize=9)
+        ax_t.set_xlabel("t [s]")
+        ax_t.set_ylabel("T [N]")
+        ax_t.grid(True, alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return fig
 
 
 def report(result: SweepResult) -> str:

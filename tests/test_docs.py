@@ -101,12 +101,47 @@ def test_scene_page_has_every_key(site):
                 assert f"{section}.{f.name}" in page
 
 
+def test_scene_tables_and_code_fit_the_page(site):
+    """The scene-key tables sit in the container the site's CSS fits to the
+    page's width (their long cells wrap), and code blocks wrap long lines."""
+    page = (site / "reference" / "scene.html").read_text()
+    tables = page.count("<table")
+    assert tables >= len(scene.SECTIONS)
+    assert page.count('class="scene-keys docutils container"') == tables
+    css = (site / "_static" / "custom.css").read_text()
+    assert re.search(r"\.scene-keys table\.docutils \{[^}]*width: 100%", css)
+    assert re.search(r"\.scene-keys td:nth-child\(n\+5\) \{ overflow-wrap: anywhere", css)
+    assert re.search(r"div\.highlight pre \{ white-space: pre-wrap", css)
+
+
 def test_api_page_has_every_function(site):
     import rawehelix.api
     page = (site / "reference" / "api.html").read_text()
     for name in rawehelix.api.__all__:
         if name[0].islower():
             assert f'id="rawehelix.api.{name}"' in page, name
+
+
+def test_api_page_example_is_code_and_every_parameter_has_words(site):
+    """The module example renders as a code block, and no parameter's entry is
+    only its name and type (autodoc's typehints with no description)."""
+    page = (site / "reference" / "api.html").read_text()
+    blocks = [re.sub(r"<[^>]+>", "", b) for b in re.findall(r"<pre>(.*?)</pre>", page, re.S)]
+    assert any("rh.load_scene(" in b and "rh.simulate(" in b for b in blocks)
+    assert not re.search(r"<strong>\w+</strong> \([^)]*\)</p>", page)  # a parameter, no words
+    assert "<strong>scene</strong>" in page
+
+
+#: user-facing pages: every page of the site but the fault table (its rows cite
+#: the issues their faults were filed in) and the README
+USER_PAGES = [p for p in DOCS.rglob("*.md") if "_build" not in p.parts
+              and p.name != "faults.md"] + [ROOT / "README.md"]
+
+
+def test_user_pages_name_what_a_feature_is_not_its_issue():
+    for page in USER_PAGES:
+        found = re.search(r"\bissues? \d+", page.read_text(), re.I)
+        assert not found, f"{page.relative_to(ROOT)}: {found.group(0)}"
 
 
 # -- the README -----------------------------------------------------------------
@@ -182,6 +217,39 @@ def test_allowed_comes_from_the_validation():
         with pytest.raises(scene.SceneError) as err:
             scene.load("stationary_table2", overrides={key: bad})
         assert rows[key]["allowed"].split("; ")[0] in str(err.value)
+
+
+def test_allowed_is_short_and_names_no_probe_value():
+    """A bound computed from other keys (EI <= EA L0^2, Wen's |gamma| <= beta) is
+    stated once, as the rule, not once per probe value of the other keys; no
+    cell quotes the generator's probes (1e-300, 1e300) or grows to a wall of text."""
+    rows = {f"{r['section']}.{r['key']}": r for r in reference.scene_key_rows()}
+    for r in rows.values():
+        assert "e-300" not in r["allowed"] and "e+300" not in r["allowed"], r
+        assert len(r["allowed"]) < 250, r
+    ei = rows["helix.EI_Nm2"]["allowed"]
+    assert "must be at most helix.EA_N x helix.length_m^2 (a slender rod" in ei
+    assert ei.count("at most") == 1
+    gamma = rows["torsion_hysteresis.gamma_m_n"]["allowed"]
+    assert "rho < 1" in gamma and gamma.count("needs") == 1
+
+
+def test_a_switch_rule_names_the_value_it_is_about():
+    """`model.twist = false` needs a torque-free scene, not `model.twist`: the
+    reference and the loader's message spell the value as the scene file does."""
+    rules = dict(reference._cross_section_rules())
+    assert "model.twist = false" in rules and "model.twist" not in rules
+    assert 'model.kinematics = "extensible"' in rules
+    with pytest.raises(scene.SceneError) as err:
+        scene.load("nominal_operation", overrides={"model.twist": False})
+    assert "model.twist: false needs a torque-free scene" in str(err.value)
+    assert "False" not in str(err.value)
+
+
+@pytest.mark.parametrize("value", [False, True, "ip", 'a "quoted" word', 1e-05, 3, -2.5, 1e300])
+def test_messages_spell_values_as_a_scene_file_does(value):
+    """What a message quotes can be pasted into a scene file (or --set) as is."""
+    assert tomllib.loads(f"v = {scene.toml_value(value)}")["v"] == value
 
 
 # -- summary.json fields --------------------------------------------------------

@@ -87,3 +87,26 @@ def test_pictures_are_written_and_vtk_is_silent(tmp_path):
     gif = Image.open(tmp_path / "h.gif")
     assert gif.size == render.GIF_SIZE and gif.n_frames == render.GIF_FRAMES
     assert Image.open(tmp_path / "m.gif").n_frames == render.MODE_FRAMES
+
+
+@pytest.mark.skipif(not render.available(), reason="pyvista is not installed")
+@pytest.mark.parametrize("moving", [True, False], ids=["displacement", "twist"])
+def test_the_colour_bar_title_stays_in_the_window(tmp_path, moving):
+    """The bar's title is centred over the bar near the right edge: a long one
+    ("displacement amplitude", "twist amplitude (rad)") was cut off there.  No
+    ink may touch the frame's right edge, and every title line fits."""
+    from PIL import Image
+    x = _sagging(n=30)
+    s = np.linspace(0.0, 1.0, len(x))
+    u = np.zeros_like(x)
+    if moving:
+        u[:, 1] = np.sin(np.pi * s)
+    path = render.mode_animation(tmp_path / "m.gif", None, x, u, np.sin(np.pi * s), 0.19,
+                                 "Lateral, 9.84 Hz", frames=2)
+    frame = Image.open(path)
+    frame.seek(0)
+    rgb = np.asarray(frame.convert("RGB")).astype(int)
+    assert (rgb[:, -3:, :].sum(axis=2) < 600).sum() == 0, "ink at the right edge: clipped"
+    for title in ("displacement amplitude", "twist amplitude (rad)", "tension T (N)"):
+        assert max(len(line) for line in render.bar_title(title).splitlines()) \
+            <= render.BAR_TITLE_CHARS

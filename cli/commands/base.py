@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from rawehelix.cli.text import printable
 from rawehelix.studies.scene import SceneError
 
 
@@ -77,4 +78,4 @@ def overrides(args, f1_grid: bool = False) -> dict:
 def say(comm, text: str):
     """The command's result, on rank 0's stdout."""
     if comm.rank == 0:
-        print(text, flush=True)
+        print(printable(text), flush=True)

@@ -165,14 +165,31 @@ def _choices(messages: list[str]) -> tuple:
     return ()
 
 
+#: a number a message quotes (a bound computed from the scene's other keys)
+_NUMBER = r"-?(?:\d+\.?\d*(?:e[+-]?\d+)?|inf|nan)"
+_QUOTED_VALUE = re.compile(r" = " + _NUMBER + r"(?=[\s),;]|$)")
+
+
 def _allowed(base, section: str, name: str, type_name: str, variants) -> str:
+    """The field's rules, each once.  A rule whose message quotes values of
+    other keys (a bound computed from them) is stated without the values: the
+    probes met it with several, and no one of them is the rule."""
     if type_name == "bool":
         return "true or false"
     messages = {text: "" for text in _refusals(base, section, name, type_name)}
     for other, value in variants:  # ranges that depend on another key of the section
         for text in _refusals(base, section, name, type_name, {other: value}):
             messages.setdefault(text, f" (when {other} = {value!r})")
-    return "; ".join(text + note for text, note in messages.items()) or "not checked"
+    shapes: dict[str, list[str]] = {}
+    for text in messages:
+        shapes.setdefault(re.sub(_NUMBER, "#", text), []).append(text)
+    rules = []
+    for texts in shapes.values():
+        if len(texts) > 1:  # one rule met at several values of other keys
+            rules.append(_QUOTED_VALUE.sub("", texts[0]))
+        else:
+            rules.append(texts[0] + messages[texts[0]])
+    return "; ".join(rules) or "not checked"
 
 
 def _default(f) -> str:
@@ -242,13 +259,15 @@ def scene_keys() -> str:
         doc = docs[section].split("\n\n")[0].replace("\n", " ")
         if doc and not doc.startswith(scene.SECTIONS[section].__name__ + "("):
             out += [doc, ""]
-        out += ["| key | type | unit | default | allowed | meaning |",
+        # in a container: docs/_static/custom.css wraps its long cells to the page's width
+        out += [":::{container} scene-keys", "",
+                "| key | type | unit | default | allowed | meaning |",
                 "| --- | --- | --- | --- | --- | --- |"]
         for r in (r for r in rows if r["section"] == section):
             out.append("| " + " | ".join(_cell(x) for x in (
                 f"`{section}.{r['key']}`", r["type"], r["unit"], r["default"], r["allowed"],
                 r["meaning"])) + " |")
-        out.append("")
+        out += ["", ":::", ""]
     out += ["## Rules between sections", "",
             "Checked when the whole scene is built (`Parameters`), whatever the sections' "
             "own ranges allow:", ""]
@@ -276,8 +295,11 @@ def _cross_section_rules() -> list[tuple[str, str]]:
         try:
             base.replace(**trial)
         except ParameterError as err:
-            if (err.key, err.allowed) not in found:
-                found.append((err.key, err.allowed))
+            # a switch's rule names the value it is about: `model.twist = false` needs ...
+            key = (f"{err.key} = {scene.toml_value(err.value)}"
+                   if isinstance(err.value, (bool, str, int, float)) else err.key)
+            if (key, err.allowed) not in found:
+                found.append((key, err.allowed))
     return found
 
 

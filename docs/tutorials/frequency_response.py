@@ -13,7 +13,7 @@
 # history leads to.  Two other tools see more:
 #
 # - `rh.response`: the *linear* response to the end's circle, the steady
-#   harmonic solution of (K - w^2 M + i w C) X = 0 about the stationary state.
+#   harmonic solution of $(K - \omega^2 M + i \omega C)\,X = 0$ about the stationary state.
 #   It is cheap (one LU per f1) and its peaks are the natural frequencies.
 # - `rh.orbits`: the *nonlinear* periodic orbits, found by shooting on the
 #   period map of the time integrator, with their Floquet multipliers
@@ -33,7 +33,8 @@ import numpy as np
 import rawehelix as rh
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
-OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials")) / "frequency_response"
+OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
+OUT = OUT / "frequency_response"
 N = 2 if SMALL else 4
 scene = rh.load_scene("mobile_end", elements=N)
 
@@ -66,8 +67,9 @@ ob = rh.orbits(scene, 11.5, 12.9, tension_step=0.1 if SMALL else None,
                superharmonics=(), max_points=60 if SMALL else 400)
 print(f"{len(ob.branch)} orbits, {ob.discretisation}")
 for p in ob.branch:
+    stability = "stable" if p["stable"] else "UNSTABLE"
     print(f"  f1 = {p['f1_Hz']:8.4f} Hz  T max = {p['tension_max_N']:6.1f} N  "
-          f"|mu| max = {p['max_multiplier']:.3f}  {'stable' if p['stable'] else 'UNSTABLE'}")
+          f"|mu| max = {p['max_multiplier']:.3f}  {stability}")
 for fold in ob.folds:
     print(f"fold at {fold['f1_Hz']:.3f} Hz (+- {fold['f1_error_Hz']:.3f}), "
           f"T max {fold['tension_max_N']:.1f} N")

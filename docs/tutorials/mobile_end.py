@@ -33,7 +33,8 @@ import numpy as np
 import rawehelix as rh
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
-OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials")) / "mobile_end"
+OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
+OUT = OUT / "mobile_end"
 N = 4 if SMALL else 8
 F1_HZ = [9.0, 10.0] if SMALL else list(np.arange(9.0, 14.01, 0.5))
 SETTINGS = {"sweep.lead_in_s": 1.0} if SMALL else {}  # the scene's lead-in is 10 s
@@ -46,7 +47,8 @@ SETTINGS = {"sweep.lead_in_s": 1.0} if SMALL else {}  # the scene's lead-in is 1
 
 # %%
 fe_scene = rh.load_scene("mobile_end", elements=N, overrides=SETTINGS)
-paper_scene = rh.load_scene("mobile_end", scheme="spline", elements=2, overrides=SETTINGS)
+paper_scene = rh.load_scene("mobile_end", scheme="spline", elements=2,
+                            overrides=SETTINGS)
 
 # %% [markdown]
 # ## The sweeps
@@ -64,7 +66,8 @@ spline = rh.sweep(paper_scene, f1_Hz=F1_HZ, checkpoint=OUT / "spline_N2")
 print(f"{'f1 [Hz]':>8s} {'FE N = %d' % N:>12s} {'spline N = 2':>14s}   T max [N]")
 for a, b in zip(fe.points, spline.points, strict=True):
     flag = "" if a["periodic"] and b["periodic"] else "  (not periodic)"
-    print(f"{a['f1_Hz']:8.2f} {a['tension_max_N']:12.1f} {b['tension_max_N']:14.1f}{flag}")
+    print(f"{a['f1_Hz']:8.2f} {a['tension_max_N']:12.1f} "
+          f"{b['tension_max_N']:14.1f}{flag}")
 
 # %% [markdown]
 # ## What the two curves say

@@ -10,7 +10,7 @@
 # # Spin-up under the rotor torque (Sec. 5.2, Fig. 6)
 #
 # In nominal operation the rotor at the upper end applies a torque M_N that
-# rises over t0 = 2 sqrt(L0/g); the ground generator holds the lower end with
+# rises over $t_0 = 2\sqrt{L_0/g}$; the ground generator holds the lower end with
 # the PD controller of Eq. (40), whose set point turns at 120 rpm.  The helix
 # carries the torque down and the whole machine spins up.  We integrate the
 # FE model in time from its stationary state (PETSc TS, generalised-alpha
@@ -27,7 +27,8 @@ import rawehelix as rh
 from rawehelix.studies import paper
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
-OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials")) / "nominal_operation"
+OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
+OUT = OUT / "nominal_operation"
 N = 4 if SMALL else 16       # the spin-up does not depend on N from N = 2 on
 UNTIL_S = 6.0 if SMALL else 30.0  # Fig. 6 shows 30 s; the spin settles in about 5 s
 
@@ -59,13 +60,14 @@ print(f"{s['steps']} steps, {s['newton_iterations']} Newton iterations, "
 
 # %%
 final = ts.spin_rpm[-1]
-print(f"spin at t = {ts.t_s[-1]:.1f} s: {final[0]:.3f}, {final[1]:.3f}, {final[2]:.3f} rpm")
+print(f"spin at t = {ts.t_s[-1]:.1f} s: "
+      f"{final[0]:.3f}, {final[1]:.3f}, {final[2]:.3f} rpm")
 print(f"settling time into the 2 % band: {s['settling_time_s']:.3f} s")
 print(f"ground torque at the end: {ts.ground_torque_Nm[-1]:.4f} Nm")
 lo, hi = s["tension_range_N"]
 print(f"tension between {lo:.1f} and {hi:.1f} N")
 target = paper.SEC52_TARGET_RPM
-assert abs(final - target).max() < 0.02 * target, "the spin is not at the paper's 120 rpm"
+assert abs(final - target).max() < 0.02 * target, "the spin is not at 120 rpm"
 assert abs(0.5 * (lo + hi) - paper.SEC52_TENSION_N) < 0.05 * paper.SEC52_TENSION_N
 
 # %% [markdown]

@@ -17,7 +17,7 @@
 # - `rawehelix.studies.study.compute` evaluates named quantities
 #   (`lateral_frequency_Hz`, `tension_s0_N`, `sag_m`, `peak_Hz`, ...; each
 #   computes the least it needs, a modal one never integrates in time) over a
-#   design of dotted scene keys, with the sensitivities d ln Q / d ln p at the
+#   design of dotted scene keys, with the sensitivities $\partial \ln Q / \partial \ln p$ at the
 #   base point.  The command is `rawehelix study`.
 # - `rawehelix.studies.calibrate.compute` fits scene keys to target
 #   quantities by least squares.  The command is `rawehelix calibrate`.
@@ -39,7 +39,8 @@ import rawehelix as rh
 from rawehelix.studies import calibrate, study
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
-OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials")) / "parameter_study"
+OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
+OUT = OUT / "parameter_study"
 N = 4 if SMALL else 16
 COUNT = 4 if SMALL else 12  # grid points in EI
 
@@ -54,7 +55,8 @@ COUNT = 4 if SMALL else 12  # grid points in EI
 # %%
 source = study.Source("mobile_end", elements=N)
 ei = study.parse_vary(f"helix.EI_Nm2=500:6000:{COUNT}")
-result = study.compute(source, [ei], ["lateral_frequency_Hz", "tension_s0_N"], OUT / "study")
+result = study.compute(source, [ei], ["lateral_frequency_Hz", "tension_s0_N"],
+                       OUT / "study")
 for EI, f, T in zip(result.keys_of()[:, 0], result.column("lateral_frequency_Hz"),
                     result.column("tension_s0_N")):
     print(f"EI = {EI:7.1f} N m^2: lateral {f:6.3f} Hz, T(0) = {T:.2f} N")
@@ -63,10 +65,12 @@ print(f"d ln f / d ln EI at Table 4's EI: {sens:.3f}")
 result.write(OUT / "study")  # study.csv, summary.json, study.png, tornado.png
 
 # %% [markdown]
-# The frequency grows with EI, but slower than sqrt(EI): the tension carries
-# part of the stiffness.  For a pinned beam under the mean tension T,
-# omega^2 = (T k^2 + EI k^4) / m with k = pi / L0, so
-# d ln f / d ln EI = EI k^2 / (2 (T + EI k^2)), below 1/2.
+# The frequency grows with EI, but slower than $\sqrt{EI}$: the tension
+# carries part of the stiffness.  For a pinned beam under the mean tension T,
+#
+# $$\omega^2 = \frac{T k^2 + EI\,k^4}{m}, \quad k = \frac{\pi}{L_0},
+# \qquad\text{so}\qquad
+# \frac{\partial \ln f}{\partial \ln EI} = \frac{EI\,k^2}{2\,(T + EI\,k^2)} < \frac{1}{2}.$$
 
 # %%
 f = result.column("lateral_frequency_Hz")
@@ -89,7 +93,7 @@ EI = fit.summary["fitted"]["helix.EI_Nm2"]
 # %% [markdown]
 # ## Against the closed form
 #
-# The tensioned pinned beam gives EI = (m omega^2 - T k^2) / k^4 at 5 Hz, with
+# The tensioned pinned beam gives $EI = (m\,\omega^2 - T k^2) / k^4$ at 5 Hz, with
 # the mean tension of the fitted scene's stationary state (Table 4 has
 # EI = 4381 N m^2; the fit is about 769 N m^2).
 
@@ -99,6 +103,7 @@ T = rh.modes(fitted_scene).info["mean_tension_N"]
 h = fitted_scene.helix
 k, m, omega = math.pi / h.length_m, h.mass_kg / h.length_m, 2 * math.pi * 5.0
 closed = (m * omega**2 - T * k**2) / k**4
-print(f"fitted EI = {EI:.3f} N m^2, closed form {closed:.3f} N m^2 ({EI / closed - 1:+.1e})")
+print(f"fitted EI = {EI:.3f} N m^2, closed form {closed:.3f} N m^2 "
+      f"({EI / closed - 1:+.1e})")
 assert abs(EI / closed - 1) < 1e-2
 print("written:", OUT)

@@ -31,8 +31,9 @@ import rawehelix as rh
 from rawehelix.studies import paper
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
-OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials")) / "stationary_table2"
-N = 8 if SMALL else 16  # elements; the shipped scene's 16 is converged to plotting accuracy
+OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
+OUT = OUT / "stationary_table2"
+N = 8 if SMALL else 16  # elements; the scene's 16 is converged to plotting accuracy
 
 # %% [markdown]
 # ## The scene
@@ -60,7 +61,7 @@ print(f"T(0) = {st.tension_N[0]:.3f} N, T(L0) = {st.tension_N[-1]:.3f} N, "
       f"sag {s['sag_m']:.4f} m, {s['newton_iterations']} Newton iterations")
 print(f"FE against shooting: {s['shooting_max_diff_m']:.2e} m")
 assert s["shooting_max_diff_m"] < 1e-4  # Newton converged to the shooting reference
-st.write(OUT / "stationary")            # summary.json, stationary.png, centre_line.xdmf
+st.write(OUT / "stationary")  # summary.json, stationary.png, centre_line.xdmf
 
 # %% [markdown]
 # ## The modes beside Table 3
@@ -69,7 +70,7 @@ st.write(OUT / "stationary")            # summary.json, stationary.png, centre_l
 # quadratic eigenproblem with SLEPc.  The paper computed Table 3 with its
 # cubic-spline Galerkin scheme at N = 2; rawehelix keeps that scheme as an
 # independent reference (`scheme="spline"`), so both can be set beside the
-# paper's values (eigenvalues normalised by sqrt(L0/g), Eq. 25).
+# paper's values (eigenvalues normalised by $\sqrt{L_0/g}$, Eq. 25).
 
 # %%
 fe = rh.modes(scene)
@@ -78,15 +79,20 @@ spline = rh.modes(rh.load_scene("stationary_table2", scheme="spline", elements=2
 
 def first(modes, family):
     """The slowest mode of a family."""
-    return min((m for m in modes if m.family == family), key=lambda m: abs(m.eigenvalue.imag))
+    return min((m for m in modes if m.family == family),
+               key=lambda m: abs(m.eigenvalue.imag))
 
 
-print(f"{'family':22s} {'Table 3':>16s} {'spline N = 2':>16s} {'FE N = %d' % N:>16s}")
+print(f"{'family':22s} {'Table 3':>16s} {'spline N = 2':>16s} {f'FE N = {N}':>16s}")
 for row in paper.TABLE3:
     if row.family == "torsional" and abs(row.eigenvalue.imag) > 30:
-        continue  # the second torsional row of Table 3; the tutorial shows each family's first
-    lam_s, lam_f = first(spline, row.family).eigenvalue, first(fe, row.family).eigenvalue
-    print(f"{row.family:22s} {row.eigenvalue:16.2f} {lam_s:16.2f} {lam_f:16.2f}")
+        continue  # Table 3's second torsional row; we show each family's first
+    lam_s = first(spline, row.family).eigenvalue
+    lam_f = first(fe, row.family).eigenvalue
+    # rounded first, + 0.0: a real part of -1e-9 prints 0.00, not -0.00
+    s2, f2 = (complex(round(z.real, 2) + 0.0, round(z.imag, 2))
+              for z in (lam_s, lam_f))
+    print(f"{row.family:22s} {row.eigenvalue:16.2f} {s2:16.2f} {f2:16.2f}")
     # the paper's scheme reproduces the printed table (3 significant digits)
     assert abs(lam_s.imag - row.eigenvalue.imag) <= 0.01 * abs(row.eigenvalue.imag)
 
@@ -98,7 +104,8 @@ for row in paper.TABLE3:
 
 # %%
 for mode in fe:
-    print(f"{mode.family:22s} {mode.frequency_Hz:8.3f} Hz, decay {mode.decay_per_s:.4f} 1/s")
+    decay = round(mode.decay_per_s, 4) + 0.0  # + 0.0: -1e-12 prints 0.0000
+    print(f"{mode.family:22s} {mode.frequency_Hz:8.3f} Hz, decay {decay:.4f} 1/s")
 periods = np.array([m.period_s for m in fe if m.period_s is not None])
 assert np.all(periods > 0)
 fe.write(OUT / "modes")  # summary.json, modes.png, modes.xdmf (+ GIFs with pyvista)
