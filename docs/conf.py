@@ -11,6 +11,7 @@ argparse parser, the scene keys from the parameter dataclasses) or by autodoc
 from __future__ import annotations
 
 import importlib
+import os
 import importlib.util
 import sys
 from pathlib import Path
@@ -77,3 +78,13 @@ html_title = f"rawehelix {release}"
 html_static_path = ["_static"]
 html_logo = None
 html_css_files = ["custom.css"]
+
+# Maths: Debian's MathJax 2 (libjs-mathjax, a dependency of python3-sphinx) where
+# the build machine has it, so a page read offline renders its maths; elsewhere
+# Sphinx's default (MathJax 3 from its CDN).  RAWEHELIX_DOCS_CDN_MATHJAX=1 forces
+# the CDN for a site that is served to others.
+_LOCAL_MATHJAX = Path("/usr/share/javascript/mathjax/MathJax.js")
+if _LOCAL_MATHJAX.exists() and not os.environ.get("RAWEHELIX_DOCS_CDN_MATHJAX"):
+    mathjax_path = _LOCAL_MATHJAX.as_uri() + "?config=TeX-AMS_CHTML"
+    mathjax2_config = {"tex2jax": {"processClass": "math",
+                                   "ignoreClass": "tex2jax_ignore|mathjax_ignore"}}
