@@ -36,11 +36,16 @@ def _world(comm):
     return MPI.COMM_WORLD
 
 
-def _resources(scene: Parameters, command: str, f1_Hz=None):
-    """Refuse, before anything is allocated, a run past this machine's memory
-    (:mod:`rawehelix.studies.resources`: one estimate for every command)."""
+def _ready(scene: Parameters, command: str, comm, f1_Hz=None) -> Parameters:
+    """The scene a command runs: refused, before anything is allocated, if the run is
+    past this machine's memory (:mod:`rawehelix.studies.resources`: one estimate for
+    every command); with the elongation found for ``ends.tension_N``
+    (:func:`rawehelix.solvers.tension_target.resolve`: unchanged if the scene gives
+    ``ends.elongation``)."""
+    from rawehelix.solvers import tension_target
     from rawehelix.studies import resources
     resources.check_run(scene, command, f1_Hz)
+    return tension_target.resolve(scene, comm)
 
 
 def load_scene(name_or_path, elements: int | None = None, degree: int | None = None,
@@ -61,9 +66,10 @@ def stationary(scene: Parameters, comm=None):
     shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
     with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``
     (``summary["limits"]``: the structure's limits in that state, issue 29)."""
-    _resources(scene, "stationary")
+    comm = _world(comm)
+    scene = _ready(scene, "stationary", comm)
     from rawehelix.studies import stationary as study
-    return study.compute(scene, _world(comm))
+    return study.compute(scene, comm)
 
 
 def modes(scene: Parameters, count: int | None = None, comm=None):
@@ -77,9 +83,10 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
     as family ``overdamped`` (a decay rate, no period; listed last); ``count``:
     the ``count`` slowest modes.  ``scene.discretisation.scheme`` picks FE
     (SLEPc) or the paper's spline scheme."""
-    _resources(scene, "modes")
+    comm = _world(comm)
+    scene = _ready(scene, "modes", comm)
     from rawehelix.studies import modes as study
-    return study.compute(scene, count=count, comm=_world(comm))
+    return study.compute(scene, count=count, comm=comm)
 
 
 def response(scene: Parameters, f1_Hz=None, comm=None):
@@ -92,9 +99,10 @@ def response(scene: Parameters, f1_Hz=None, comm=None):
     the nearest natural mode, ``natural`` (the modes of the same
     linearisation) and ``summary``.  One f1's complex response vector:
     :class:`rawehelix.solvers.response.HarmonicResponse`."""
-    _resources(scene, "response", f1_Hz)
+    comm = _world(comm)
+    scene = _ready(scene, "response", comm, f1_Hz)
     from rawehelix.studies import response as study
-    return study.compute(scene, f1_Hz, comm=_world(comm))
+    return study.compute(scene, f1_Hz, comm=comm)
 
 
 def simulate(scene: Parameters, until_s: float | None = None, comm=None,
@@ -107,9 +115,10 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
     (``summary["limits"]``: the structure's limits over the run, issue 29; also in a
     failed run's ``SimulationError.partial``).  ``options``: PETSc options of the integrator without the
     prefix, e.g. ``{"ts_type": "cn"}``."""
-    _resources(scene, "simulate")
+    comm = _world(comm)
+    scene = _ready(scene, "simulate", comm)
     from rawehelix.studies import simulate as study
-    return study.compute(scene, until_s=until_s, comm=_world(comm), options=options,
+    return study.compute(scene, until_s=until_s, comm=comm, options=options,
                          progress=progress)
 
 
@@ -121,9 +130,10 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
     ``tension_mean_N``, ``periods``, ``periodic``) and ``summary``.
     ``checkpoint``: a directory that keeps finished points, so that the same
     call resumes a stopped sweep."""
-    _resources(scene, "sweep", f1_Hz)
+    comm = _world(comm)
+    scene = _ready(scene, "sweep", comm, f1_Hz)
     from rawehelix.studies import sweep as study
-    return study.compute(scene, f1_Hz, comm=_world(comm), checkpoint=checkpoint)
+    return study.compute(scene, f1_Hz, comm=comm, checkpoint=checkpoint)
 
 
 def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None,
@@ -144,9 +154,10 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     ``method``: "shooting" (above), "hb" (harmonic balance, Hill's method for the
     multipliers, H chosen by accuracy and reported per point) or "auto" (the rule
     of :func:`rawehelix.studies.orbit_method.choose`)."""
-    _resources(scene, "orbits")
+    comm = _world(comm)
+    scene = _ready(scene, "orbits", comm)
     from rawehelix.studies import orbits as study
-    return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
+    return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=comm, progress=progress,
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
                          superharmonics=superharmonics, method=method)
 
@@ -165,9 +176,10 @@ def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=Non
     most a branch steps in f1 (stability is judged at its points)."""
     from rawehelix.studies import envelope as study
     from rawehelix.studies.sampling import Variable, parse_vary
-    _resources(scene, "orbits")
+    comm = _world(comm)
+    scene = _ready(scene, "orbits", comm)
     vary = vary if isinstance(vary, Variable) else parse_vary(vary)
-    return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=_world(comm), outdir=outdir,
+    return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=comm, outdir=outdir,
                          method=method, progress=progress, f1_step_Hz=f1_step_Hz)
 
 

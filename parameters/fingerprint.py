@@ -13,12 +13,14 @@ LATER_MODEL_SWITCHES = {"kinematics": "paper", "rotary_inertia": True,
                         **components.later_switches("model", Model)}
 #: the same for the helix section (the EI law)
 LATER_HELIX_SWITCHES = components.later_switches("helix", Helix)
+#: the same for the ends (ends.tension_N, issue 41)
+LATER_ENDS_SWITCHES = {"tension_N": None}
 
 
 def drop_later_switches(data: dict) -> dict:
     """``data`` (Parameters as a dict) without the later switches at their defaults."""
     for section, switches in (("model", LATER_MODEL_SWITCHES),
-                              ("helix", LATER_HELIX_SWITCHES)):
+                              ("helix", LATER_HELIX_SWITCHES), ("ends", LATER_ENDS_SWITCHES)):
         for key, default in switches.items():  # fingerprints stored before them
             if data[section][key] == default:
                 data[section].pop(key)

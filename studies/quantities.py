@@ -280,6 +280,13 @@ def evaluate(params: Parameters, wanted: list[str], timed_out: Callable | None =
         stage = ("sweep", f1) if quantity.stage == f"sweep{AT}F1" else (quantity.stage, None)
         stages.setdefault(stage, []).append((name, quantity))
     values, errors, cpu, wall = {}, {}, {}, {}
+    try:  # ends.tension_N: the point's own elongation (solvers/tension_target.py)
+        from rawehelix.solvers import tension_target
+        params = tension_target.resolve(params, _comm())
+    except POINT_ERRORS as err:
+        reason = f"ends.tension_N: {type(err).__name__}: {err}"
+        return {"values": dict.fromkeys(wanted), "errors": dict.fromkeys(wanted, reason),
+                "cpu_s": cpu, "wall_s": wall}
     for (stage, f1), members in stages.items():
         label = stage if f1 is None else f"{stage}{AT}{f1:g}"
         late = timed_out() if timed_out else None
