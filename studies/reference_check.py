@@ -50,9 +50,6 @@ def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
     if law != "solid":
         return (f"section.law = {law!r}: the references model the solid section "
                 "(helix.EA_N, helix.EI_Nm2)")
-    if params.model.kinematics == "paper" and params.helix.EI_law is not None:
-        return ("helix.EI_law with model.kinematics = 'paper': Sys. (67) has a constant EI "
-                "(the EI law's reference is model.kinematics = 'extensible')")
     if not params.model.bending:
         return "model.bending = false: the references need a bending stiffness"
     q = params.normalised()
