@@ -2,8 +2,9 @@
 
     import rawehelix as rh
 
+    st = rh.stationary(rh.load_scene("stationary_table2", elements=8))
+    print(st.summary["tension_N"])     # st.s_m, st.centre_line_m, st.tension_N, st.summary
     scene = rh.load_scene("nominal_operation", elements=8)
-    st = rh.stationary(scene)          # st.s_m, st.centre_line_m, st.tension_N, st.summary
     ts = rh.simulate(scene, until_s=10.0)
     print(ts.spin_rpm[-1], ts.summary["settling_time_s"])
     ts.write("results/spin_up")        # computing never writes files; write() does
@@ -62,10 +63,15 @@ def load_scene(name_or_path, elements: int | None = None, degree: int | None = N
 
 
 def stationary(scene: Parameters, comm=None):
-    """The stationary state with fixed ends (Sec. 5.1), checked against the
-    shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
-    with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``
-    (``summary["limits"]``: the structure's limits in that state, issue 29)."""
+    """The stationary state with fixed ends (Sec. 5.1) under the ends' balanced
+    torque (torque.top_Nm, held by the ground: a twisted state, Omega = 0; a
+    controller that spins the helix up, controller.k1 > 0 with a target_rpm, raises
+    SceneError), checked against the shooting reference where it applies: a
+    :class:`~rawehelix.studies.stationary.Stationary` with ``s_m``,
+    ``centre_line_m`` (n x 3), ``tension_N`` and ``summary`` (``summary["limits"]``:
+    the structure's limits in that state; ``"ends"``: the elongation, and the
+    tension asked for with ``ends.tension_N``; ``"torque"``: the twist;
+    ``"shooting"``: "compared", "not applicable: why" or "did not converge: why")."""
     comm = _world(comm)
     scene = _ready(scene, "stationary", comm)
     from rawehelix.studies import stationary as study
