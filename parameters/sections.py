@@ -90,10 +90,12 @@ class Ends:
     (solvers/tension_target.py); every command then runs with that elongation."""
 
     elevation_deg: float  # Gamma0, elevation of the chord [deg]
-    # eps0: chord = (1 + eps0) L0, Eq. (66); or give ends.tension_N instead
+    # eps0: chord = (1 + eps0) L0, Eq. (66); a scene gives exactly one of
+    # ends.elongation and ends.tension_N
     elongation: float | None = None
-    # T, the stationary tension's mean along s [N]: the elongation is found by the
-    # stationary solve (a weightless straight rod would have T / EA); or give ends.elongation
+    # T, the mean along s of the tension of the torque-free stationary state (the one
+    # every run starts from) [N]: the stationary solve finds the elongation that gives
+    # it (T / EA, the weightless straight rod's, misses it); instead of ends.elongation
     tension_N: float | None = None
     circle_radius_m: float = 0.0  # R1, radius of the upper end's circle, Eq. (70) [m]
     circle_frequency_Hz: float = 0.0  # f1, frequency of the upper end's circle [Hz]
