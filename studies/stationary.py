@@ -88,6 +88,17 @@ def static_torque(params: Parameters) -> float:
             f"(Omega = 0) for 'stationary'; run 'rawehelix simulate {params.name} --until "
             f"{params.time.until_s:g}' for the spin-up and its steady spin, or set "
             f"controller.target_rpm = 0 for the static twisted state")
+    hysteresis = params.model.torsion_hysteresis
+    if hysteresis.active and params.torque.top_Nm != 0:
+        # Bouc-Wen is rate-independent: at rest any internal twist z is static, and the
+        # one a torque leaves depends on how it was applied (forms/hysteresis.py)
+        raise SceneError(
+            params.name, "torsion_hysteresis.rho",
+            f"{hysteresis.rho:g} < 1 (hysteretic torsion) with torque.top_Nm = "
+            f"{params.torque.top_Nm:g}: the static twist depends on how the torque was "
+            f"applied, so 'stationary' has no one state to give; run 'rawehelix simulate "
+            f"{params.name} --until {params.time.until_s:g}' for the ramp of Eq. (69), or set "
+            f"torque.top_Nm = 0")
     return params.normalised().mN0
 
 

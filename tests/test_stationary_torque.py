@@ -68,3 +68,14 @@ def test_the_refusal_comes_before_any_work():
     p = scene.load("nominal_operation", elements=2)
     with pytest.raises(SceneError, match="spins the helix up to 120 rpm"):
         stationary.static_torque(p)
+
+
+def test_a_hysteretic_twist_under_torque_is_refused():
+    """Bouc-Wen torsion (rho < 1) is rate-independent: the static twist under a torque
+    depends on its history; refused with what to run, not a state with z = 0."""
+    p = scene.load("stationary_table2", elements=2).replace(
+        torque={"top_Nm": 10.0}, torsion_hysteresis={"rho": 0.5, "beta_m_n": 0.5})
+    with pytest.raises(SceneError, match="torsion_hysteresis.rho.*rawehelix simulate"):
+        stationary.compute(p, MPI.COMM_SELF)
+    torque_free = p.replace(torque={"top_Nm": 0.0})
+    assert stationary.compute(torque_free, MPI.COMM_SELF).summary["torque"] is None
