@@ -79,7 +79,10 @@ def solve(params: Parameters, comm=None, twisted: bool = False,
     except shooting.OverBudget:
         status = f"did not converge: stopped after its budget of {budget_s:g} s of wall time"
     except (RuntimeError, ValueError, ArithmeticError) as err:
-        status = f"did not converge: {err}"
+        # one line (scipy's messages hold newlines), without the advice to the API's
+        # callers (shooting.solve's segments, which no command sets)
+        why = " ".join(str(err).split()).replace("; try more segments", "")
+        status = f"did not converge: {why.removeprefix('shooting did not converge: ')}"
     if comm is not None:
         statuses = comm.allgather(status)
         failed = [s for s in statuses if s != COMPARED]

@@ -40,6 +40,17 @@ def test_a_scene_it_models_is_compared(EI):
     assert check.compared and check.reference is not None
 
 
+@pytest.mark.parametrize("changes", [{"ends": {"elevation_deg": 90.0}},
+                                     {"environment": {"wind_speed_m_s": 40.0}}])
+def test_a_reference_that_fails_is_reported_in_one_line(changes):
+    """Values inside the documented ranges where the shooting's root finder fails
+    (a vertical chord; a strong wind): reported, one line, no traceback, no advice
+    that no command can follow."""
+    check = reference_check.solve(table2(**changes))
+    assert check.status.startswith("did not converge: ") and check.reference is None
+    assert "\n" not in check.status and "segments" not in check.status
+
+
 def test_a_reference_past_its_budget_did_not_converge():
     t0 = time.perf_counter()
     check = reference_check.solve(table2(), budget_s=0.05)
