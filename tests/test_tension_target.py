@@ -112,6 +112,11 @@ def test_commands_run_a_tension_scene(tmp_path):
         in r.stdout
     modes = rh.modes(rh.load_scene(OWN, elements=4), count=4, comm=MPI.COMM_SELF)
     assert len(modes) == 4 and all(m.frequency_Hz >= 0 for m in modes)
+    # a forced scene: its response about the state with the end at the circle's centre
+    # (which keeps the elongation found: it is found there)
+    forced = rh.load_scene("mobile_end", elements=4).replace(ends={"tension_N": 75.0})
+    response = rh.response(forced, f1_Hz=[5.0], comm=MPI.COMM_SELF)
+    assert response.tension_amplitude_N[0] > 0
 
 
 @pytest.mark.parametrize("ends, given", [({"tension_N": 200.0}, "both"),
