@@ -4,8 +4,9 @@ Example::
 
     import rawehelix as rh
 
+    st = rh.stationary(rh.load_scene("stationary_table2", elements=8))
+    print(st.summary["tension_N"])     # st.s_m, st.centre_line_m, st.tension_N, st.summary
     scene = rh.load_scene("nominal_operation", elements=8)
-    st = rh.stationary(scene)          # st.s_m, st.centre_line_m, st.tension_N, st.summary
     ts = rh.simulate(scene, until_s=10.0)
     print(ts.spin_rpm[-1], ts.summary["settling_time_s"])
     ts.write("results/spin_up")        # computing never writes files; write() does
@@ -38,11 +39,16 @@ def _world(comm):
     return MPI.COMM_WORLD
 
 
-def _resources(scene: Parameters, command: str, f1_Hz=None):
-    """Refuse, before anything is allocated, a run past this machine's memory
-    (:mod:`rawehelix.studies.resources`: one estimate for every command)."""
+def _ready(scene: Parameters, command: str, comm, f1_Hz=None) -> Parameters:
+    """The scene a command runs: refused, before anything is allocated, if the run is
+    past this machine's memory (:mod:`rawehelix.studies.resources`: one estimate for
+    every command); with the elongation found for ``ends.tension_N``
+    (:func:`rawehelix.solvers.tension_target.resolve`: unchanged if the scene gives
+    ``ends.elongation``)."""
+    from rawehelix.solvers import tension_target
     from rawehelix.studies import resources
     resources.check_run(scene, command, f1_Hz)
+    return tension_target.resolve(scene, comm)
 
 
 def load_scene(name_or_path, elements: int | None = None, degree: int | None = None,
@@ -75,17 +81,23 @@ def section(scene: Parameters):
 
 
 def stationary(scene: Parameters, comm=None):
-    """The stationary state with fixed ends (Sec. 5.1), checked against the
-    shooting reference: a :class:`~rawehelix.studies.stationary.Stationary`
-    with ``s_m``, ``centre_line_m`` (n x 3), ``tension_N`` and ``summary``
-    (``summary["limits"]``: the structure's limits in that state).
+    """The stationary state with fixed ends (Sec. 5.1) under the ends' balanced
+    torque (torque.top_Nm, held by the ground: a twisted state, Omega = 0; a
+    controller that spins the helix up, controller.k1 > 0 with a target_rpm, raises
+    SceneError), checked against the shooting reference where it applies: a
+    :class:`~rawehelix.studies.stationary.Stationary` with ``s_m``,
+    ``centre_line_m`` (n x 3), ``tension_N`` and ``summary`` (``summary["limits"]``:
+    the structure's limits in that state; ``"ends"``: the elongation, and the
+    tension asked for with ``ends.tension_N``; ``"torque"``: the twist;
+    ``"shooting"``: "compared", "not applicable: why" or "did not converge: why").
 
     Args:
         scene: the validated scene (:func:`load_scene`).
         comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
-    _resources(scene, "stationary")
+    comm = _world(comm)
+    scene = _ready(scene, "stationary", comm)
     from rawehelix.studies import stationary as study
-    return study.compute(scene, _world(comm))
+    return study.compute(scene, comm)
 
 
 def modes(scene: Parameters, count: int | None = None, comm=None):
@@ -104,9 +116,10 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
         scene: the validated scene (:func:`load_scene`).
         count: how many of the slowest modes to compute (default: the list above).
         comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
-    _resources(scene, "modes")
+    comm = _world(comm)
+    scene = _ready(scene, "modes", comm)
     from rawehelix.studies import modes as study
-    return study.compute(scene, count=count, comm=_world(comm))
+    return study.compute(scene, count=count, comm=comm)
 
 
 def response(scene: Parameters, f1_Hz=None, comm=None):
@@ -124,9 +137,10 @@ def response(scene: Parameters, f1_Hz=None, comm=None):
         scene: the validated scene (:func:`load_scene`).
         f1_Hz: the forcing frequencies [Hz] (default: the scene's ``[sweep]`` list).
         comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
-    _resources(scene, "response", f1_Hz)
+    comm = _world(comm)
+    scene = _ready(scene, "response", comm, f1_Hz)
     from rawehelix.studies import response as study
-    return study.compute(scene, f1_Hz, comm=_world(comm))
+    return study.compute(scene, f1_Hz, comm=comm)
 
 
 def simulate(scene: Parameters, until_s: float | None = None, comm=None,
@@ -147,9 +161,10 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
             ``{"ts_type": "cn"}``.
         progress: print a progress line now and then (default: when stdout is
             a terminal)."""
-    _resources(scene, "simulate")
+    comm = _world(comm)
+    scene = _ready(scene, "simulate", comm)
     from rawehelix.studies import simulate as study
-    return study.compute(scene, until_s=until_s, comm=_world(comm), options=options,
+    return study.compute(scene, until_s=until_s, comm=comm, options=options,
                          progress=progress)
 
 
@@ -168,9 +183,10 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
             (default: the scene's ``[sweep]`` list).
         comm: the MPI communicator (default ``MPI.COMM_WORLD``).
         checkpoint: a directory that keeps finished points (default: none)."""
-    _resources(scene, "sweep", f1_Hz)
+    comm = _world(comm)
+    scene = _ready(scene, "sweep", comm, f1_Hz)
     from rawehelix.studies import sweep as study
-    return study.compute(scene, f1_Hz, comm=_world(comm), checkpoint=checkpoint)
+    return study.compute(scene, f1_Hz, comm=comm, checkpoint=checkpoint)
 
 
 def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None,
@@ -205,9 +221,10 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
         superharmonics: the orders k of the k:1 superharmonic sites to close in
             on (default (2, 3); () for none).
         method: "shooting", "hb" or "auto"."""
-    _resources(scene, "orbits")
+    comm = _world(comm)
+    scene = _ready(scene, "orbits", comm)
     from rawehelix.studies import orbits as study
-    return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
+    return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=comm, progress=progress,
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
                          superharmonics=superharmonics, method=method)
 
@@ -238,9 +255,10 @@ def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=Non
         f1_step_Hz: the most a branch steps in f1 [Hz] (default: the method's own)."""
     from rawehelix.studies import envelope as study
     from rawehelix.studies.sampling import Variable, parse_vary
-    _resources(scene, "orbits")
+    comm = _world(comm)
+    scene = _ready(scene, "orbits", comm)
     vary = vary if isinstance(vary, Variable) else parse_vary(vary)
-    return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=_world(comm), outdir=outdir,
+    return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=comm, outdir=outdir,
                          method=method, progress=progress, f1_step_Hz=f1_step_Hz)
 
 

@@ -158,6 +158,8 @@ def main(argv: list[str] | None = None) -> int:
             params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                    scheme=args.scheme,
                                    overrides=overrides(args, command.f1_grid))
+            from rawehelix.solvers import tension_target
+            params = tension_target.resolve(params, comm)  # ends.tension_N -> its elongation
             outdir = args.output or Path("results") / params.name / args.command
             outdir_check.check(outdir, args.command)
             with outdir_lock.hold(outdir, comm):  # one writer per output folder: exit 2 if held

@@ -15,12 +15,14 @@ LATER_MODEL_SWITCHES = {"kinematics": "paper", "rotary_inertia": True,
 LATER_HELIX_SWITCHES = {**components.later_switches("helix", Helix), "stiffness": "given"}
 #: keys of the model's [section] added after results with a [section] were stored
 LATER_SECTION_KEYS = {"rings": None}
+#: the same for the ends (ends.tension_N)
+LATER_ENDS_SWITCHES = {"tension_N": None}
 
 
 def drop_later_switches(data: dict) -> dict:
     """``data`` (Parameters as a dict) without the later switches at their defaults."""
     for section, switches in (("model", LATER_MODEL_SWITCHES),
-                              ("helix", LATER_HELIX_SWITCHES)):
+                              ("helix", LATER_HELIX_SWITCHES), ("ends", LATER_ENDS_SWITCHES)):
         for key, default in switches.items():  # fingerprints stored before them
             if data[section][key] == default:
                 data[section].pop(key)

@@ -84,7 +84,9 @@ class Normalised(EndForcing):
             nu=env.air_density_kg_m3 * h.drag_length_m * L0**2 * h.drag_coefficient / (2 * M),
             delta=beta * sigma / (2 * mu),  # (27)
             v_w0=env.wind_speed_m_s / np.sqrt(g * L0),
-            eps0=e.elongation, Gamma0=math.radians(e.elevation_deg),
+            # eps0: nan until the elongation of ends.tension_N is found (Parameters.normalised)
+            eps0=math.nan if e.elongation is None else e.elongation,
+            Gamma0=math.radians(e.elevation_deg),
             r1=e.circle_radius_m / L0, omega1=2 * math.pi * e.circle_frequency_Hz * t_scale,
             phase0=0.0,
             mN0=p.torque.top_Nm / (h.GJ_Nm2 / L0), t0=p.torque.rise_time_s / t_scale,

@@ -81,6 +81,9 @@ class Parameters:
         the model's damping (the scene's ``[damping]`` section), ``torsion_hysteresis={...}``
         its hysteretic torsion."""
         sections = dict(sections)
+        ends = self._ends_after(sections)
+        if ends is not None:
+            sections["ends"] = ends
         for nested in components.nested("model"):  # held by Model
             if nested in sections:
                 value = dataclasses.replace(getattr(self.model, nested), **sections.pop(nested))
@@ -90,15 +93,44 @@ class Parameters:
                    for name, values in sections.items()}
         return dataclasses.replace(self, **changed)
 
+    def _ends_after(self, sections: dict) -> dict | None:
+        """The ``ends`` changes of :meth:`replace`, completed so that the elongation
+        found for ``ends.tension_N`` (solvers/tension_target.py) never outlives what it
+        was found for: a given elongation drops the tension, a given tension the
+        elongation, and a change of any section that moves the stationary state
+        (:data:`KEEP_FOUND_ELONGATION` lists those that do not) drops it, to be found
+        again.  None: ``ends`` unchanged."""
+        ends = dict(sections.get("ends", {}))
+        if "elongation" in ends and "tension_N" not in ends:
+            ends["tension_N"] = None
+        elif "tension_N" in ends and "elongation" not in ends:
+            ends["elongation"] = None
+        elif self.ends.tension_N is not None and (
+                set(sections) - KEEP_FOUND_ELONGATION - {"ends"}
+                or set(ends) - {"circle_radius_m", "circle_frequency_Hz"}):
+            ends["elongation"] = None
+        return ends or None
+
     def as_dict(self) -> dict:
         """Every section as plain data, without the labels (name, title): what
         fingerprints of results hash."""
         data = dataclasses.asdict(self)
+        if self.ends.tension_N is not None:  # the scene's input, not what a solve found
+            data["ends"]["elongation"] = None
         data.pop("name")
         data.pop("title")
         return drop_later_switches(data)
 
     def normalised(self) -> "Normalised":
+        """The groups of Eqs. (25)-(29); a scene with ``ends.tension_N`` needs its
+        elongation found first (rawehelix.solvers.tension_target.resolve, which every
+        command runs)."""
+        if not self.ends.resolved:
+            raise ParameterError(
+                "ends.tension_N", self.ends.tension_N,
+                "the elongation that gives this tension is not found yet: "
+                "rawehelix.solvers.tension_target.resolve(params) finds it (every command "
+                "and API function does)")
         return Normalised.from_parameters(self)
 
     def describe_model(self, planar: bool = False) -> str:
@@ -106,6 +138,12 @@ class Parameters:
         text = self.model.describe(planar)
         return text if self.helix.EI_law is None else f"{text}; {self.helix.EI_law.describe()}"
 
+
+#: the sections whose change keeps the elongation found for ``ends.tension_N``: they do
+#: not move the torque-free stationary state it is found on (the ends' circle keys do
+#: not either: it is found with the upper end at the circle's centre)
+KEEP_FOUND_ELONGATION = {"discretisation", "time", "sweep", "torque", "controller", "damping",
+                         "torsion_hysteresis", "name", "title"}
 
 _L0, _M, _g, _GJ = "helix.length_m", "helix.mass_kg", "environment.g_m_s2", "helix.GJ_Nm2"
 _T = (_L0, _g)  # t_scale = sqrt(L0/g)

@@ -111,23 +111,49 @@ class Environment:
 
 @dataclass(frozen=True)
 class Ends:
-    """Prescribed end positions, Eqs. (35), (36), (66) and (70)."""
+    """Prescribed end positions, Eqs. (35), (36), (66) and (70).
 
-    elongation: float  # eps0: chord = (1 + eps0) L0
+    A scene gives exactly one of ``elongation`` and ``tension_N`` (the scene loader
+    refuses both or neither): with ``tension_N`` the stationary solve finds the
+    elongation whose stationary state has that mean tension along s
+    (solvers/tension_target.py); every command then runs with that elongation."""
+
     elevation_deg: float  # Gamma0, elevation of the chord [deg]
+    # eps0: chord = (1 + eps0) L0, Eq. (66); a scene gives exactly one of
+    # ends.elongation and ends.tension_N
+    elongation: float | None = None
+    # T, the mean along s of the tension of the torque-free stationary state (the one
+    # every run starts from) [N]: the stationary solve finds the elongation that gives
+    # it (T / EA, the weightless straight rod's, misses it); instead of ends.elongation
+    tension_N: float | None = None
     circle_radius_m: float = 0.0  # R1, radius of the upper end's circle, Eq. (70) [m]
     circle_frequency_Hz: float = 0.0  # f1, frequency of the upper end's circle [Hz]
 
     def __post_init__(self):
+        if self.elongation is None and self.tension_N is None:
+            raise ParameterError("ends.elongation", None, ONE_OF_ENDS)
         # The straight-chord tension EA*eps0 must be > 0: a slack helix has no
         # stationary state in this model (the tension law, Eq. 22, is linear).
-        if not (self.elongation > 0 and math.isfinite(self.elongation)):
+        if self.elongation is not None and not (self.elongation > 0
+                                                and math.isfinite(self.elongation)):
             raise ParameterError(
                 "ends.elongation", self.elongation,
                 "must be > 0 (the tension EA*elongation must be positive)")
+        if self.tension_N is not None:
+            _positive("ends", self, "tension_N")
         if not (-90.0 <= self.elevation_deg <= 90.0):
             raise ParameterError("ends.elevation_deg", self.elevation_deg, "must lie in [-90, 90]")
         _non_negative("ends", self, "circle_radius_m", "circle_frequency_Hz")
+
+    @property
+    def resolved(self) -> bool:
+        """The elongation is known (given, or found for ``tension_N``)."""
+        return self.elongation is not None
+
+
+#: what a scene must say about its ends' stretch (the scene loader's one-line refusal)
+ONE_OF_ENDS = ("give exactly one of ends.elongation (eps0 > 0) and ends.tension_N "
+               "(the mean stationary tension [N] > 0)")
 
 
 @dataclass(frozen=True)

@@ -66,6 +66,11 @@ class PlanarRod:
                     dolfinx.fem.dirichletbc(self.r_top, dolfinx.fem.locate_dofs_topological(
                         self.W, 0, top_v))]
 
+    def set_top_position(self, position):
+        """r(1) <- ``position`` (its x and z), Eq. (36)."""
+        self.top_xz = np.array([position[0], position[2]], dtype=float)
+        set_constant(self.r_top, self.top_xz)
+
     def centre_line(self):
         return embed(self.w)
 

@@ -9,7 +9,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import dolfinx
 import numpy as np
+import ufl
 from mpi4py import MPI
 
 from rawehelix import compat
@@ -17,8 +19,14 @@ from rawehelix.parameters import Parameters
 from rawehelix.solvers import fields
 from rawehelix.forms.kinematics import tension
 from rawehelix.solvers.discrete import RodDiscretisation
-from rawehelix.solvers.planar import PlanarRod
+from rawehelix.solvers.planar import PlanarRod, planar_allowed
 from rawehelix.solvers.snes import NewtonSolver, SolverError
+
+
+def reduced(params: Parameters) -> bool:
+    """The stationary state is solved on the planar (x, z) rod (solvers/planar.py):
+    ``model.reduction = "auto"`` and a planar scene."""
+    return params.model.reduction == "auto" and planar_allowed(params)
 
 
 class SlackError(SolverError):
@@ -72,6 +80,14 @@ class StationarySolver:
         if hasattr(self.rod, "get_state"):
             result.state = self.rod.get_state()
         return result
+
+    def mean_tension(self) -> float:
+        """The mean of the tension along s, int_0^1 T ds~ (normalised, Eq. 29), in
+        the current state; every rank gets it.  Collective."""
+        if not hasattr(self, "_mean_tension_form"):
+            self._mean_tension_form = dolfinx.fem.form(self.tension_expr * ufl.dx(self.rod.mesh))
+        local = dolfinx.fem.assemble_scalar(self._mean_tension_form)
+        return float(self.rod.comm.allreduce(local, op=MPI.SUM))
 
     def set_end_torques(self, ground: float = 0.0, top: float = 0.0):
         """Torques at s = 0 and s = L0 (normalised by GJ / L0), Eqs. (38)-(39);

@@ -180,6 +180,14 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
     curves from other ticks still cross it."""
     if not (0 < f1_lo < f1_hi):
         raise SceneError("--f1", f"{f1_lo}:{f1_hi}", "must be LO:HI with 0 < LO < HI [Hz]")
+    if params.ends.tension_N is not None:
+        # continuing in KEY holds the elongation found for the scene's ends.tension_N
+        # (solvers/tension_target.py), as an elongation scene holds its own
+        if vary.key in ("ends.tension_N", "ends.elongation"):
+            raise SceneError("--vary", vary.key, "an envelope in the end's stretch needs a "
+                             "scene with ends.elongation (vary ends.elongation); 'rawehelix "
+                             "stationary' prints the elongation each ends.tension_N gives")
+        params = params.replace(ends={"elongation": params.ends.elongation})
     values = values_of(vary)
     for v in values:
         params_at(params, vary.key, v)  # every value checked before any work

@@ -86,9 +86,14 @@ def lab_parameters(helix_scene: Parameters, elements: int | None = None,
         model["kinematics"] = "extensible"
         if h.EI_law is None:
             helix["EI_law"] = {"a_Nm2_per_N": EQ64[0], "b_Nm2": EQ64[1]}
+    # the segment's ends are the lab's (a wall, a dead load): the scene's stretch does not
+    # enter, so a scene with ends.tension_N needs no elongation found (T / EA stands in)
+    ends = {} if helix_scene.ends.tension_N is None else {
+        "elongation": helix_scene.ends.tension_N / h.EA_N}
     try:  # --elements and --degree checked as a scene's (exit 2, one line)
         return helix_scene.replace(helix=helix, environment={"wind_speed_m_s": 0.0},
-                                   model=model, discretisation=disc, name=f"{helix_scene.name}_lab")
+                                   model=model, discretisation=disc, ends=ends,
+                                   name=f"{helix_scene.name}_lab")
     except ParameterError as err:
         raise SceneError(f"labtest ({helix_scene.name})", err.key,
                          f"{toml_value(err.value)} {err.allowed}") from None

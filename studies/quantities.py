@@ -9,7 +9,9 @@ A quantity is evaluated in one or both of two ways:
 
 At a point, each quantity belongs to one *stage*, the least computation that gives it:
 
-    stationary   Newton on the stationary state alone (no shooting reference)
+    stationary   Newton on the torque-free stationary state alone (no shooting reference):
+                 the state every run starts from (the torque ramp of Eq. 69 starts at 0),
+                 which ``rawehelix stationary`` gives for the scene without its torque
     modes        the stationary state and its modes (never a time integration)
     spin_up      the dynamics from the stationary state to ``time.until_s``
     sweep        the brute-force sweep over the scene's [sweep] list (Fig. 8)
@@ -198,9 +200,9 @@ QUANTITIES = {q.name: q for q in [
              ladders.dynamic_methods((4, 8, 16), (2, 3, 4, 6), ladders.TENSION_MAX_DTS, _N),
              ladders.tension_max, ["T max at 10 Hz"], **_DT_REFERENCE),
     Quantity("tension_s0_N", "N", "stationary", lambda r: r["tension_s0_N"],
-             "tension at the ground end s = 0 of the stationary state"),
+             "tension at the ground end s = 0 of the torque-free stationary state"),
     Quantity("sag_m", "m", "stationary", lambda r: r["sag_m"],
-             "largest distance of the stationary centre line from the chord"),
+             "largest distance of the torque-free stationary centre line from the chord"),
     Quantity("lateral_frequency_Hz", "Hz", "modes",
              lambda m: min(_lowest(m, (f,)).frequency_Hz for f in LATERAL),
              "the lower frequency of the lowest lateral modes of the two planes"),
@@ -280,6 +282,13 @@ def evaluate(params: Parameters, wanted: list[str], timed_out: Callable | None =
         stage = ("sweep", f1) if quantity.stage == f"sweep{AT}F1" else (quantity.stage, None)
         stages.setdefault(stage, []).append((name, quantity))
     values, errors, cpu, wall = {}, {}, {}, {}
+    try:  # ends.tension_N: the point's own elongation (solvers/tension_target.py)
+        from rawehelix.solvers import tension_target
+        params = tension_target.resolve(params, _comm())
+    except POINT_ERRORS as err:
+        reason = f"ends.tension_N: {type(err).__name__}: {err}"
+        return {"values": dict.fromkeys(wanted), "errors": dict.fromkeys(wanted, reason),
+                "cpu_s": cpu, "wall_s": wall}
     for (stage, f1), members in stages.items():
         label = stage if f1 is None else f"{stage}{AT}{f1:g}"
         late = timed_out() if timed_out else None

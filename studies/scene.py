@@ -23,7 +23,7 @@ from pathlib import Path
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
 from rawehelix.parameters import (Controller, Discretisation, Ends, Environment, Helix, Model,
                                   ParameterError, Parameters, Sweep, Time, Torque, components)
-from rawehelix.parameters.sections import STIFFNESS_KEYS
+from rawehelix.parameters.sections import ONE_OF_ENDS, STIFFNESS_KEYS
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
@@ -101,6 +101,10 @@ def _section(path, name: str, table) -> object:
                and f.default_factory is dataclasses.MISSING]
     if missing:
         raise SceneError(path, f"{name}.{missing[0]}", "is required")
+    if cls is Ends and ("elongation" in values) == ("tension_N" in values):
+        given = "both" if "elongation" in values else "neither"
+        raise SceneError(path, "ends.elongation, ends.tension_N", f"{ONE_OF_ENDS}; the scene "
+                         f"gives {given}")
     try:
         return cls(**values)
     except ParameterError as err:

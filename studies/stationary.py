@@ -50,16 +50,56 @@ class Stationary:
         return outdir
 
 
-def solve(params: Parameters, comm=MPI.COMM_WORLD):
+def solve(params: Parameters, comm=MPI.COMM_WORLD, top_torque: float = 0.0):
     """Newton alone (no shooting reference): ``(solver, result, planar)`` on the
     FE rod of :func:`compute` (the planar (x, z) rod where ``model.reduction``
-    allows it); the parameter studies' stationary quantities take it."""
-    from rawehelix.solvers.planar import planar_allowed
-    from rawehelix.solvers.stationary import StationarySolver
+    allows it and the state is torque-free); ``top_torque`` (normalised, Eq. 39) the
+    torque of both ends, balanced (:func:`static_torque`): the twisted state.  The
+    parameter studies' stationary quantities take the torque-free one."""
+    from rawehelix.solvers.stationary import StationarySolver, reduced
 
-    planar = params.model.reduction == "auto" and planar_allowed(params)
+    planar = reduced(params) and top_torque == 0.0
     solver = StationarySolver(params, comm, scene=params.name, planar=planar)
+    if top_torque:
+        # alpha(0) = 0 pins the free rotation (a Dirichlet end: the ground's torque is
+        # its reaction, m0 = mN by the balance); the top's torque enters by Eq. (39)
+        solver.set_end_torques(ground=top_torque, top=top_torque)
     return solver, solver.solve(), planar
+
+
+def static_torque(params: Parameters) -> float:
+    """The ends' torque of the static state (Omega = 0) of ``params``, normalised
+    (Eqs. 38-39): the rotor's torque.top_Nm at the top, held by the ground.
+
+    The ground torque of Eq. (40), integrated: m0 = mN + k1 (alpha(0) - alpha_dot* t)
+    + k2 alpha_t(0) + C.  At rest (alpha_t = 0) it is constant, and balances the top's
+    (m0 = mN, C = 0: the twist's stationary equation tau' = 0), unless k1 > 0 and a
+    target spin alpha_dot* != 0, which makes it grow in time: that helix spins up to
+    the target and has no static state, and this raises SceneError with what to run
+    instead.  Without a controller (k1 = k2 = 0) the ground follows the rotor's torque
+    (m0 = mN): the static twisted state exists, and is the one a run settles to only
+    if something damps the torsional oscillation (a [damping] torsion_s)."""
+    c = params.controller
+    if c.k1 > 0 and c.target_rpm != 0:
+        raise SceneError(
+            params.name, "controller.target_rpm",
+            f"{c.target_rpm:g} rpm with controller.k1 = {c.k1:g} > 0: the ground torque of "
+            f"Eq. (40) spins the helix up to {c.target_rpm:g} rpm, so it has no static state "
+            f"(Omega = 0) for 'stationary'; run 'rawehelix simulate {params.name} --until "
+            f"{params.time.until_s:g}' for the spin-up and its steady spin, or set "
+            f"controller.target_rpm = 0 for the static twisted state")
+    hysteresis = params.model.torsion_hysteresis
+    if hysteresis.active and params.torque.top_Nm != 0:
+        # Bouc-Wen is rate-independent: at rest any internal twist z is static, and the
+        # one a torque leaves depends on how it was applied (forms/hysteresis.py)
+        raise SceneError(
+            params.name, "torsion_hysteresis.rho",
+            f"{hysteresis.rho:g} < 1 (hysteretic torsion) with torque.top_Nm = "
+            f"{params.torque.top_Nm:g}: the static twist depends on how the torque was "
+            f"applied, so 'stationary' has no one state to give; run 'rawehelix simulate "
+            f"{params.name} --until {params.time.until_s:g}' for the ramp of Eq. (69), or set "
+            f"torque.top_Nm = 0")
+    return params.normalised().mN0
 
 
 def sag_m(params: Parameters, result) -> float:
@@ -83,32 +123,35 @@ def limits_block(params: Parameters, solver) -> dict | None:
 
 def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     """Newton on the FE rod (the planar (x, z) rod where ``model.reduction``
-    allows it), compared with the shooting solution of Sys. (67) (of the extensible
-    elastica, references/shooting.py::solve_extensible, with model.kinematics = "extensible")
-    where it applies: a scene off the x-z plane (the circle of Eq. 70) is solved
-    without it, and ``summary["shooting"]`` says why."""
-    from rawehelix.references import shooting, shooting_shear
+    allows it and the ends carry no torque) under the ends' balanced torque
+    (:func:`static_torque`: a twisted state), checked against the independent
+    reference of its kinematics where one applies (studies/reference_check.py: the
+    shooting solution of Sys. (67), the extensible elastica, the shearable rod), within
+    a time budget; ``summary["shooting"]`` says "compared", "not applicable (why)" or
+    "did not converge (why)", beside the FE result.  A scene with ``ends.tension_N``
+    comes with its elongation found (api: solvers/tension_target.py); the summary's
+    ``ends`` block gives both."""
+    from rawehelix.studies import reference_check
 
     if params.discretisation.scheme != "fe":
         raise SceneError(params.name, "discretisation.scheme",
                          "'stationary' runs the FE scheme; the spline reference's stationary "
                          "state is part of 'modes'")
+    top_torque = static_torque(params)  # refuses an unbalanced scene before any work
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
-    solver, result, planar = solve(params, comm)
+    solver, result, planar = solve(params, comm, top_torque)
     block = limits_block(params, solver)  # collective; before residual_at moves the state
-    # the independent reference: Sys. (67), or the extensible elastica (with the EI law);
-    # planar only: a scene off the x-z plane is reported without it
-    not_applicable = shooting.not_applicable(q) or shooting_shear.not_applicable(params)
-    reference = None
-    if not_applicable is None:
-        # the reference of each kinematics (model.kinematics), by name
-        solve_reference = {"paper": shooting.solve, "extensible": shooting.solve_extensible,
-                           "shearable": shooting_shear.solve_shearable}
-        reference = solve_reference[params.model.kinematics](q)
+    twist = twist_of(solver) if top_torque else None  # collective
+    mean_tension = solver.mean_tension()  # collective
+    check = reference_check.solve(params, comm, twisted=bool(top_torque))
+    if check.compared:
+        reference = check.reference
         residual_at_shooting = solver.residual_at(  # collective
             reference.centre_line, getattr(reference, "director", None))
+        solver.rod.set_chord()
+        residual_scale = solver.newton.residual_norm()  # collective: Newton's first guess
     out = Stationary(params, None, None, None, None, None, state=result.state, rank=comm.rank)
     summary = None
     if comm.rank == 0:
@@ -126,18 +169,26 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
             "ranks": comm.size,
             "newton_iterations": result.newton_iterations,
             "tension_N": {"s0": float(T[0]), "s1": float(T[-1]),
-                          "min": float(T.min()), "max": float(T.max())},
+                          "min": float(T.min()), "max": float(T.max()),
+                          "mean": float(q.tension_N(mean_tension))},
             "sag_m": sag_m(params, result),
-            "shooting": "compared" if reference else f"not applicable: {not_applicable}",
+            "ends": ends_block(params, q.tension_N(mean_tension)),
+            "torque": None if twist is None else {
+                "top_Nm": params.torque.top_Nm, "ground_Nm": params.torque.top_Nm,
+                "twist_end_to_end_rad": twist,
+                "held_by": "the ground: Eq. (40) at rest, m0 = mN"},
+            "shooting": check.status,
             "limits": block,
         }
-        if reference:
+        if check.compared:
             x_ref = q.length_m(reference.centre_line(result.s))
             out.shooting_centre_line_m = x_ref
             summary.update({
                 "shooting_max_diff_m": float(np.max(np.linalg.norm(x - x_ref, axis=1))),
                 "shooting_tension_s0_N": float(q.tension_N(reference.tension(0.0))),
-                "residual_at_shooting": float(residual_at_shooting)})
+                "residual_at_shooting": float(residual_at_shooting),
+                "residual_at_chord": float(residual_scale),
+                "residual_at_shooting_relative": float(residual_at_shooting / residual_scale)})
         summary["wall_s"] = time.perf_counter() - start
         log.debug("%s: %s model, N = %d, p = %d: %d Newton iterations, %.2f s", params.name,
                  "planar" if planar else "full", disc.elements, disc.degree,
@@ -146,19 +197,58 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     return out
 
 
+def twist_of(solver) -> float | None:
+    """alpha(L0) - alpha(0) [rad] of the solver's state, on rank 0.  Collective."""
+    from rawehelix.solvers import fields
+    rod = solver.rod
+    s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
+    return None if alpha is None else float(alpha[-1, 0] - alpha[0, 0])
+
+
+def ends_block(params: Parameters, mean_tension_N: float) -> dict:
+    """summary.json's ``ends``: the elongation, and for a scene with ``ends.tension_N``
+    the tension asked for, where it is met and the state's mean tension."""
+    from rawehelix.solvers.tension_target import WHERE
+    e = params.ends
+    block = {"elongation": e.elongation}
+    if e.tension_N is not None:
+        block.update({"tension_N": e.tension_N, "tension_at": WHERE,
+                      "elongation_found": True, "mean_tension_N": float(mean_tension_N)})
+    return block
+
+
 def report(result: Stationary) -> str:
     """The lines a user reads after a stationary solve."""
     s = result.summary
-    T = s["tension_N"]
-    head = (f"{s['scene']}: N = {s['elements']}, p = {s['degree']} "
-            f"({s['model'].split(';')[0]}): {s['newton_iterations']} Newton iterations, "
-            f"{s['wall_s']:.2f} s\n")
-    if "shooting_tension_s0_N" not in s:
-        return (head + f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N\n"
-                f"  sag {s['sag_m']:.5f} m; shooting reference {s['shooting']}"
-                + structure_limits.line(s.get("limits")))
-    return (head + f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N "
-            f"(shooting T(0) = {s['shooting_tension_s0_N']:.3f} N)\n"
-            f"  sag {s['sag_m']:.5f} m; FE vs shooting max |dr| = {s['shooting_max_diff_m']:.3e} m; "
-            f"FE residual at shooting = {s['residual_at_shooting']:.3e}"
-            + structure_limits.line(s.get("limits")))
+    T, ends, torque = s["tension_N"], s["ends"], s.get("torque")
+    lines = [f"{s['scene']}: N = {s['elements']}, p = {s['degree']} "
+             f"({s['model'].split(';')[0]}): {s['newton_iterations']} Newton iterations, "
+             f"{s['wall_s']:.2f} s"]
+    if "tension_N" in ends:
+        here = " under the torque" if torque else ""
+        lines.append(f"  ends.tension_N = {ends['tension_N']:g} N ({ends['tension_at']}): "
+                     f"elongation found {ends['elongation']:.6g}; mean tension{here} "
+                     f"{ends['mean_tension_N']:.3f} N")
+    if torque:
+        lines.append(f"  torque {torque['top_Nm']:g} N m at the top, held by the ground "
+                     f"(Eq. 40 at rest): twist alpha(L0) - alpha(0) = "
+                     f"{torque['twist_end_to_end_rad']:.6g} rad")
+    ref_T = (f" (shooting T(0) = {s['shooting_tension_s0_N']:.3f} N)"
+             if "shooting_tension_s0_N" in s else "")
+    lines.append(f"  tension T(0) = {T['s0']:.3f} N, T(L0) = {T['s1']:.3f} N{ref_T}")
+    if "shooting_max_diff_m" not in s:
+        lines.append(f"  sag {s['sag_m']:.5f} m; shooting reference {_status(s['shooting'])}")
+    else:
+        lines.append(f"  sag {s['sag_m']:.5f} m; FE vs shooting max |dr| = "
+                     f"{s['shooting_max_diff_m']:.3e} m")
+        lines.append(f"  FE residual at the shooting state = {s['residual_at_shooting_relative']:.3g}"
+                     f" x the load's (|F| at the chord, Newton's first guess): the reference "
+                     f"is not the discrete solution, which differs from it by the |dr| above "
+                     f"(both |F| fall like N^-1/2, Sec. 5.1)")
+    return "\n".join(lines) + structure_limits.line(s.get("limits"))
+
+
+def _status(status: str) -> str:
+    """"not applicable: why" -> "not applicable (why)" (the printed form)."""
+    head, _, why = status.partition(": ")
+    return f"{head} ({why})" if why else head

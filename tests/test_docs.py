@@ -314,6 +314,9 @@ def test_cheap_runs_summaries_are_documented():
     import rawehelix as rh
     runs = {
         "stationary": rh.stationary(rh.load_scene("stationary_table2", elements=4)),
+        # ends.tension_N and a balanced end torque (the ends and torque blocks)
+        "stationary (tension, torque)": rh.stationary(rh.load_scene(
+            Path(__file__).parent / "data" / "own_helix.toml", elements=4)),
         "modes (spline)": rh.modes(rh.load_scene("stationary_table2", elements=2,
                                                  scheme="spline")),
         "modes (fe)": rh.modes(rh.load_scene("stationary_table2", elements=4)),

@@ -50,6 +50,12 @@ FAULTS = [
       "--set", "discretisation.grading=1e9"], 2,
      "discretisation.grading: gmsh cannot grade 8 elements by 1e+09"),
     (["sweep", "mobile_end", "--f1", "1:2"], 2, "is not START:STOP:STEP"),
+    # issue 41: both ends.elongation and ends.tension_N; a helix its controller spins up
+    (["stationary", "stationary_table2", "--set", "ends.tension_N=200"], 2,
+     "ends.elongation, ends.tension_N: give exactly one of"),
+    (["modes", "stationary_table2", "--set", "ends.tension_N=200"], 2, "the scene gives both"),
+    (["stationary", "nominal_operation", "--elements", "2"], 2,
+     "controller.target_rpm: 120 rpm with controller.k1 = 0.5 > 0"),
     (["converge", "stationary_table2", "--quantity", "nothing"], 2, "--quantity: nothing"),
     (["extremes", "nosuchcase"], 2, "unknown case(s)"),
     (["study", "stationary_table2", "--vary", "helix.EI_Nm2=1:2:3", "--quantity", "tension"], 2,

@@ -233,6 +233,8 @@ def check(way: str, load, changed: list[str]):
                    for c in changed), f"{message!r} names none of {changed}"
         COUNTS[way, "refused"] += 1
         return "refused"
+    if not params.ends.resolved:  # ends.tension_N: the search starts from T / EA
+        params = params.replace(ends={"elongation": params.ends.tension_N / params.helix.EA_N})
     q = params.normalised()  # valid: the groups a solve starts from are numbers
     numbers = {f.name: getattr(q, f.name) for f in dataclasses.fields(q)
                if not isinstance(getattr(q, f.name), str)}  # (section_law: a name)

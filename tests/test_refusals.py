@@ -211,8 +211,9 @@ def test_a_study_with_failed_points_exits_3_and_says_so(tmp_path):
 def test_stationary_runs_a_scene_off_the_plane(tmp_path):
     """mobile_end's upper end is on the circle of Eq. (70), off the x-z plane:
     the summary says the shooting reference does not apply, exit 0."""
-    code, out, err, wall, rss = run(["stationary", "mobile_end", "--elements", "4", "-o",
-                                     str(tmp_path / "o")], tmp_path)
+    code, out, err, wall, rss = run(["stationary", "mobile_end", "--elements", "4",
+                                     "--set", "controller.target_rpm=0", "--set",
+                                     "torque.top_Nm=0", "-o", str(tmp_path / "o")], tmp_path)
     assert code == 0, err
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert s["shooting"].startswith("not applicable: the scene is not planar")

@@ -48,7 +48,10 @@ def test_mobile_end_top_follows_eq70():
 # The keys of example.toml that do not show their default, on purpose: the
 # required ones have none (their values there are Table 2's).
 EXAMPLE_NOT_DEFAULT = {"helix.length_m", "helix.mass_kg", "helix.EA_N", "helix.EI_Nm2",
-                       "helix.GJ_Nm2", "ends.elongation", "ends.elevation_deg"}
+                       "helix.GJ_Nm2", "ends.elevation_deg"}
+# Keys of a pair a scene gives exactly one of: example.toml shows the first with a
+# value (not its default, None), the second commented out
+EXAMPLE_ONE_OF = {"ends.elongation": "ends.tension_N"}
 
 
 def test_example_documents_every_key_with_its_default():
@@ -68,16 +71,20 @@ def test_example_documents_every_key_with_its_default():
                   if f.name not in scene.NESTED]
         # a key whose default is None (absent: TOML has no null) is shown commented out,
         # unless another key makes it required (helix.EA_N, EI_Nm2, GJ_Nm2: required
-        # unless helix.stiffness = "from_section")
+        # unless helix.stiffness = "from_section") or it is one of two alternatives
         given = {f"helix.{k}" for k in parameters.sections.STIFFNESS_KEYS}
-        absent = {f.name for f in fields if f.default is None and f"{name}.{f.name}" not in given}
+        absent = {f.name for f in fields if f.default is None
+                  and f"{name}.{f.name}" not in given and f"{name}.{f.name}" not in EXAMPLE_ONE_OF}
         assert set(table) == {f.name for f in fields} - absent, f"[{name}]: keys differ"
         for f in fields:
             key = f"{name}.{f.name}"
             if f.name in absent:
                 assert re.search(rf"^# {f.name} = ", path.read_text(), re.M), f"{key} not shown"
                 continue
-            if f.default is dataclasses.MISSING or key in given:
+            if key in EXAMPLE_ONE_OF:
+                assert table[f.name] is not None and EXAMPLE_ONE_OF[key].split(".")[1] \
+                    not in table, f"{key}: shown, and its alternative commented out"
+            elif f.default is dataclasses.MISSING or key in given:
                 required.add(key)
             elif key not in EXAMPLE_NOT_DEFAULT:
                 assert table[f.name] == f.default and type(table[f.name]) is type(f.default), \

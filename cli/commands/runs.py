@@ -156,7 +156,8 @@ def _none(p):
 
 
 COMMANDS = [
-    Command("stationary", "stationary state with fixed ends (Sec. 5.1)", _none, _stationary),
+    Command("stationary", "stationary state with fixed ends (Sec. 5.1), under the ends' balanced "
+            "torque (a twisted state)", _none, _stationary),
     Command("modes", "natural modes about the stationary state (Table 3)", _modes_arguments,
             _modes),
     Command("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)",

@@ -24,15 +24,27 @@ class Stationary:
     start: str  # "shooting" or "chord"
 
 
+#: the wall time the shooting first guess may take [s]; past it Newton starts from the chord
+FIRST_GUESS_BUDGET_S = 10.0
+
+
 @functools.lru_cache(maxsize=8)
 def _shooting(nd):
-    """The shooting solution of Sys. (67) for ``nd`` (cached), or None when
-    ``rawehelix.references.shooting`` is not available."""
+    """The shooting solution of Sys. (67) for ``nd`` (cached), or None where it does
+    not serve as a first guess: ``rawehelix.references.shooting`` not available, a
+    scene off the x-z plane or too stiff for it (more than its MAX_SEGMENTS), or a
+    shooting that fails or runs past :data:`FIRST_GUESS_BUDGET_S`."""
     try:
         from rawehelix.references import shooting
     except ImportError:
         return None
-    return shooting.solve(nd)
+    if shooting.not_applicable(nd) or shooting.default_segments(nd) > shooting.MAX_SEGMENTS:
+        return None
+    try:
+        with shooting.budget(FIRST_GUESS_BUDGET_S):
+            return shooting.solve(nd)
+    except (shooting.OverBudget, RuntimeError, ValueError):
+        return None
 
 
 def shooting_nodes(system: SplineGalerkin):

@@ -49,7 +49,7 @@ class Refinement:
     reference: str  # label of the reference method (its finest run is the reference)
     evaluate: object  # (params, method, ladder value) -> np.ndarray of values
     components: list = field(default_factory=list)
-    independent: object = None  # params -> independent reference value, or None
+    independent: object = None  # params -> (independent value or None, its status), or None
     # label of the method whose finest run is the reference of the dt ladders
     # (their time error alone, at their N); None: the main reference
     time_reference: str | None = None
@@ -80,9 +80,14 @@ def tension_s0(params: Parameters, method: Method, value) -> np.ndarray:
 
 
 def shooting_tension_s0(params: Parameters):
-    from rawehelix.references import shooting
+    """(T(0) [N] of the shooting reference or None, the check's status): the reference
+    where it applies and within its budget (studies/reference_check.py)."""
+    from rawehelix.studies import reference_check
+    check = reference_check.solve(params)
+    if not check.compared:
+        return None, check.status
     q = params.normalised()
-    return np.array([q.tension_N(shooting.solve(q).tension(0.0))])
+    return np.array([q.tension_N(check.reference.tension(0.0))]), check.status
 
 
 def eigenvalues(params: Parameters, method: Method, value) -> np.ndarray:

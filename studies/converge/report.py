@@ -53,6 +53,9 @@ def markdown(summary: dict, qty, name: str) -> str:
     if ref["independent"] is not None:
         lines.append(f"That reference differs from the independent one by "
                      f"{ref['independent_rel_diff']:.1e} (relative).")
+    elif ref.get("independent_status"):
+        status, _, why = ref["independent_status"].partition(": ")
+        lines.append(f"The independent reference (shooting): {status} ({why}).")
     lines += ["", f"| method | run | value [{unit}] | rel. error | observed order | wall [s] |",
               "| --- | --- | --- | --- | --- | --- |"]
     for r in summary["runs"]:

@@ -124,13 +124,16 @@ def _summarise(qty: quantities.Quantity, params, runs: list[Run], name: str):
     if time_ref is not None:
         by_method.update(errors_and_orders([r for r in runs if r not in space], time_ref.result,
                                            scale))
-    independent = how.independent(params) if how.independent else None
+    # the independent reference, where it applies and within its budget: its status
+    # is reported beside the runs, never instead of them (studies/reference_check.py)
+    independent, independent_status = how.independent(params) if how.independent else (None, None)
     summary = {
         "scene": name, "quantity": qty.name, "unit": qty.unit,
         "components": how.components,
         "reference": {"method": how.reference, how.methods[0].variable: ref_run.value_of_ladder,
                       "value": reference,
                       "independent": independent,
+                      "independent_status": independent_status,
                       "independent_rel_diff": None if independent is None else
                       float(np.max(np.abs(reference - independent) / np.abs(independent)))},
         "error_scale": scale,
@@ -184,4 +187,9 @@ def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "sce
             orders = [f"{r.order:.2f}" for r in series if np.isfinite(r.order)]
             log(f"  {label:>10}: errors {' '.join(f'{r.error:.1e}' for r in series)}; "
                 f"observed orders {' '.join(orders)}")
+        ref = summary["reference"]
+        if ref["independent_status"] is not None:
+            log(f"  independent reference (shooting): " + (
+                f"compared, {ref['independent_rel_diff']:.1e} from the finest run"
+                if ref["independent"] is not None else ref["independent_status"]))
     return comm.bcast(summary, root=0)

@@ -1,0 +1,91 @@
+"""The stationary state's independent reference, checked where it applies and within
+a budget: the shooting solution of Sys. (67) (model.kinematics = "paper"), of the
+extensible elastica ("extensible", with the EI law) or of the shearable rod
+("shearable"), references/.
+
+A reference check never replaces the result it checks: :func:`solve` gives a
+:class:`Check` whose ``status`` is one of
+
+* ``"compared"`` (``reference`` holds the solution),
+* ``"not applicable: WHY"``: the scene is outside what the reference models (off the
+  x-z plane, another section law, a twisted state, ...), decided before any work;
+* ``"did not converge: WHY"``: its root finder failed, or it ran past
+  :data:`BUDGET_S` of wall time (``references.shooting.budget``),
+
+and the command prints and stores that status beside its own numbers
+(``stationary``'s summary.json ``shooting``; ``converge``'s ``reference.independent_status``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rawehelix.parameters import Parameters
+
+#: the wall time one reference solve may take [s]; the shooting of a scene it models
+#: takes 0.1-3 s (Table 2, 7 segments: 2.5 s at most)
+BUDGET_S = 20.0
+COMPARED = "compared"
+
+
+@dataclass(frozen=True)
+class Check:
+    reference: object | None  # the reference's solution (normalised), or None
+    status: str  # COMPARED, "not applicable: ..." or "did not converge: ..."
+
+    @property
+    def compared(self) -> bool:
+        return self.status == COMPARED
+
+
+def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
+    """Why no reference models the stationary state of ``params`` (``twisted``: the
+    state carries the ends' torque), or None."""
+    from rawehelix.references import shooting, shooting_shear
+    law = params.value("section.law")
+    if twisted:
+        return ("the state is twisted by the ends' torque (torque.top_Nm), and the "
+                "references are torque-free, planar rods")
+    if law != "solid":
+        return (f"section.law = {law!r}: the references model the solid section "
+                "(helix.EA_N, helix.EI_Nm2)")
+    if not params.model.bending:
+        return "model.bending = false: the references need a bending stiffness"
+    q = params.normalised()
+    if params.model.kinematics == "paper" and shooting.default_segments(q) > shooting.MAX_SEGMENTS:
+        return (f"Sys. (67)'s axial mode grows like exp(sqrt(sigma/mu)) = "
+                f"e^{math.sqrt(q.sigma / q.mu):.0f} along the rod: its shooting needs "
+                f"{shooting.default_segments(q)} segments, more than the {shooting.MAX_SEGMENTS} that fit "
+                f"the check's budget of {BUDGET_S:g} s (a larger helix.EI_Nm2 needs fewer)")
+    return shooting.not_applicable(q) or shooting_shear.not_applicable(params)
+
+
+def solve(params: Parameters, comm=None, twisted: bool = False,
+          budget_s: float = BUDGET_S) -> Check:
+    """The reference of ``params``' kinematics where it applies, stopped after
+    ``budget_s`` of wall time.  With ``comm`` every rank solves it and all agree on
+    the status (rank 0's words)."""
+    from rawehelix.references import shooting, shooting_shear
+    why = not_applicable(params, twisted)
+    if why is not None:
+        return Check(None, f"not applicable: {why}")
+    solve_reference = {"paper": shooting.solve, "extensible": shooting.solve_extensible,
+                       "shearable": shooting_shear.solve_shearable}[params.model.kinematics]
+    reference, status = None, COMPARED
+    try:
+        with shooting.budget(budget_s):
+            reference = solve_reference(params.normalised())
+    except shooting.OverBudget:
+        status = f"did not converge: stopped after its budget of {budget_s:g} s of wall time"
+    except (RuntimeError, ValueError, ArithmeticError) as err:
+        # one line (scipy's messages hold newlines), without the advice to the API's
+        # callers (shooting.solve's segments, which no command sets)
+        why = " ".join(str(err).split()).replace("; try more segments", "")
+        status = f"did not converge: {why.removeprefix('shooting did not converge: ')}"
+    if comm is not None:
+        statuses = comm.allgather(status)
+        failed = [s for s in statuses if s != COMPARED]
+        if failed:
+            return Check(None, failed[0])
+    return Check(reference, status)
