@@ -75,7 +75,11 @@ def load_scene(name_or_path, elements: int | None = None, degree: int | None = N
 def section(scene: Parameters):
     """EA, EI and GJ of the scene's section's members (closed forms, no solve), what
     they come from, and the lab tests' values: :mod:`rawehelix.studies.section_moduli`
-    (``rawehelix section``).  ``result.summary``, ``result.write(outdir)``."""
+    (``rawehelix section``).  ``result.summary``, ``result.write(outdir)``.
+
+    Args:
+        scene: the validated scene (:func:`load_scene`); its ``[section]`` gives the
+            members (tethers, their EA, radius, lay angle, self-stress, bars)."""
     from rawehelix.studies import section_moduli
     return section_moduli.compute(scene)
 

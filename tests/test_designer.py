@@ -295,7 +295,7 @@ def test_section_prints_the_lab_tests_values_for_a_given_scene(tmp_path):
     (["helix.GJ_Nm2=100"], "helix.GJ_Nm2: is given, but helix.stiffness = 'from_section'"),
     (["section.tether_EA_N=nan"], "section.tether_EA_N"),
     (["section.lay_angle_deg=0"], "section.lay_angle_deg: 0.0 gives no torsional stiffness"),
-    (["helix.stiffness=\"members\""], "helix.stiffness: 'members' must be one of"),
+    (["helix.stiffness=\"members\""], "helix.stiffness: \"members\" must be one of"),
 ])
 def test_from_section_refuses_too_much_or_too_little(tmp_path, sets, message):
     (tmp_path / "in").mkdir()
