@@ -1,0 +1,65 @@
+"""Output-folder faults of the multi-point commands (issue 41): an envelope rerun into
+its own folder with any argument changed, two --vary given to envelope, and a command
+run into another command's folder are refused with one line and exit status 2, the
+folder unchanged; a write that fails mid-file leaves no ``Exception ignored`` behind."""
+
+import hashlib
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+CLI = [sys.executable, "-m", "rawehelix.cli.main"]
+ENVELOPE = ["envelope", "mobile_end", "--elements", "2", "--degree", "3"]
+VARY, F1 = ["--vary", "helix.EI_Nm2=4381:4600:2"], ["--f1", "12.3:12.5"]
+
+
+def run(args, cwd):
+    return subprocess.run([*CLI, *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def snapshot(folder: Path) -> dict:
+    """Every file's path, size, mtime and content hash under ``folder``."""
+    return {str(p.relative_to(folder)): (p.stat().st_size, p.stat().st_mtime_ns,
+                                         hashlib.sha256(p.read_bytes()).hexdigest())
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def assert_one_line(done, *words):
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2, done.stderr
+    assert len(lines) == 1 and lines[0].startswith("rawehelix: error: "), done.stderr
+    assert "Traceback" not in done.stderr + done.stdout
+    for word in words:
+        assert word in lines[0], lines[0]
+
+
+@pytest.fixture(scope="module")
+def envelope_dir(tmp_path_factory):
+    """A finished envelope (N = 2, two values, ~12 s)."""
+    cwd = tmp_path_factory.mktemp("envelope")
+    done = run([*ENVELOPE, *VARY, *F1, "-o", "out"], cwd)
+    assert done.returncode == 0, done.stderr
+    return cwd, cwd / "out"
+
+
+@pytest.mark.parametrize("change, option", [
+    (["--vary", "helix.EI_Nm2=4381:4600:3", *F1], "--vary LO:HI:COUNT"),
+    (["--vary", "helix.mass_kg=0.5:1:2", *F1], "--vary KEY"),
+    ([*VARY, "--f1", "12.3:12.6"], "--f1"),
+    ([*VARY, *F1, "--method", "shooting"], "--method"),
+    ([*VARY, *F1, "--set", "ends.elongation=0.004"], "--set"),
+])
+def test_an_envelope_rerun_with_an_argument_changed_is_refused(envelope_dir, change, option):
+    cwd, out = envelope_dir
+    before = snapshot(out)
+    done = run([*ENVELOPE, *change, "-o", "out"], cwd)
+    assert_one_line(done, "-o", "holds another envelope", option, "use another -o")
+    assert snapshot(out) == before
+
+
+def test_two_vary_are_refused(tmp_path):
+    done = run([*ENVELOPE, *VARY, "--vary", "helix.mass_kg=0.5:1:2", *F1, "-o", "out"], tmp_path)
+    assert_one_line(done, "--vary", "more than once", "rawehelix study")
+    assert list(tmp_path.iterdir()) == []
