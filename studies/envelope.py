@@ -52,6 +52,8 @@ HEADER = "envelope.json"  # the envelope's identity in its output folder
 OPTION_OF = {"scene": "SCENE", "fingerprint": "the scene's keys (--set, --elements, --degree, "
              "--scheme)", "key": "--vary KEY", "values": "--vary LO:HI:COUNT",
              "f1_window_Hz": "--f1", "method": "--method"}
+#: the order in which a value's first limits are found along its branch
+RISING = "f1 rising along the branch, read from LO of --f1"
 FIRST_LIMIT_BISECTIONS = 8  # the limit's f1 to 1/256 of the branch's spacing
 
 
@@ -170,9 +172,13 @@ def _tick(params, key, value, f1_window, method, outdir, progress, f1_step_Hz):
             bifurcation_starts.append({"bracket_Hz": (a.f1_Hz, b.f1_Hz), "X": a.X,
                                        "resolution": a.steps, "kind": kind,
                                        "f1_Hz": inside[0]["f1_Hz"] if inside else a.f1_Hz})
+    rising = branch.branch[::-1] if branch.branch and branch.branch[0]["f1_Hz"] > \
+        branch.branch[-1]["f1_Hz"] else branch.branch  # traced from HI: read from LO
     tick = {"value": value, "branch": [
         {k: e.get(k) for k in ("f1_Hz", "tension_max_N", "stable", "first_limit")}
         for e in branch.branch], "folds": branch.folds, "bifurcations": branch.bifurcations,
+        "limits": branch_limits.over_points(rising, order=RISING),
+        "limits_first_by_kind": branch_limits.first_by_kind(rising),
         "f1_gap_max_Hz": max((abs(b.f1_Hz - a.f1_Hz) for a, b in zip(points, points[1:])),
                              default=0.0),
         "wall_s": branch.wall_s}
@@ -277,6 +283,10 @@ def report(result: EnvelopeResult) -> str:
         lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits "
                      f"(stability at their points, at most {t['f1_gap_max_Hz']:.3g} Hz apart), "
                      + (f"folds at {folds} Hz" if folds else "no fold in the window"))
+    for t in s["ticks"]:
+        if "limits_first_by_kind" in t:
+            lines.append(f"  {result.key} = {t['value']:g}, "
+                         + branch_limits.first_line(t["limits_first_by_kind"], t["limits"]))
     for c in s["limit_curve"]:
         lines.append(f"  first limit ({c['kind']}) {'reached' if c['entering'] else 'left'} at "
                      f"f1 = {c['f1_Hz']:.4f} Hz (+- {c['f1_error_Hz']:.1e}) for "
