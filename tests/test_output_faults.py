@@ -63,3 +63,35 @@ def test_two_vary_are_refused(tmp_path):
     done = run([*ENVELOPE, *VARY, "--vary", "helix.mass_kg=0.5:1:2", *F1, "-o", "out"], tmp_path)
     assert_one_line(done, "--vary", "more than once", "rawehelix study")
     assert list(tmp_path.iterdir()) == []
+
+
+# a process whose files may not grow past a few kB (RLIMIT_FSIZE: a write past it fails
+# with EFBIG, a disk's error, as a full disk's ENOSPC): the .npz of a state fails mid-file
+SMALL_FILES = """
+import resource, signal, sys
+import numpy as np
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
+from rawehelix.studies import outdir_lock, writers
+try:
+    writers.write_npz(sys.argv[1], {"X": np.ones(100000), "state_ds": np.ones(3)})
+except outdir_lock.OutputFault as err:
+    print(f"rawehelix: error: {err}", file=sys.stderr)
+    sys.exit(1)
+"""
+
+
+@pytest.mark.parametrize("name", ["points/f1_00009.00000.npz", "window0/p0003.npz",
+                                  "tick1/window0/p0000.npz"])
+def test_a_failed_npz_write_leaves_one_line_and_no_temporary(tmp_path, name):
+    """The stores of sweep, orbits and envelope write their states by write_npz: a
+    write that fails mid-file ends with the one-line fault and nothing after it (no
+    ``Exception ignored in ZipFile.__del__``), and no file left."""
+    path = tmp_path / name
+    path.parent.mkdir(parents=True)
+    done = subprocess.run([sys.executable, "-c", SMALL_FILES, str(path)], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and path.name in lines[0] and "File too large" in lines[0], done.stderr
+    assert list(path.parent.iterdir()) == []
