@@ -95,3 +95,36 @@ def test_a_failed_npz_write_leaves_one_line_and_no_temporary(tmp_path, name):
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and path.name in lines[0] and "File too large" in lines[0], done.stderr
     assert list(path.parent.iterdir()) == []
+
+
+def test_another_command_into_an_envelopes_folder_is_refused(envelope_dir):
+    cwd, out = envelope_dir
+    before = snapshot(out)
+    assert (out / ".rawehelix-command").read_text().strip() == "envelope"
+    for argv in (["sweep", "mobile_end", "--f1", "9:10:1"], ["orbits", "mobile_end", "--f1", "9:10"],
+                 ["stationary", "mobile_end"]):
+        done = run([*argv, "-o", "out"], cwd)
+        assert_one_line(done, "-o", "holds the output of 'rawehelix envelope'",
+                        f"use another -o directory for '{argv[0]}'")
+        assert snapshot(out) == before
+
+
+def test_each_command_keeps_its_own_folder(tmp_path):
+    """stationary's folder: stationary again runs (its own), modes is refused; a folder
+    of an older rawehelix (no marker) is known by its store's header file (sweep.json);
+    a refused command writes no marker into a new folder."""
+    st = ["stationary_table2", "--elements", "4", "-o", "st"]
+    assert run(["stationary", *st], tmp_path).returncode == 0
+    assert run(["stationary", *st], tmp_path).returncode == 0
+    before = snapshot(tmp_path / "st")
+    assert_one_line(run(["modes", *st], tmp_path), "'rawehelix stationary'", "'modes'")
+    assert snapshot(tmp_path / "st") == before
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "sweep.json").write_text("{}")
+    assert_one_line(run(["orbits", "mobile_end", "--f1", "9:10", "-o", "old"], tmp_path),
+                    "'rawehelix sweep'", "'orbits'")
+    assert sorted(p.name for p in old.iterdir()) == ["sweep.json"]
+    assert_one_line(run(["modes", "stationary_table2", "--elements", "0", "-o", "new"], tmp_path),
+                    "discretisation.elements")
+    assert not (tmp_path / "new").exists()
