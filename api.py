@@ -108,6 +108,8 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
     failed run's ``SimulationError.partial``).  ``options``: PETSc options of the integrator without the
     prefix, e.g. ``{"ts_type": "cn"}``."""
     _resources(scene, "simulate")
+    from rawehelix.studies import resources
+    resources.check_simulate(scene, until_s, "until_s")
     from rawehelix.studies import simulate as study
     return study.compute(scene, until_s=until_s, comm=_world(comm), options=options,
                          progress=progress)
@@ -145,7 +147,9 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
     multipliers, H chosen by accuracy and reported per point) or "auto" (the rule
     of :func:`rawehelix.studies.orbit_method.choose`)."""
     _resources(scene, "orbits")
-    from rawehelix.studies import orbits as study
+    from rawehelix.studies import orbits as study, resources
+    resources.check_branches(scene, _world(comm).size, f1_start_Hz, f1_stop_Hz, method,
+                             key="--f1", max_points=max_points)
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=_world(comm), progress=progress,
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
                          superharmonics=superharmonics, method=method)
@@ -165,8 +169,11 @@ def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=Non
     most a branch steps in f1 (stability is judged at its points)."""
     from rawehelix.studies import envelope as study
     from rawehelix.studies.sampling import Variable, parse_vary
-    _resources(scene, "orbits")
+    from rawehelix.studies import resources
+    _resources(scene, "envelope")
     vary = vary if isinstance(vary, Variable) else parse_vary(vary)
+    resources.check_branches(scene, vary.count or study.DEFAULT_VALUES, f1_lo_Hz, f1_hi_Hz,
+                             method)
     return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=_world(comm), outdir=outdir,
                          method=method, progress=progress, f1_step_Hz=f1_step_Hz)
 

@@ -118,6 +118,11 @@ def _envelope(rh, params, args, outdir, comm) -> int:
         lo, hi = (float(x) for x in args.f1.split(":"))
     except ValueError:
         raise SceneError("--f1", args.f1, "must be LO:HI in Hz") from None
+    from rawehelix.cli.commands.runs import _check_branch_disk
+    from rawehelix.studies.sampling import parse_vary
+    vary = parse_vary(args.vary[0])
+    _check_branch_disk(params, "envelope", outdir, vary.count or envelope.DEFAULT_VALUES,
+                       lo, hi, args.method)
     try:
         result = rh.envelope(params, args.vary[0], lo, hi, comm=comm, outdir=outdir,
                              method=args.method,

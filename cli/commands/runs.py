@@ -40,8 +40,11 @@ def _simulate_arguments(p):
 
 
 def _simulate(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import resources, simulate
+    from rawehelix.studies import outdir as outdir_check, resources, simulate
     resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
+    resources.check_simulate(params, args.until)  # its outputs, frames and steps
+    outdir_check.check(outdir, "simulate",
+                       extra_bytes=resources.simulate_output_bytes(params, args.until))
 
     def checkpoint(partial):  # the last good state and the series so far, every minute
         partial.write(outdir, pictures=False)
@@ -125,6 +128,8 @@ def _orbits(rh, params, args, outdir, comm) -> int:
                          "must be integers K[,K...] >= 2 or 'none'") from None
     if args.sweep is not None:
         orbits.check_sweep_dir(args.sweep)
+    _check_branch_disk(params, "orbits", outdir, comm.size, start, stop, args.method,
+                       args.max_points)
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
@@ -140,6 +145,18 @@ def _orbits(rh, params, args, outdir, comm) -> int:
         result.write(outdir, sweep_dir=args.sweep)
     say(comm, orbits.report(result) + f"\n  wrote {outdir}/")
     return 0
+
+
+def _check_branch_disk(params, command, outdir, branches, lo, hi, method, max_points=None):
+    """The disk of the branches' stored points (orbits, envelope): their memory first
+    (studies/resources.py), then the folder's room (studies/outdir.py)."""
+    from rawehelix.studies import outdir as outdir_check, resources
+    resources.check(params, command)  # the discretisation's own check comes first
+    points = resources.check_branches(params, branches, lo, hi, method,
+                                      key="--vary" if command == "envelope" else "--f1",
+                                      max_points=max_points or resources.MAX_BRANCH_POINTS)
+    outdir_check.check(outdir, command,
+                       extra_bytes=points * resources.store_bytes_per_point(params, method))
 
 
 def _none(p):
