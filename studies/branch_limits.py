@@ -175,8 +175,8 @@ def first_lines(firsts: dict, block: dict, indent: str = "  ") -> list[str]:
                          x["already_at_first_point"] else "") + f"f1 = {x['f1_Hz']:g} Hz, "
                          + place(x))
     if any(x and x["already_at_first_point"] for x in firsts.values()):
-        lines.append(f"{indent}  (met already at the first point: the run starts past it, and "
-                     f"where it begins lies before f1 = {lo:g} Hz; start the run lower to find it)")
+        lines.append(f"{indent}  (met already at the first point, f1 = {lo:g} Hz: the run starts "
+                     f"past it; extend the run before that f1 to find where it begins)")
     return lines
 
 

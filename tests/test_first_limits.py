@@ -53,7 +53,7 @@ def test_a_collapse_met_at_every_point_does_not_hide_the_first_slack():
     assert "torsional collapse: already at the first point, f1 = 1 Hz" in text
     assert "moment saturation: not reached in f1 = 1..1.6 Hz" in text
     assert "breaking force: not checked (section.breaking_force_N not set)" in text
-    assert "start the run lower" in text
+    assert "already at the first point, f1 = 1 Hz: the run starts past it" in text
 
 
 def test_first_is_in_the_runs_own_order_not_the_lowest_f1():
@@ -140,3 +140,27 @@ def test_a_sweep_prints_and_lists_each_kinds_first(tmp_path, extra, kinds):
     assert "breaking force: not checked" in out if "breaking" not in kinds else \
         "limit 100 N" in out
     assert (tmp_path / "out" / "sweep.png").stat().st_size > 0
+
+
+def test_orbits_traced_downwards_prints_its_firsts_along_the_branch(tmp_path):
+    """A real branch (FE shooting, N = 4, --f1 9.1:9.0, ~4 s): the order is the
+    branch's (its first point at 9.1 Hz), each kind's first names its branch point,
+    and the report's lines say so."""
+    from rawehelix.studies import orbits
+    done = subprocess.run([sys.executable, "-m", "rawehelix.cli.main", "orbits", "mobile_end",
+                           "--elements", "4", "--f1", "9.1:9.0", "--superharmonics", "none",
+                           "--set", "time.dt_s=1e-3", "-o", "out"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())
+    branch, firsts = s["branch"], s["limits_first_by_kind"]
+    assert branch[0]["f1_Hz"] == 9.1 and s["limits"]["f1_range_Hz"][0] == 9.1
+    assert f"first limit of each kind ({orbits.ALONG}; {len(branch)} points, f1 = 9.1.." \
+        in done.stdout
+    reached = [k for k, x in firsts.items() if x]
+    assert reached  # this scene's solid section slackens its inner tether near 9 Hz
+    for kind in reached:
+        x = firsts[kind]
+        assert branch[x["point"]]["f1_Hz"] == x["f1_Hz"]
+        assert not any(branch_limits.kinds_of(p["limits"]).get(kind) for p in branch[:x["point"]])
+        assert f"    {branch_limits.NAMES[kind]}: " in done.stdout
