@@ -153,6 +153,17 @@ def over_points(points: list[dict], order: str = RISING) -> dict:
     return out
 
 
+def _each(firsts: dict, block: dict):
+    """(name, first or None, why it is off or None) of each criterion, in CRITERIA's order."""
+    off = block.get("criteria_off", {})
+    return [(NAMES[kind], firsts.get(kind), off.get(kind)) for kind in CRITERIA]
+
+
+def _met(x: dict) -> str:
+    return ("already at the first point, " if x["already_at_first_point"] else "") + \
+        f"f1 = {x['f1_Hz']:g} Hz"
+
+
 def first_lines(firsts: dict, block: dict, indent: str = "  ") -> list[str]:
     """The report's lines of each kind's first (:func:`first_by_kind`) over the points
     of the summary's ``block`` (:func:`over_points`): its f1 and place, or why none."""
@@ -164,16 +175,10 @@ def first_lines(firsts: dict, block: dict, indent: str = "  ") -> list[str]:
     order = block["first_limit_by"].partition(":")[0]
     lines = [f"{indent}first limit of each kind ({order}; {block['points_recorded']} points, "
              f"{span}):"]
-    for kind in CRITERIA:
-        x, name = firsts.get(kind), NAMES[kind]
-        if kind in block.get("criteria_off", {}):
-            lines.append(f"{indent}  {name}: not checked ({block['criteria_off'][kind]})")
-        elif x is None:
-            lines.append(f"{indent}  {name}: not reached in {span}")
-        else:
-            lines.append(f"{indent}  {name}: " + ("already at the first point, " if
-                         x["already_at_first_point"] else "") + f"f1 = {x['f1_Hz']:g} Hz, "
-                         + place(x))
+    for name, x, off in _each(firsts, block):
+        lines.append(f"{indent}  {name}: " + (f"not checked ({off})" if off else
+                                             f"not reached in {span}" if x is None else
+                                             f"{_met(x)}, {place(x)}"))
     if any(x and x["already_at_first_point"] for x in firsts.values()):
         lines.append(f"{indent}  (met already at the first point, f1 = {lo:g} Hz: the run starts "
                      f"past it; extend the run before that f1 to find where it begins)")
@@ -186,17 +191,9 @@ def first_line(firsts: dict, block: dict) -> str:
     if not block or not block.get("points_recorded"):
         return "limits not recorded at any point"
     lo, hi = block["f1_range_Hz"]
-    parts = []
-    for kind in CRITERIA:
-        x, name = firsts.get(kind), NAMES[kind]
-        if kind in block.get("criteria_off", {}):
-            parts.append(f"{name} not checked")
-        elif x is None:
-            parts.append(f"{name} not reached")
-        else:
-            parts.append(f"{name} at f1 = {x['f1_Hz']:g} Hz" + (
-                " (already at the first point)" if x["already_at_first_point"] else "")
-                + f", s = {x['s_m']:.3f} m")
+    parts = [f"{name}: " + ("not checked" if off else "not reached" if x is None else
+                            f"{_met(x)}, s = {x['s_m']:.3f} m")
+             for name, x, off in _each(firsts, block)]
     return f"first limits in f1 = {lo:g}..{hi:g} Hz: " + "; ".join(parts)
 
 
