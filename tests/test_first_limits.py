@@ -164,3 +164,31 @@ def test_orbits_traced_downwards_prints_its_firsts_along_the_branch(tmp_path):
         assert branch[x["point"]]["f1_Hz"] == x["f1_Hz"]
         assert not any(branch_limits.kinds_of(p["limits"]).get(kind) for p in branch[:x["point"]])
         assert f"    {branch_limits.NAMES[kind]}: " in done.stdout
+
+
+def test_the_figures_mark_each_kinds_first():
+    """A vertical line a kind at its f1 on every panel (sweep, orbits), labelled once with
+    its f1; on an envelope's rows a marker a kind, inside the window, labelled once."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    firsts = {"slack": {"f1_Hz": 1.44, "already_at_first_point": False},
+              "torsional_collapse": {"f1_Hz": 1.0, "already_at_first_point": True},
+              "breaking": None, "moment_saturation": None}
+    fig, (a, b) = plt.subplots(2)
+    branch_limits.mark_firsts((a, b), firsts)
+    for ax in (a, b):
+        assert sorted(line.get_xdata()[0] for line in ax.get_lines()) == [1.0, 1.44]
+    labels = [line.get_label() for line in a.get_lines()]
+    assert "first slack: 1.44 Hz" in labels
+    assert "first torsional collapse: 1 Hz (already at the first point)" in labels
+    assert not any(line.get_label().startswith("first") for line in b.get_lines())
+    seen = set()
+    fig2, ax = plt.subplots()
+    for row in (1.0, 2.0):
+        branch_limits.mark_firsts((ax,), firsts, row, seen, window=(1.2, 3.0))
+    xs = sorted((line.get_xdata()[0], line.get_ydata()[0]) for line in ax.get_lines())
+    assert xs == [(1.2, 1.0), (1.2, 2.0), (1.44, 1.0), (1.44, 2.0)]  # 1.0 Hz on the edge
+    assert sum(line.get_label().startswith("first") for line in ax.get_lines()) == 2
+    plt.close(fig)
+    plt.close(fig2)

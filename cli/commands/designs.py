@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from rawehelix.cli.commands.base import Command, overrides, say
+from rawehelix.cli.commands.base import Command, check_branch_output, overrides, say
 from rawehelix.studies import quantities
 from rawehelix.studies.scene import SceneError
 
@@ -118,10 +118,9 @@ def _envelope(rh, params, args, outdir, comm) -> int:
         lo, hi = (float(x) for x in args.f1.split(":"))
     except ValueError:
         raise SceneError("--f1", args.f1, "must be LO:HI in Hz") from None
-    from rawehelix.cli.commands.runs import _check_branch_disk
     from rawehelix.studies.sampling import parse_vary
     vary = parse_vary(args.vary[0])
-    _check_branch_disk(params, "envelope", outdir, vary.count or envelope.DEFAULT_VALUES,
+    check_branch_output(params, "envelope", outdir, vary.count or envelope.DEFAULT_VALUES,
                        lo, hi, args.method)
     try:
         result = rh.envelope(params, args.vary[0], lo, hi, comm=comm, outdir=outdir,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from rawehelix.cli.commands.base import Command, say
+from rawehelix.cli.commands.base import Command, check_branch_output, say
 from rawehelix.studies.scene import SceneError
 
 
@@ -128,7 +128,7 @@ def _orbits(rh, params, args, outdir, comm) -> int:
                          "must be integers K[,K...] >= 2 or 'none'") from None
     if args.sweep is not None:
         orbits.check_sweep_dir(args.sweep)
-    _check_branch_disk(params, "orbits", outdir, comm.size, start, stop, args.method,
+    check_branch_output(params, "orbits", outdir, comm.size, start, stop, args.method,
                        args.max_points)
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
@@ -145,18 +145,6 @@ def _orbits(rh, params, args, outdir, comm) -> int:
         result.write(outdir, sweep_dir=args.sweep)
     say(comm, orbits.report(result) + f"\n  wrote {outdir}/")
     return 0
-
-
-def _check_branch_disk(params, command, outdir, branches, lo, hi, method, max_points=None):
-    """The disk of the branches' stored points (orbits, envelope): their memory first
-    (studies/resources.py), then the folder's room (studies/outdir.py)."""
-    from rawehelix.studies import outdir as outdir_check, resources
-    resources.check(params, command)  # the discretisation's own check comes first
-    points = resources.check_branches(params, branches, lo, hi, method,
-                                      key="--vary" if command == "envelope" else "--f1",
-                                      max_points=max_points or resources.MAX_BRANCH_POINTS)
-    outdir_check.check(outdir, command,
-                       extra_bytes=points * resources.store_bytes_per_point(params, method))
 
 
 def _none(p):
