@@ -285,9 +285,10 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
-    if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
+    if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz
+            and np.isfinite(f1_start_Hz + f1_stop_Hz)):
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
-                          f"different frequencies > 0 [Hz]")
+                          f"different finite frequencies > 0 [Hz]")
     refuse_turning_ring(params)  # before any output
     method, method_reason = orbit_method.choose(params, method)
     tension_step = TENSION_STEP if tension_step is None else tension_step

@@ -170,7 +170,10 @@ def check_run(params: Parameters, command: str, f1_Hz=None, copies: int = 1):
         check_count(key, count, copies)
     check(params, command, copies)
     if command == "sweep":  # its samples and periods, past the discretisation's own check
-        top = max(f1_Hz) if f1_Hz is not None else params.sweep.f1_stop_Hz
+        try:
+            top = max(float(f) for f in f1_Hz) if f1_Hz is not None else params.sweep.f1_stop_Hz
+        except (TypeError, ValueError):
+            top = None  # not a list of numbers: the sweep's own check says so
         check_sweep(params, count, top, key, copies)
 
 
@@ -239,7 +242,8 @@ def check_sweep(params: Parameters, count: int, f1_max_Hz: float, key: str, copi
                 f"sweep.samples_per_period = {sw.samples_per_period:g}, sweep.record_periods = "
                 f"{sw.record_periods:g}, sweep.max_periods = {sw.max_periods:g}", need, have,
                 f"fewer points ({key}), samples or periods")
-    if params.discretisation.scheme == "fe":
+    if params.discretisation.scheme == "fe" and f1_max_Hz is not None and \
+            0 < f1_max_Hz < math.inf:  # else refused by the sweep's own check of f1
         steps = count * sw.min_periods / (f1_max_Hz * params.time.dt_s)
         _refuse_wall("sweep.min_periods", f"{sw.min_periods:g}", f"{count:g} points of at least "
                      f"{sw.min_periods:g} periods in steps of time.dt_s = {params.time.dt_s:g} s",
@@ -249,7 +253,10 @@ def check_sweep(params: Parameters, count: int, f1_max_Hz: float, key: str, copi
 
 def branch_points(f1_lo_Hz: float, f1_hi_Hz: float, max_points: int = MAX_BRANCH_POINTS) -> int:
     """The points a branch over the window is expected to hold (module docstring)."""
-    return int(min(max_points, math.ceil(POINTS_PER_HZ * abs(f1_hi_Hz - f1_lo_Hz)) + 1))
+    width = abs(float(f1_hi_Hz) - float(f1_lo_Hz))
+    if not math.isfinite(width):  # a window the command refuses itself: count the most
+        return int(max_points)
+    return int(min(max_points, math.ceil(POINTS_PER_HZ * width) + 1))
 
 
 def orbit_size(params: Parameters, method: str = "hb") -> int:

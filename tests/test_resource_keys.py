@@ -61,3 +61,19 @@ def test_every_registered_command_has_its_estimates():
     output estimate (outdir.OUTPUT_BYTES) would be checked against the defaults."""
     assert sorted(set(COMMANDS) - set(resources.HEAVIEST)) == []
     assert sorted(set(COMMANDS) - set(outdir.OUTPUT_BYTES)) == []
+
+
+@pytest.mark.parametrize("f1", [[0.0], ["x"], [float("nan")], [], [float("inf")]])
+def test_a_bad_frequency_list_is_the_sweeps_own_refusal(f1):
+    """The estimates read the list before the sweep checks it: a list they cannot
+    count from still ends in the sweep's one-line refusal, never another error."""
+    import rawehelix as rh
+    with pytest.raises(rh.SceneError, match="f1_Hz"):
+        rh.sweep(scene.load("mobile_end", elements=2), f1_Hz=f1)
+
+
+@pytest.mark.parametrize("window", [(float("nan"), 9.0), (9.0, float("inf")), (9.0, 9.0)])
+def test_a_bad_window_is_the_orbits_own_refusal(window):
+    import rawehelix as rh
+    with pytest.raises(rh.SolverError, match="two different finite frequencies"):
+        rh.orbits(scene.load("mobile_end", elements=2), *window)
