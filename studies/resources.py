@@ -306,3 +306,13 @@ def simulate_output_bytes(params: Parameters, until_s: float | None = None) -> f
     until_s = tm.until_s if until_s is None else until_s
     return (150.0 * until_s / tm.output_every_s
             + BYTES_PER_FRAME_NODE * _nodes(params) * until_s / tm.fields_every_s)
+
+
+def sweep_output_bytes(params: Parameters, count: int) -> float:
+    """The disk of a sweep's ``count`` stored points beyond outdir.py's record: each
+    point's JSON series (``sweep.samples_per_period`` x ``sweep.record_periods`` pairs,
+    ~50 B each) and period extremes (``sweep.max_periods``, ~50 B each), and its
+    final state (.npz: a few vectors of the FE unknowns)."""
+    sw = params.sweep
+    series = 50.0 * (float(sw.samples_per_period) * sw.record_periods + 2.0 * sw.max_periods)
+    return count * (series + 4 * 8.0 * unknowns(params))

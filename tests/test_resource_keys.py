@@ -30,8 +30,6 @@ SIM = ["simulate", "nominal_operation", "--elements", "4"]
      ("--vary", "1e+08 points")),
     (["envelope", "mobile_end", "--elements", "200", "--vary", "helix.EI_Nm2=4000:5000:5",
       "--f1", "1:15"], ("-o", "MB free", "'envelope' writes")),
-    (["orbits", "mobile_end", "--elements", "80", "--f1", "1:15", "--method", "hb"],
-     ("-o", "MB free", "'orbits' writes")),
 ])
 def test_a_key_that_multiplies_the_work_is_refused_before_work(tmp_path, args, words):
     assert_refused(tmp_path, [*args, "-o", str(tmp_path / "o")], *words)
@@ -77,3 +75,27 @@ def test_a_bad_window_is_the_orbits_own_refusal(window):
     import rawehelix as rh
     with pytest.raises(rh.SolverError, match="two different finite frequencies"):
         rh.orbits(scene.load("mobile_end", elements=2), *window)
+
+
+@pytest.mark.parametrize("argv, estimate_MB", [
+    # 141 f1 of 4 x 50000 samples a point: 141 x 10 MB of series
+    (["sweep", "mobile_end", "--f1", "1:15:0.1", "--set", "sweep.samples_per_period=50000"],
+     1400),
+    # a 14 Hz branch (351 points) at N = 8, HB: 12 (7 x 100)^2 B a point
+    (["orbits", "mobile_end", "--elements", "8", "--f1", "1:15", "--method", "hb"], 2000),
+])
+def test_the_disk_estimate_counts_the_points(tmp_path, monkeypatch, capsys, argv, estimate_MB):
+    """With 1 GB free (the filesystem's free space patched), a run whose points' stored
+    series or states pass it is refused before work, and the estimate is counted from its
+    keys (it was a fixed 20 or 50 MB)."""
+    import collections
+
+    from rawehelix.cli import main as cli
+    usage = collections.namedtuple("usage", "total used free")
+    monkeypatch.setattr(outdir.shutil, "disk_usage", lambda path: usage(2e9, 1e9, 1e9))
+    assert cli.main([*argv, "-o", str(tmp_path / "o")]) == 2
+    line, = capsys.readouterr().err.strip().splitlines()
+    assert "-o" in line and "1e+03 MB free" in line and f"'{argv[0]}' writes" in line, line
+    need = float(line.split("the about ")[1].split(" MB")[0])
+    assert estimate_MB < need < 3 * estimate_MB, line
+    assert not (tmp_path / "o").exists()

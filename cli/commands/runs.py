@@ -72,8 +72,12 @@ def _sweep_arguments(p):
 
 
 def _sweep(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import sweep
+    from rawehelix.studies import outdir as outdir_check, resources, sweep
     from rawehelix.studies.sweep_store import SweepError
+    count = resources.frequency_count(params)
+    resources.check_run(params, "sweep")  # before the disk's estimate counts its points
+    outdir_check.check(outdir, "sweep", points=count,
+                       extra_bytes=resources.sweep_output_bytes(params, count))
     try:
         result = rh.sweep(params, comm=comm, checkpoint=outdir)
     except SweepError as err:
