@@ -167,6 +167,8 @@ def simulate(scene: Parameters, until_s: float | None = None, comm=None,
             a terminal)."""
     comm = _world(comm)
     scene = _ready(scene, "simulate", comm)
+    from rawehelix.studies import resources
+    resources.check_simulate(scene, until_s, "until_s")
     from rawehelix.studies import simulate as study
     return study.compute(scene, until_s=until_s, comm=comm, options=options,
                          progress=progress)
@@ -227,7 +229,9 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
         method: "shooting", "hb" or "auto"."""
     comm = _world(comm)
     scene = _ready(scene, "orbits", comm)
-    from rawehelix.studies import orbits as study
+    from rawehelix.studies import orbits as study, resources
+    resources.check_branches(scene, comm.size, f1_start_Hz, f1_stop_Hz, method,
+                             key="--f1", max_points=max_points)
     return study.compute(scene, f1_start_Hz, f1_stop_Hz, comm=comm, progress=progress,
                          outdir=outdir, tension_step=tension_step, max_points=max_points,
                          superharmonics=superharmonics, method=method)
@@ -259,9 +263,12 @@ def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=Non
         f1_step_Hz: the most a branch steps in f1 [Hz] (default: the method's own)."""
     from rawehelix.studies import envelope as study
     from rawehelix.studies.sampling import Variable, parse_vary
+    from rawehelix.studies import resources
     comm = _world(comm)
-    scene = _ready(scene, "orbits", comm)
+    scene = _ready(scene, "envelope", comm)
     vary = vary if isinstance(vary, Variable) else parse_vary(vary)
+    resources.check_branches(scene, vary.count or study.DEFAULT_VALUES, f1_lo_Hz, f1_hi_Hz,
+                             method)
     return study.compute(scene, vary, f1_lo_Hz, f1_hi_Hz, comm=comm, outdir=outdir,
                          method=method, progress=progress, f1_step_Hz=f1_step_Hz)
 

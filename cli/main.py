@@ -162,7 +162,8 @@ def main(argv: list[str] | None = None) -> int:
             params = tension_target.resolve(params, comm)  # ends.tension_N -> its elongation
             outdir = args.output or Path("results") / params.name / args.command
             outdir_check.check(outdir, args.command)
-            with outdir_lock.hold(outdir, comm):  # one writer per output folder: exit 2 if held
+            # one writer per output folder, one command's output in it: exit 2 otherwise
+            with outdir_lock.hold(outdir, comm, args.command):
                 status = command.run(rh, params, args, outdir, comm)
         _warn_unused_after_run(petsc_options, comm)
         return status

@@ -24,7 +24,10 @@ The curves: studies/envelope_curves.py.
 
 MPI: the ticks are dealt to the ranks (a rank's ticks, one branch each); the curves
 are traced on rank 0 from the gathered ticks.  Resumable (``outdir``): each
-tick's branch is an orbits store (``tick<k>/``).
+tick's branch is an orbits store (``tick<k>/``), under the envelope's header
+(``envelope.json``: scene, KEY and its values, f1 window, method), checked before
+any tick: a rerun with any of them changed is refused (:class:`EnvelopeStoreError`)
+and changes nothing in the folder.
 """
 
 from __future__ import annotations
@@ -40,10 +43,41 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits.bifurcations import critical, stability_changes
 from rawehelix.studies import branch_limits, envelope_curves, orbits, writers
+from rawehelix.studies.orbits_store import OrbitsStoreError
 from rawehelix.studies.sampling import Variable
 
 DEFAULT_VALUES = 5  # ticks when --vary gives no COUNT
+HEADER = "envelope.json"  # the envelope's identity in its output folder
+#: the command-line way to each key of the header
+OPTION_OF = {"scene": "SCENE", "fingerprint": "the scene's keys (--set, --elements, --degree, "
+             "--scheme)", "key": "--vary KEY", "values": "--vary LO:HI:COUNT",
+             "f1_window_Hz": "--f1", "method": "--method"}
+#: the order in which a value's first limits are found along its branch
+RISING = "f1 rising along the branch, read from LO of --f1"
 FIRST_LIMIT_BISECTIONS = 8  # the limit's f1 to 1/256 of the branch's spacing
+
+
+class EnvelopeStoreError(OrbitsStoreError):
+    """The output folder holds another envelope."""
+
+
+def claim(outdir, header: dict, comm):
+    """Lock ``outdir`` and refuse it if it holds another envelope (its header differs),
+    before any tick is opened; else write the header (collective).  The lock, held
+    by the caller as long as it writes."""
+    from rawehelix.studies import outdir_lock
+    lock = outdir_lock.hold(outdir, comm)
+    old = writers.claim_directory(Path(outdir) / HEADER, header, comm)
+    if old is not None:
+        lock.release()
+        now = writers._jsonable(header)
+        changed = [OPTION_OF.get(k, k) for k in header if old.get(k) != now.get(k)]
+        raise EnvelopeStoreError(
+            f"{Path(outdir) / HEADER}: holds another envelope (scene {old.get('scene')!r}, "
+            f"--vary {old.get('key')} = {old.get('values')}, --f1 {old.get('f1_window_Hz')}, "
+            f"--method {old.get('method')}; changed: {', '.join(changed)}); use another -o "
+            f"directory or delete it")
+    return lock
 
 
 def values_of(vary: Variable) -> list[float]:
@@ -138,9 +172,13 @@ def _tick(params, key, value, f1_window, method, outdir, progress, f1_step_Hz):
             bifurcation_starts.append({"bracket_Hz": (a.f1_Hz, b.f1_Hz), "X": a.X,
                                        "resolution": a.steps, "kind": kind,
                                        "f1_Hz": inside[0]["f1_Hz"] if inside else a.f1_Hz})
+    rising = branch.branch[::-1] if branch.branch and branch.branch[0]["f1_Hz"] > \
+        branch.branch[-1]["f1_Hz"] else branch.branch  # traced from HI: read from LO
     tick = {"value": value, "branch": [
         {k: e.get(k) for k in ("f1_Hz", "tension_max_N", "stable", "first_limit")}
         for e in branch.branch], "folds": branch.folds, "bifurcations": branch.bifurcations,
+        "limits": branch_limits.over_points(rising, order=RISING),
+        "limits_first_by_kind": branch_limits.first_by_kind(rising),
         "f1_gap_max_Hz": max((abs(b.f1_Hz - a.f1_Hz) for a, b in zip(points, points[1:])),
                              default=0.0),
         "wall_s": branch.wall_s}
@@ -191,6 +229,12 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
     values = values_of(vary)
     for v in values:
         params_at(params, vary.key, v)  # every value checked before any work
+    lock = None
+    if outdir is not None:
+        from rawehelix.studies.sweep_store import fingerprint
+        lock = claim(outdir, {"scene": params.name, "fingerprint": fingerprint(params),
+                              "key": vary.key, "values": values, "f1_window_Hz": [f1_lo, f1_hi],
+                              "method": method, "f1_step_Hz": f1_step_Hz}, comm)
     start = time.perf_counter()
     mine, error = [], None
     for k in range(comm.rank, len(values), comm.size):
@@ -231,7 +275,10 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
                                 fold_curves=curves, limit_curve=crossings,
                                 wall_s=time.perf_counter() - start,
                                 fold_curves_wall_s=fold_wall, bifurcation_curves=others)
-    return comm.bcast(result, root=0)
+    result = comm.bcast(result, root=0)
+    if lock is not None:
+        lock.release()
+    return result
 
 
 def report(result: EnvelopeResult) -> str:
@@ -244,6 +291,10 @@ def report(result: EnvelopeResult) -> str:
         lines.append(f"  {result.key} = {t['value']:g}: {len(t['branch'])} orbits "
                      f"(stability at their points, at most {t['f1_gap_max_Hz']:.3g} Hz apart), "
                      + (f"folds at {folds} Hz" if folds else "no fold in the window"))
+    for t in s["ticks"]:
+        if "limits_first_by_kind" in t:
+            lines.append(f"  {result.key} = {t['value']:g}, "
+                         + branch_limits.first_line(t["limits_first_by_kind"], t["limits"]))
     for c in s["limit_curve"]:
         lines.append(f"  first limit ({c['kind']}) {'reached' if c['entering'] else 'left'} at "
                      f"f1 = {c['f1_Hz']:.4f} Hz (+- {c['f1_error_Hz']:.1e}) for "

@@ -2,7 +2,8 @@
 row coloured by what a designer needs (single stable response within the limits,
 coexisting responses, a limit exceeded, unstable), the fold curves bounding the band
 of coexistence, the period-doubling and Neimark-Sacker curves bounding the unstable
-bands and the first-limit boundary over them.  Plots take data (the summary)."""
+bands and the first-limit boundary over them, and on each row the first f1 of each
+limit along its branch (f1 rising).  Plots take data (the summary)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.studies import writers
+from rawehelix.studies import branch_limits, writers
 
 COLOURS = {"single": "tab:green", "coexisting": "tab:orange", "limit": "tab:red",
            "unstable": "0.55"}
@@ -99,7 +100,7 @@ def draw(ax, summary: dict):
     """One envelope on the axes ``ax``."""
     values = summary["values"]
     gap = (max(values) - min(values)) / max(len(values) - 1, 1)
-    seen = set()
+    seen, firsts_seen = set(), set()
     cuts = {}
     for c in summary["limit_curve"]:
         cuts.setdefault(c["value"], []).append(c["f1_Hz"])
@@ -125,6 +126,8 @@ def draw(ax, summary: dict):
                 segment(f[i:i + 2], b if a != b else a, tick["value"])
         for fold in tick["folds"]:
             ax.plot(fold["f1_Hz"], tick["value"], "k|", ms=14)
+        branch_limits.mark_firsts((ax,), tick.get("limits_first_by_kind", {}), tick["value"],
+                                  firsts_seen, window=summary["f1_window_Hz"])
     _bands(ax, summary["fold_curves"], COLOURS["coexisting"], "two stable responses coexist")
     _bands(ax, summary.get("bifurcation_curves", []), COLOURS["unstable"],
            "unstable between PD / NS curves")

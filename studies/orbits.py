@@ -50,6 +50,8 @@ from rawehelix.studies import branch_limits, schemes, writers
 from rawehelix.studies.orbits_report import report  # noqa: F401  (the command's text)
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
+#: the order of a branch's points, in which its first limits are found
+ALONG = "along the branch from the first f1 of --f1"
 LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
 ABORT_TAG = 713  # a rank's failure, sent to the others
 
@@ -96,7 +98,8 @@ class OrbitsResult:
                 "superharmonic_orders": list(self.superharmonics),
                 "branch": self.branch, "folds": self.folds, "bifurcations": self.bifurcations,
                 "peaks": self.peaks, "windows": self.windows, "junctions": self.junctions,
-                "limits": branch_limits.over_points(self.branch, order="f1 along the branch"),
+                "limits": branch_limits.over_points(self.branch, order=ALONG),
+                "limits_first_by_kind": branch_limits.first_by_kind(self.branch),
                 "wall_s": self.wall_s}
 
     def write(self, outdir, sweep_dir=None) -> Path:
@@ -105,7 +108,8 @@ class OrbitsResult:
         writers.write_json(outdir / "summary.json", self.summary)
         sweep = _sweep_points(sweep_dir) if sweep_dir else []
         diagram_png(outdir / "orbits.png", self.branch, self.folds, sweep,
-                    f"{self.title}: periodic orbits, {self.discretisation}")
+                    f"{self.title}: periodic orbits, {self.discretisation}",
+                    firsts=self.summary["limits_first_by_kind"])
         return outdir
 
 
@@ -130,9 +134,11 @@ def _sweep_points(sweep_dir) -> list[dict]:
         return json.load(fh)["points"]
 
 
-def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
+def diagram_png(path: Path, branch, folds, sweep_points, title: str,
+                firsts: dict | None = None) -> Path:
     """Bifurcation diagram: T max against f1, stable solid, unstable dashed,
-    folds marked, the brute-force sweep's points overlaid."""
+    folds marked, the brute-force sweep's points overlaid, each limit's first along
+    the branch (``firsts``: the summary's limits_first_by_kind) a vertical line."""
     plt = writers._pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2))
     f = np.array([p["f1_Hz"] for p in branch])
@@ -153,6 +159,7 @@ def diagram_png(path: Path, branch, folds, sweep_points, title: str) -> Path:
     if sweep_points:
         ax.plot([p["f1_Hz"] for p in sweep_points], [p["tension_max_N"] for p in sweep_points],
                 "o", mfc="none", color="C3", label="brute-force sweep")
+    branch_limits.mark_firsts((ax,), firsts or {})
     ax.set_xlabel("f1 [Hz]")
     ax.set_ylabel("T max at s = 0 [N]")
     ax.grid(alpha=0.3)
@@ -278,9 +285,10 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
-    if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz):
+    if not (f1_start_Hz > 0 and f1_stop_Hz > 0 and f1_start_Hz != f1_stop_Hz
+            and np.isfinite(f1_start_Hz + f1_stop_Hz)):
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
-                          f"different frequencies > 0 [Hz]")
+                          f"different finite frequencies > 0 [Hz]")
     refuse_turning_ring(params)  # before any output
     method, method_reason = orbit_method.choose(params, method)
     tension_step = TENSION_STEP if tension_step is None else tension_step

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from rawehelix.studies import branch_limits
+
 
 def report(result) -> str:
     s = result.summary
@@ -21,6 +23,8 @@ def report(result) -> str:
     ratio = s.get("limits", {}).get("moment_ratio_max")
     if ratio:
         lines.append(f"  largest |M| / (N R): {ratio['value']:.3f} at f1 = {ratio['f1_Hz']:.4f} Hz")
+    if "limits_first_by_kind" in s:
+        lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"])
     for w in s["windows"]:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")

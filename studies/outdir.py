@@ -7,7 +7,10 @@ Estimated output per command (rough, from the files of runs at the default
 resolutions: pictures of 0.1-0.3 MB, summaries of a few kB, a simulate's
 XDMF series and GIF of up to ~50 MB, a sweep's or study's records of a few
 kB a point): ``OUTPUT_BYTES``, plus ``BYTES_PER_POINT`` for each point of a
-count.  A refusal is a :class:`SceneError` on ``-o`` (exit status 2).
+count, plus what a command counts from its own keys (``extra_bytes``: the stored
+branch points of ``orbits`` and ``envelope``, about 1.1 MB a point at N = 4,
+studies/resources.py::store_bytes_per_point; a simulation's series and frames).
+A refusal is a :class:`SceneError` on ``-o`` (exit status 2).
 """
 
 from __future__ import annotations
@@ -23,7 +26,8 @@ MB = 1e6
 OUTPUT_BYTES = {"stationary": 5 * MB, "modes": 20 * MB, "simulate": 200 * MB,
                 "sweep": 20 * MB, "response": 10 * MB, "orbits": 50 * MB,
                 "converge": 20 * MB, "extremes": 50 * MB, "labtest": 5 * MB,
-                "study": 10 * MB, "calibrate": 5 * MB, "section": 0.1 * MB}
+                "study": 10 * MB, "calibrate": 5 * MB, "section": 0.1 * MB,
+                "envelope": 10 * MB}  # + its branches' stored points (extra_bytes)
 BYTES_PER_POINT = 20e3  # a stored point (study, calibrate, orbits: JSON and arrays)
 
 
@@ -35,11 +39,11 @@ def _existing(path: Path) -> Path:
     return p
 
 
-def estimate_bytes(command: str, points: int = 0) -> float:
-    return OUTPUT_BYTES.get(command, 50 * MB) + BYTES_PER_POINT * points
+def estimate_bytes(command: str, points: int = 0, extra_bytes: float = 0.0) -> float:
+    return OUTPUT_BYTES.get(command, 50 * MB) + BYTES_PER_POINT * points + extra_bytes
 
 
-def check(outdir, command: str, points: int = 0, option: str = "-o"):
+def check(outdir, command: str, points: int = 0, option: str = "-o", extra_bytes: float = 0.0):
     """Refuse ``outdir`` for ``command`` (SceneError on ``option``); writes nothing."""
     path = Path(outdir).absolute()
     base = _existing(path)
@@ -54,7 +58,7 @@ def check(outdir, command: str, points: int = 0, option: str = "-o"):
                          ) from None
     os.close(fd)
     os.unlink(name)
-    need, free = estimate_bytes(command, points), shutil.disk_usage(base).free
+    need, free = estimate_bytes(command, points, extra_bytes), shutil.disk_usage(base).free
     if free < need:
         raise SceneError(option, str(outdir),
                          f"its filesystem has {free / MB:.3g} MB free, less than the about "

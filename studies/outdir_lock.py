@@ -17,6 +17,15 @@ Taking the lock removes the temporary files a killed run left behind
 removes ``.lock``, and the folder too if the lock made it and it stayed
 empty (bad input found after the lock was taken writes nothing).
 
+One command per output folder (issue 41): the command line names its command when
+it takes the lock (:func:`hold`'s ``command``), and a folder whose marker
+``OUTDIR/.rawehelix-command`` names another command (or, written before the
+marker existed, holds another command's header file: :data:`HEADERS`) is refused
+at once (bad input, exit status 2: use another -o), so that no command
+overwrites another's summary.json.  The marker is written as the lock is let go,
+if the folder then holds anything (a refusal found later writes nothing, and
+leaves no marker).
+
 A write that fails for the disk's sake (full, read-only, over quota) is an
 :class:`OutputFault`: one line naming the folder, the file and the fault;
 the command line exits with status 1 (the input was good: free space and run
@@ -36,9 +45,12 @@ from pathlib import Path
 from rawehelix.errors import OutputFault, SceneError  # noqa: F401  (OutputFault re-exported)
 
 LOCK = ".lock"
+OWNER = ".rawehelix-command"  # the command whose output the folder holds
+#: the header file of a resumable command's store, for folders written before OWNER
+HEADERS = {"sweep.json": "sweep", "orbits.json": "orbits", "envelope.json": "envelope"}
 #: the errors of a disk, not of the program: turned into OutputFault by :func:`hold`
 DISK_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG)
-_held: dict[Path, list] = {}  # folder -> [fd, count, made the folder]
+_held: dict[Path, list] = {}  # folder -> [fd, count, made the folder, command]
 
 
 class FolderBusy(SceneError):
@@ -64,10 +76,33 @@ def _holder_of(path: Path) -> str:
     return "a process that has not yet written its name into .lock"
 
 
-def _take(folder: Path):
-    """Lock ``folder`` on this process (reentrant): raises FolderBusy or OutputFault."""
+def owner(folder: Path) -> str | None:
+    """The command whose output ``folder`` holds: its marker's, else (an older folder)
+    its store's header file's (:data:`HEADERS`); None if it holds none."""
+    try:
+        return (folder / OWNER).read_text().strip() or None
+    except OSError:
+        pass
+    return next((command for name, command in HEADERS.items() if (folder / name).exists()),
+                None)
+
+
+def _refuse_another(folder: Path, command: str):
+    """SceneError if ``folder`` holds another command's output."""
+    other = owner(folder)
+    if other is not None and other != command:
+        raise SceneError("-o", str(folder),
+                         f"holds the output of 'rawehelix {other}' (its summary.json would be "
+                         f"overwritten); use another -o directory for '{command}'")
+
+
+def _take(folder: Path, command: str | None = None):
+    """Lock ``folder`` on this process (reentrant), refusing another ``command``'s
+    folder: raises FolderBusy, SceneError or OutputFault."""
     if folder in _held:
         _held[folder][1] += 1
+        if command is not None:
+            _held[folder][3] = command
         return
     made = not folder.exists()
     try:
@@ -95,6 +130,16 @@ def _take(folder: Path):
         if same:
             break
         os.close(fd)
+    if command is not None:
+        try:
+            _refuse_another(folder, command)
+        except SceneError:
+            try:
+                os.unlink(path)  # while still held, as _let_go: the folder as it was
+            except OSError:
+                pass
+            os.close(fd)
+            raise
     try:
         os.ftruncate(fd, 0)
         os.write(fd, f"pid {os.getpid()} on host {socket.gethostname()}, since "
@@ -104,7 +149,7 @@ def _take(folder: Path):
     except OSError as err:
         os.close(fd)
         raise OutputFault.of(err, path) from err
-    _held[folder] = [fd, 1, made]
+    _held[folder] = [fd, 1, made, command]
 
 
 def _let_go(folder: Path):
@@ -114,7 +159,13 @@ def _let_go(folder: Path):
     entry[1] -= 1
     if entry[1] > 0:
         return
-    fd, _, made = _held.pop(folder)
+    fd, _, made, command = _held.pop(folder)
+    if command is not None and not (folder / OWNER).exists():
+        try:
+            if any(p.name != LOCK for p in folder.iterdir()):  # the command wrote something
+                (folder / OWNER).write_text(command + "\n")
+        except OSError:
+            pass  # a full disk: the run's own fault is the one reported
     try:
         os.unlink(folder / LOCK)  # while still held: see _take
     except OSError:
@@ -151,17 +202,19 @@ class Holding:
         return False
 
 
-def hold(folder, comm=None) -> Holding:
+def hold(folder, comm=None, command: str | None = None) -> Holding:
     """Take the lock of the output folder ``folder`` (collective on ``comm``:
-    rank 0 takes it, every rank gets its verdict).  Raises :class:`FolderBusy`
-    (another run holds it), :class:`OutputFault` or SceneError (it cannot be
-    made) on every rank."""
+    rank 0 takes it, every rank gets its verdict) for ``command`` (the command line's:
+    a folder holding another command's output is refused; None: the stores' own,
+    reentrant holds).  Raises :class:`FolderBusy` (another run holds it),
+    :class:`OutputFault` or SceneError (it cannot be made, or holds another
+    command's output) on every rank."""
     folder = Path(os.path.abspath(folder))
     rank = 0 if comm is None else comm.rank
     verdict = None
     if rank == 0:
         try:
-            _take(folder)
+            _take(folder, command)
         except FolderBusy as err:
             verdict = ("busy", err.folder, err.holder)
         except OutputFault as err:

@@ -24,6 +24,25 @@ takes less than 10 ms (a stationary solve at N = 2); a count whose records
 pass the memory limit, or whose time passes 30 days at that least cost, is
 refused.
 
+Time and count keys (issue 41): what a run keeps grows with them too, and is
+counted before anything is allocated (:func:`check_simulate`, :func:`check_sweep`,
+:func:`check_branches`):
+
+    simulate    per output step (``time.output_every_s`` up to ``--until`` /
+                ``time.until_s``) its row, its output time and the limits
+                history: 498 B at peak, measured with tracemalloc (nominal_operation,
+                N = 2, 1000 and 3000 outputs, 2026-12-05) -> BYTES_PER_OUTPUT;
+                per frame (``time.fields_every_s``) its fields along s;
+                and at least SECONDS_PER_STEP a time step of ``time.dt_s``
+                (3.3 ms measured at N = 2: the bound is a third of it)
+    sweep       per point its tension series (``sweep.samples_per_period`` x
+                ``sweep.record_periods``) and period extremes (``sweep.max_periods``),
+                one point's section samples for its limits block, and at least
+                ``sweep.min_periods`` periods of fixed steps a point
+    orbits, envelope   per branch point its orbit (X) and record; the points of a
+                window: at most --max-points (400), about POINTS_PER_HZ a Hz of
+                the window; an envelope has COUNT branches (``--vary``)
+
 Every refusal is a :class:`SceneError` (exit status 2) naming the key, the
 estimate and the limit.
 """
@@ -43,11 +62,23 @@ BYTES_PER_DOF = {"stationary": 1.5e3, "dynamics": 1.5e3, "modes": 22e3}
 HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dynamics",
             "spin_up": "dynamics", "sweep": "dynamics", "converge": "modes",
             "modes": "modes", "response": "modes", "orbits": "modes",
-            "section": "stationary"}  # section: closed forms, no FE (the smallest estimate)
+            "section": "stationary",  # closed forms, no FE (the smallest estimate)
+            "envelope": "modes",  # its branches are orbits' (and their linearisations)
+            # a design's points: the stage its quantities need (check_quantities); the
+            # worst (modes) for the command as a whole
+            "study": "modes", "calibrate": "modes",
+            "extremes": "modes"}  # its cases' eigenproblems
 SPLINE_BYTES_PER_N2 = 4.5e3  # the spline scheme's dense matrices: bytes per N^2
 BYTES_PER_POINT = 2e3  # a sweep's, response's or study's record of one point
 SECONDS_PER_POINT = 0.01  # the least a point costs (a stationary solve at N = 2)
 WALL_LIMIT_S = 30 * 86400.0  # a count longer than this at the least cost is refused
+BYTES_PER_OUTPUT = 500.0  # simulate: a row, its output time, the limits history (docstring)
+BYTES_PER_FRAME = 1.5e3  # simulate: a frame's arrays' headers ...
+BYTES_PER_FRAME_NODE = 100.0  # ... and its fields at a node (11 float64 and headroom)
+SECONDS_PER_STEP = 1e-3  # the least a fixed time step costs (3.3 ms measured at N = 2)
+BYTES_PER_SECTION_NODE = 100.0  # sweep: a section sample of the limits block at a node
+POINTS_PER_HZ = 25  # a branch's points a Hz of f1 (docs/envelope, N = 4: 13-23 a Hz)
+MAX_BRANCH_POINTS = 400  # orbits' --max-points default (and the envelope's branches')
 
 
 def machine_bytes() -> float:
@@ -136,8 +167,15 @@ def check_run(params: Parameters, command: str, f1_Hz=None, copies: int = 1):
     response, its frequency list (given, or the scene's)."""
     if command in ("sweep", "response"):
         count = len(f1_Hz) if f1_Hz is not None else frequency_count(params)
-        check_count("--f1" if f1_Hz is None else "f1_Hz", count, copies)
+        key = "--f1" if f1_Hz is None else "f1_Hz"
+        check_count(key, count, copies)
     check(params, command, copies)
+    if command == "sweep":  # its samples and periods, past the discretisation's own check
+        try:
+            top = max(float(f) for f in f1_Hz) if f1_Hz is not None else params.sweep.f1_stop_Hz
+        except (TypeError, ValueError):
+            top = None  # not a list of numbers: the sweep's own check says so
+        check_sweep(params, count, top, key, copies)
 
 
 def check_quantities(params: Parameters, wanted, copies: int = 1):
@@ -147,3 +185,135 @@ def check_quantities(params: Parameters, wanted, copies: int = 1):
     from rawehelix.studies import quantities
     for stage in {quantities.parse(name)[0].stage.partition("@")[0] for name in wanted}:
         check(params, stage, copies)
+
+
+def _refuse(key: str, value, what: str, need: float, have: float, advice: str):
+    raise SceneError(key, value, f"{what} need about {_gb(need)}, more than the {_gb(have)} "
+                                 f"this machine has (estimates in studies/resources.py); {advice}")
+
+
+def _refuse_wall(key: str, value, what: str, wall: float, advice: str):
+    if wall > WALL_LIMIT_S:
+        raise SceneError(key, value, f"{what} take at least {wall / 86400:.3g} days, more than "
+                                     f"the limit of {WALL_LIMIT_S / 86400:g} days; {advice}")
+
+
+def _nodes(params: Parameters) -> int:
+    disc = params.discretisation
+    return disc.degree * disc.elements + 1
+
+
+def check_simulate(params: Parameters, until_s: float | None = None, key: str = "--until"):
+    """Refuse a simulation whose outputs (``time.output_every_s``), frames
+    (``time.fields_every_s``) or time steps (``time.dt_s``) up to ``until_s``
+    (None: ``time.until_s``, then ``key`` is that) pass the memory or the wall limit."""
+    tm = params.time
+    if until_s is None:
+        until_s, key = tm.until_s, "time.until_s"
+    outputs, frames = until_s / tm.output_every_s, until_s / tm.fields_every_s
+    kept = (BYTES_PER_OUTPUT * outputs,
+            frames * (BYTES_PER_FRAME + BYTES_PER_FRAME_NODE * _nodes(params)))
+    need, have = estimate_bytes(params, "simulate") + sum(kept), machine_bytes()
+    if need > have:
+        by = ("time.output_every_s", f"{outputs:.3g} output steps of {tm.output_every_s:g} s") \
+            if kept[0] >= kept[1] else \
+            ("time.fields_every_s", f"{frames:.3g} frames of the fields every {tm.fields_every_s:g} s")
+        _refuse(key, f"{until_s:g} s", by[1], need, have,
+                f"a shorter {key} or a longer {by[0]} (--set {by[0]}=...)")
+    _refuse_wall(key, f"{until_s:g} s", f"{until_s / tm.dt_s:.3g} time steps of time.dt_s = "
+                 f"{tm.dt_s:g} s at {SECONDS_PER_STEP * 1e3:g} ms each",
+                 until_s / tm.dt_s * SECONDS_PER_STEP, f"a shorter {key}")
+
+
+def check_sweep(params: Parameters, count: int, f1_max_Hz: float, key: str, copies: int = 1):
+    """Refuse a sweep whose ``count`` points' records (their series,
+    ``sweep.samples_per_period`` x ``sweep.record_periods``, and period extremes,
+    ``sweep.max_periods``), one point's section samples, or its time (at least
+    ``sweep.min_periods`` periods of the highest f1 a point, in fixed steps) pass the
+    limits."""
+    sw = params.sweep
+    samples = float(sw.samples_per_period) * sw.record_periods
+    record = BYTES_PER_POINT + 16.0 * samples + 16.0 * sw.max_periods
+    sections = samples * _nodes(params) * BYTES_PER_SECTION_NODE
+    need, have = estimate_bytes(params, "sweep") + count * record + sections, machine_bytes()
+    if need > have:
+        big = "sweep.samples_per_period" if sections + count * 16 * samples >= \
+            count * 16 * sw.max_periods else "sweep.max_periods"
+        _refuse(big, f"{getattr(sw, big.split('.')[1]):g}", f"{count:g} points at "
+                f"sweep.samples_per_period = {sw.samples_per_period:g}, sweep.record_periods = "
+                f"{sw.record_periods:g}, sweep.max_periods = {sw.max_periods:g}", need, have,
+                f"fewer points ({key}), samples or periods")
+    if params.discretisation.scheme == "fe" and f1_max_Hz is not None and \
+            0 < f1_max_Hz < math.inf:  # else refused by the sweep's own check of f1
+        steps = count * sw.min_periods / (f1_max_Hz * params.time.dt_s)
+        _refuse_wall("sweep.min_periods", f"{sw.min_periods:g}", f"{count:g} points of at least "
+                     f"{sw.min_periods:g} periods in steps of time.dt_s = {params.time.dt_s:g} s",
+                     steps * SECONDS_PER_STEP / max(copies, 1),
+                     f"fewer points ({key}) or periods")
+
+
+def branch_points(f1_lo_Hz: float, f1_hi_Hz: float, max_points: int = MAX_BRANCH_POINTS) -> int:
+    """The points a branch over the window is expected to hold (module docstring)."""
+    width = abs(float(f1_hi_Hz) - float(f1_lo_Hz))
+    if not math.isfinite(width):  # a window the command refuses itself: count the most
+        return int(max_points)
+    return int(min(max_points, math.ceil(POINTS_PER_HZ * width) + 1))
+
+
+def orbit_size(params: Parameters, method: str = "hb") -> int:
+    """The entries of an orbit's unknown X: harmonic balance's (2 H + 1) unknowns at its
+    first H (H_START: it grows where the orbit needs it), shooting's state (3n), the
+    spline scheme's 8 N."""
+    if params.discretisation.scheme == "spline":
+        return 8 * params.discretisation.elements
+    if method == "shooting":
+        return 3 * unknowns(params)
+    from rawehelix.solvers.harmonic_balance import H_START
+    return (2 * H_START + 1) * unknowns(params)
+
+
+def store_bytes_per_point(params: Parameters, method: str = "hb") -> float:
+    """Disk of one stored branch point (orbits_store.py): the continuation's Jacobian
+    as CSR (12 B a stored entry, up to n^2), X and the state's vectors, the record.
+    Measured (2026-12-05, mobile_end, p = 3, H = 3): N = 2, n = 196: 0.47 MB; N = 4,
+    n = 364: 1.10 MB a point (this bound: 0.47 and 1.61 MB)."""
+    n = float(orbit_size(params, method))
+    return 12.0 * n * n + 48.0 * n + 4e3  # + 4 vectors of n, the zip headers and the record
+
+
+def check_branches(params: Parameters, branches: int, f1_lo_Hz: float, f1_hi_Hz: float,
+                   method: str = "hb", key: str = "--vary", max_points: int = MAX_BRANCH_POINTS):
+    """Refuse ``branches`` branches (an envelope's COUNT, orbits' ranks) whose points
+    kept in memory (X and the record) pass the machine's memory; returns the expected
+    points (for the disk's estimate, studies/outdir.py)."""
+    check_count(key, branches)
+    points = branches * branch_points(f1_lo_Hz, f1_hi_Hz, max_points)
+    n = float(orbit_size(params, method))
+    # + the continuation's dense n x n matrices (its Jacobian, LU and bordered system)
+    need = (estimate_bytes(params, "envelope") + points * (BYTES_PER_POINT + 16.0 * n)
+            + 3 * 8.0 * n * n)
+    have = machine_bytes()
+    if need > have:
+        _refuse(key, f"{branches:g} branches", f"about {points:g} orbits ({orbit_size(params, method)} "
+                f"entries each)", need, have, "fewer values or elements, or a narrower --f1")
+    return points
+
+
+def simulate_output_bytes(params: Parameters, until_s: float | None = None) -> float:
+    """The disk of a simulation's series (time_series.csv, ~150 B an output step) and
+    frames (centre_line.xdmf/.h5, ~100 B a node a frame) up to ``until_s``
+    (studies/outdir.py's extra_bytes)."""
+    tm = params.time
+    until_s = tm.until_s if until_s is None else until_s
+    return (150.0 * until_s / tm.output_every_s
+            + BYTES_PER_FRAME_NODE * _nodes(params) * until_s / tm.fields_every_s)
+
+
+def sweep_output_bytes(params: Parameters, count: int) -> float:
+    """The disk of a sweep's ``count`` stored points beyond outdir.py's record: each
+    point's JSON series (``sweep.samples_per_period`` x ``sweep.record_periods`` pairs,
+    ~50 B each) and period extremes (``sweep.max_periods``, ~50 B each), and its
+    final state (.npz: a few vectors of the FE unknowns)."""
+    sw = params.sweep
+    series = 50.0 * (float(sw.samples_per_period) * sw.record_periods + 2.0 * sw.max_periods)
+    return count * (series + 4 * 8.0 * unknowns(params))

@@ -13,7 +13,11 @@ the extremes and the first limit reached; :meth:`Tracker.block` is the block:
 * ``twist_per_length_max``: the largest |tau| [rad/m];
 * ``first_limit``: the first criterion reached (members.py::CRITERIA), its kind, s and
   t, or None; ``criteria`` gives each criterion's threshold, None where a scene key
-  leaves it off (section.breaking_force_N, section.ring_spacing_m or section.rings).
+  leaves it off (section.breaking_force_N, section.ring_spacing_m or section.rings);
+* ``first_by_kind``: each criterion's own first (:func:`first_of_kind`: the earliest
+  t, then the smallest s), None where not reached: a criterion met from the start
+  (the twist of a collapse already at the stationary state) does not hide another
+  reached later (a member going slack).
 
 The members' forces: with the solid section, the forces of a tensegrity of the
 scene's ``[section]`` members carrying the solid's resultants (members.py::
@@ -26,6 +30,11 @@ from __future__ import annotations
 import numpy as np
 
 from rawehelix.members import CRITERIA, ConeSection, Members
+
+
+#: what each criterion measures (a kind's first's ``quantity``): its name and unit
+QUANTITIES = {"member_force_N": ("member force", "N"), "moment_ratio": ("|M| / (N R)", ""),
+              "ring_twist_rad": ("twist between rings", "rad")}
 
 
 def _at(value, s, t) -> dict:
@@ -42,6 +51,7 @@ class Tracker:
         self._slack = 0.0
         self._no_tension = None
         self._first = None
+        self._by_kind = dict.fromkeys(CRITERIA)
         self.history: list[tuple] = []  # (t [s], min, max member force [N]) per add()
         self.sampled_every_s = None  # set by a caller that adds every k-th output only
 
@@ -119,18 +129,45 @@ class Tracker:
         i = int(np.argmax(np.abs(tau)))
         if self._twist is None or abs(tau[i]) > self._twist["value"]:
             self._twist = _at(abs(tau[i]), s_m[i], t_s)
+        reached = self._reached(f, fraction, ratio, bad, tau)
         if self._first is None:
-            self._first = self._first_of(s_m, t_s, f, fraction, ratio, ~tension & (np.abs(M) > 0),
-                                         tau)
+            self._first = self._first_of(s_m, t_s, reached)
+        psi = np.broadcast_to(np.asarray(psi, dtype=float), np.shape(s_m))
+        for kind, mask in reached.items():
+            if self._by_kind[kind] is None and mask.any():
+                i = int(np.argmax(mask))  # the smallest s where it is met
+                self._by_kind[kind] = {**_at(0.0, s_m[i], t_s),
+                                       **self._where(kind, f[i], ratio[i], tau[i], psi[i])}
 
-    def _first_of(self, s_m, t_s, f, fraction, ratio, no_tension, tau):
-        """The first criterion reached at this time (smallest s; CRITERIA's order on a tie)."""
+    def _reached(self, f, fraction, ratio, no_tension, tau) -> dict:
+        """Each criterion's mask over the sections at one time (members.py)."""
         m = self.members
-        reached = {"slack": fraction > 0,
-                   "breaking": (f.max(axis=-1) >= m.breaking_N) if m.breaking_N is not None
-                   else np.zeros_like(fraction, dtype=bool),
-                   "moment_saturation": (ratio >= m.saturation) | no_tension,
-                   "torsional_collapse": np.abs(m.ring_twist(tau)) >= m.critical_twist()}
+        return {"slack": fraction > 0,
+                "breaking": (f.max(axis=-1) >= m.breaking_N) if m.breaking_N is not None
+                else np.zeros_like(fraction, dtype=bool),
+                "moment_saturation": (ratio >= m.saturation) | no_tension,
+                "torsional_collapse": np.abs(m.ring_twist(tau)) >= m.critical_twist()}
+
+    def _where(self, kind, f, ratio, tau, psi) -> dict:
+        """What a criterion met at one section measures there: ``value`` of its
+        ``quantity`` (:data:`QUANTITIES`) against its ``threshold``, and for a member's
+        criterion which member: its index and its angle from the bending plane's inner
+        side (members.py)."""
+        m = self.members
+        if kind in ("slack", "breaking"):
+            j = int(np.argmin(f) if kind == "slack" else np.argmax(f))
+            return {"value": float(f[j]), "quantity": "member_force_N",
+                    "threshold": 0.0 if kind == "slack" else m.breaking_N, "member": j,
+                    "member_angle_deg": float(np.degrees(m.phi[j] + psi) % 360.0)}
+        if kind == "moment_saturation":
+            return {"value": float(ratio) if ratio > 0 else None,  # None: a moment without tension
+                    "quantity": "moment_ratio", "threshold": m.saturation}
+        return {"value": float(abs(m.ring_twist(tau))), "quantity": "ring_twist_rad",
+                "threshold": m.critical_twist()}
+
+    @staticmethod
+    def _first_of(s_m, t_s, reached):
+        """The first criterion reached at this time (smallest s; CRITERIA's order on a tie)."""
         hits = [(float(s_m[np.argmax(mask)]), CRITERIA.index(kind), kind)
                 for kind, mask in reached.items() if mask.any()]
         if not hits:
@@ -152,6 +189,7 @@ class Tracker:
             "moment_without_tension": self._no_tension,
             "twist_per_length_max": self._twist,
             "first_limit": self._first,
+            "first_by_kind": dict(self._by_kind),
             "criteria": self.thresholds(),
             "sampled_every_s": self.sampled_every_s,
         }

@@ -185,7 +185,8 @@ class SweepResult:
             return outdir
         outdir.mkdir(parents=True, exist_ok=True)
         writers.write_json(outdir / "summary.json", self.summary)
-        sweep_png(outdir / "sweep.png", self.points, self.series, self.params.name)
+        sweep_png(outdir / "sweep.png", self.points, self.series, self.params.name,
+                  firsts=self.summary.get("limits_first_by_kind", {}))
         if series:
             write_series(outdir, self.series)
         return outdir
@@ -240,6 +241,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
                    "slack_Hz": [p["f1_Hz"] for p in points if p.get("slack")],
                    "failed_Hz": [p["f1_Hz"] for p in points if p.get("failed")],
                    "limits": branch_limits.over_points(points),
+                   "limits_first_by_kind": branch_limits.first_by_kind(points),
                    "ranks": comm.size, "computed_now": computed,
                    "model": params.describe_model(),
                    "wall_s": time.perf_counter() - start}
@@ -256,9 +258,10 @@ def write_series(outdir: Path, series: dict):
                    comments="")
 
 
-def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz: float = 10.0):
+def sweep_png(path: Path, points: list[dict], series: dict, title: str, inset_Hz: float = 10.0,
+              firsts: dict | None = None):
     """Fig. 8 (:func:`sweep_figure`) written to ``path``; None without a finished point."""
-    fig = sweep_figure(points, series, title, inset_Hz)
+    fig = sweep_figure(points, series, title, inset_Hz, firsts)
     if fig is None:
         return None
     fig.savefig(path, dpi=120)
@@ -271,9 +274,11 @@ def _legend_beside(ax, **kw):
     return ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, **kw)
 
 
-def sweep_figure(points: list[dict], series: dict, title: str, inset_Hz: float = 10.0):
+def sweep_figure(points: list[dict], series: dict, title: str, inset_Hz: float = 10.0,
+                 firsts: dict | None = None):
     """Fig. 8: maximum tension at s = 0 against f1, the section's moment ratio
-    below it, and T(t) near ``inset_Hz`` in a panel of its own; the legends
+    below it, and T(t) near ``inset_Hz`` in a panel of its own; each limit's first
+    f1 (``firsts``: the summary's limits_first_by_kind) a vertical line; the legends
     stand beside the axes, so nothing is drawn over the data."""
     failed = [p["f1_Hz"] for p in points if p.get("tension_max_N") is None]
     points = [p for p in points if p.get("tension_max_N") is not None]
@@ -296,6 +301,7 @@ def sweep_figure(points: list[dict], series: dict, title: str, inset_Hz: float =
         ax.plot(f[~ok], tmax[~ok], "x", color="C3", ms=9, label="T max (not periodic: cap hit)")
     for k, f1 in enumerate(failed):
         ax.axvline(f1, color="C3", ls="--", lw=1, label="failed (see summary)" if k == 0 else None)
+    branch_limits.mark_firsts((ax, ax_m), firsts or {})
     ax.set_ylabel("tension at s = 0 [N]")
     ax.set_title(f"{title}: maximum tension against f1 (Fig. 8)")
     ax.grid(True, alpha=0.3)
@@ -332,4 +338,6 @@ def report(result: SweepResult) -> str:
                       ("slack_Hz", "slack (T <= 0)"), ("failed_Hz", "failed (see summary.json)")):
         if s[key]:
             lines.append(f"  {what}: f1 = {', '.join(f'{f:g}' for f in s[key])} Hz")
+    if "limits_first_by_kind" in s:
+        lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"])
     return "\n".join(lines)

@@ -279,8 +279,17 @@ def dynamics_png(path: Path, rows: np.ndarray, target_rpm: float, title: str) ->
 
 
 def write_npz(path: Path, arrays: dict) -> Path:
-    """Write arrays to an .npz atomically (:func:`_atomic`)."""
-    return _atomic(path, lambda f: np.savez(f, **arrays))
+    """Write arrays to an .npz atomically (:func:`_atomic`).  The archive is built in
+    memory and written in one piece: np.savez straight into the file leaves its
+    ZipFile unclosed when a write fails (a full disk), and the ZipFile's __del__
+    then prints ``Exception ignored`` at exit after the run's one-line message."""
+    import io
+
+    def fill(f):
+        buffer = io.BytesIO()
+        np.savez(buffer, **arrays)
+        f.write(buffer.getbuffer())
+    return _atomic(path, fill)
 
 
 #: the members' fields of a frame (studies/structure_limits.py::Tracker.profile)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from rawehelix.members import CRITERIA
 from rawehelix.studies import branch_limits, checkpoints, scene, sweep, sweep_store
 
 # FE at N = 2: a few seconds a point (tests/test_sweep.py's FE_TINY)
@@ -146,7 +147,10 @@ def test_the_orbits_summary_carries_the_branch_block_and_resumes_it(tmp_path):
     top = max(first.branch, key=lambda p: p["moment_ratio_max"])
     assert block["moment_ratio_max"]["value"] == top["moment_ratio_max"]
     assert block["moment_ratio_max"]["f1_Hz"] == top["f1_Hz"]
-    assert block["first_limit_by"].startswith("f1 along the branch")
+    assert block["first_limit_by"].startswith(orbits.ALONG)  # the run's order, not the lowest f1
+    reached = [p for p in first.branch if p["first_limit"] is not None]
+    assert (block["first_limit"] or {}).get("f1_Hz") == (reached[0]["f1_Hz"] if reached else None)
+    assert set(first.summary["limits_first_by_kind"]) == set(CRITERIA)
 
 
 def test_the_spline_maps_orbit_block_says_not_available():

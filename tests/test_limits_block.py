@@ -17,7 +17,7 @@ from rawehelix.studies.structure_limits import Tracker
 
 KEYS = {"law", "members", "min_member_force_N", "max_member_force_N", "slack_fraction_max",
         "moment_ratio_max", "moment_without_tension", "twist_per_length_max", "first_limit",
-        "criteria", "sampled_every_s"}
+        "first_by_kind", "criteria", "sampled_every_s"}
 
 
 def _statics_min(tension_N, ratio, members):

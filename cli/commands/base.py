@@ -79,3 +79,15 @@ def say(comm, text: str):
     """The command's result, on rank 0's stdout."""
     if comm.rank == 0:
         print(printable(text), flush=True)
+
+
+def check_branch_output(params, command, outdir, branches, lo, hi, method, max_points=None):
+    """The disk of the branches' stored points (orbits, envelope): their memory first
+    (studies/resources.py), then the folder's room (studies/outdir.py)."""
+    from rawehelix.studies import outdir as outdir_check, resources
+    resources.check(params, command)  # the discretisation's own check comes first
+    points = resources.check_branches(params, branches, lo, hi, method,
+                                      key="--vary" if command == "envelope" else "--f1",
+                                      max_points=max_points or resources.MAX_BRANCH_POINTS)
+    outdir_check.check(outdir, command,
+                       extra_bytes=points * resources.store_bytes_per_point(params, method))

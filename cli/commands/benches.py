@@ -20,7 +20,7 @@ def _extremes_arguments(p):
 
 def _extremes(rh, args, comm) -> int:
     from rawehelix.studies import extremes
-    with outdir_lock.hold(args.output, comm):
+    with outdir_lock.hold(args.output, comm, "extremes"):
         outdir_check.check(args.output, "extremes")
         unknown = [c for c in args.cases if c not in extremes.CASES]
         if unknown:
@@ -70,7 +70,7 @@ def _labtest(rh, args, comm) -> int:
     scene = rh.load_scene(args.scene, overrides=overrides(args))
     outdir = args.output or Path("results") / "labtest" / (args.test + "_fit" * args.fit)
     outdir_check.check(outdir, "labtest")
-    with outdir_lock.hold(outdir, comm):  # one writer per output folder, as every command
+    with outdir_lock.hold(outdir, comm, "labtest"):  # one writer, one command, as every command
         result = rh.labtest(args.test, scene, tensions_N=_numbers("--tension", args.tension),
                             loads=_numbers("--loads", args.loads), fit=args.fit,
                             rod_EI_Nm2=args.rod_EI, elements=args.elements, degree=args.degree,

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from rawehelix.cli.commands.base import Command, overrides, say
+from rawehelix.cli.commands.base import Command, check_branch_output, overrides, say
 from rawehelix.studies import quantities
 from rawehelix.studies.scene import SceneError
 
@@ -98,9 +98,10 @@ def _write_and_say(comm, result, text: str, outdir) -> int:
 
 
 def _envelope_arguments(p):
-    p.add_argument("--vary", required=True, metavar="KEY=LO:HI[:COUNT]",
+    p.add_argument("--vary", required=True, action="append", metavar="KEY=LO:HI[:COUNT]",
                    help="the dotted scene key across the map and its range (COUNT values, "
-                        "default 5), e.g. helix.EI_Nm2=2000:8000:5 or ends.elongation")
+                        "default 5), e.g. helix.EI_Nm2=2000:8000:5 or ends.elongation; "
+                        "one only (a map has one axis of keys)")
     p.add_argument("--f1", required=True, metavar="LO:HI", help="the f1 window in Hz")
     p.add_argument("--method", default="hb", choices=("hb", "shooting", "auto"),
                    help="the periodic-orbit problem of the branches and the curves "
@@ -109,14 +110,25 @@ def _envelope_arguments(p):
 
 def _envelope(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import envelope
+    if len(args.vary) > 1:
+        raise SceneError("--vary", " ".join(args.vary),
+                         "is given more than once: an envelope maps one scene key against "
+                         "f1; give one --vary (several keys: rawehelix study)")
     try:
         lo, hi = (float(x) for x in args.f1.split(":"))
     except ValueError:
         raise SceneError("--f1", args.f1, "must be LO:HI in Hz") from None
-    result = rh.envelope(params, args.vary, lo, hi, comm=comm, outdir=outdir,
-                         method=args.method,
-                         progress=lambda v, o: say(comm, f"  {v:g}: f1 = {o.f1_Hz:.4f} Hz, "
-                                                   f"T max {o.tension_max_N:.2f} N"))
+    from rawehelix.studies.sampling import parse_vary
+    vary = parse_vary(args.vary[0])
+    check_branch_output(params, "envelope", outdir, vary.count or envelope.DEFAULT_VALUES,
+                       lo, hi, args.method)
+    try:
+        result = rh.envelope(params, args.vary[0], lo, hi, comm=comm, outdir=outdir,
+                             method=args.method,
+                             progress=lambda v, o: say(comm, f"  {v:g}: f1 = {o.f1_Hz:.4f} "
+                                                       f"Hz, T max {o.tension_max_N:.2f} N"))
+    except envelope.OrbitsStoreError as err:  # the folder holds another envelope or branch
+        raise SceneError("-o", str(outdir), str(err)) from None
     if comm.rank == 0:
         result.write(outdir)
     say(comm, envelope.report(result) + f"\n  wrote {outdir}/")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from rawehelix.cli.commands.base import Command, say
+from rawehelix.cli.commands.base import Command, check_branch_output, say
 from rawehelix.studies.scene import SceneError
 
 
@@ -49,8 +49,11 @@ def _simulate_arguments(p):
 
 
 def _simulate(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import resources, simulate
+    from rawehelix.studies import outdir as outdir_check, resources, simulate
     resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
+    resources.check_simulate(params, args.until)  # its outputs, frames and steps
+    outdir_check.check(outdir, "simulate",
+                       extra_bytes=resources.simulate_output_bytes(params, args.until))
 
     def checkpoint(partial):  # the last good state and the series so far, every minute
         partial.write(outdir, pictures=False)
@@ -78,8 +81,12 @@ def _sweep_arguments(p):
 
 
 def _sweep(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import sweep
+    from rawehelix.studies import outdir as outdir_check, resources, sweep
     from rawehelix.studies.sweep_store import SweepError
+    count = resources.frequency_count(params)
+    resources.check_run(params, "sweep")  # before the disk's estimate counts its points
+    outdir_check.check(outdir, "sweep", points=count,
+                       extra_bytes=resources.sweep_output_bytes(params, count))
     try:
         result = rh.sweep(params, comm=comm, checkpoint=outdir)
     except SweepError as err:
@@ -134,6 +141,8 @@ def _orbits(rh, params, args, outdir, comm) -> int:
                          "must be integers K[,K...] >= 2 or 'none'") from None
     if args.sweep is not None:
         orbits.check_sweep_dir(args.sweep)
+    check_branch_output(params, "orbits", outdir, comm.size, start, stop, args.method,
+                       args.max_points)
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
