@@ -34,9 +34,7 @@ is normalised as in Eqs. (25)-(29): lengths by L0, forces by M g.
 
 from __future__ import annotations
 
-import contextlib
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -44,6 +42,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 from rawehelix.parameters import Normalised
+from rawehelix.references.budget import OverBudget, budget, watched
 
 __all__ = ["OverBudget", "budget", "MAX_SEGMENTS", "ShootingSolution", "solve", "rhs", "load_vector", "default_segments",
            "ExtensibleSolution", "solve_extensible", "bending_law"]
@@ -168,38 +167,8 @@ class ShootingSolution:
         return self.normalised.sigma * (np.linalg.norm(d1, axis=1) - 1.0)
 
 
-class OverBudget(Exception):
-    """A shooting solve ran past the wall time of :func:`budget` (not a RuntimeError:
-    the solvers' own "did not converge" handling lets it through)."""
-
-
-_DEADLINE = [None]  # perf_counter() past which an integration stops: set by budget()
-
-
-@contextlib.contextmanager
-def budget(seconds: float):
-    """Every shooting solve inside the block stops with :class:`OverBudget` once
-    ``seconds`` of wall time have passed (checked at each evaluation of the right
-    side, so a stiff scene whose steps shrink without end stops too)."""
-    outer = _DEADLINE[0]
-    _DEADLINE[0] = time.perf_counter() + seconds
-    try:
-        yield
-    finally:
-        _DEADLINE[0] = outer
-
-
-def _watched(f, deadline: float):
-    def g(s, y):
-        if time.perf_counter() > deadline:
-            raise OverBudget("stopped at its time budget")
-        return f(s, y)
-    return g
-
-
 def _integrate(f, s0, s1, y0, rtol, atol, dense=False):
-    if _DEADLINE[0] is not None:
-        f = _watched(f, _DEADLINE[0])
+    f = watched(f)
     sol = solve_ivp(f, (s0, s1), y0, method="DOP853", rtol=rtol, atol=atol,
                     dense_output=dense)
     if not sol.success:
