@@ -50,7 +50,7 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
-from rawehelix.models.unshearable import PAIR_ROLES
+from rawehelix.models.base import PAIR_ROLES
 from rawehelix.solvers.discrete import RodDiscretisation
 
 
