@@ -64,6 +64,17 @@ def test_an_unknown_name_is_refused_as_a_scenes_is():
     assert all(name in str(by_registry.value) for name in KINEMATICS)
 
 
+def test_a_kinematics_that_leaves_a_decision_is_refused_when_defined():
+    with pytest.raises(TypeError, match="does not decide .*'planar_reduction'"):
+        class Undecided(kinematics.Kinematics):  # noqa: F841
+            name, reference = "undecided", "shooting"
+            rod_model = staticmethod(kinematics.unshearable_rod)
+            bending_in_axial_damping = False
+            cantilever_transverse = staticmethod(kinematics.paper_transverse)
+    for kin in kinematics.KINEMATICS_REGISTRY.values():
+        assert all(getattr(kin, k) is not None for k in kin.DECISIONS)
+
+
 def test_each_kinematics_has_its_rod_model():
     from rawehelix.models import rod_model
     for name in KINEMATICS:
