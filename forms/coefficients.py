@@ -13,7 +13,8 @@ from rawehelix.forms.paper import PaperKinematics
 from rawehelix.forms.shearable import ShearableKinematics
 from rawehelix.forms import section_law
 
-#: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py)
+#: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py):
+#: the UFL half of the kinematics registry models/kinematics.py (forms lie below models)
 KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics,
               "shearable": ShearableKinematics}
 
@@ -75,7 +76,7 @@ class Coefficients:
             gamma_eps=make(model.gamma_eps),
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
             shear=make(q.shear_stiffness), rotary=make(q.rotary_inertia),
-            kinematics=KINEMATICS[model.kinematics](),
+            kinematics=KINEMATICS[model.kinematics](),  # kinematics by name: the UFL half
             damping=KelvinVoigt.from_normalised(q, make),
             bending_law=TensionDependentBending.from_normalised(q, make),
             hysteresis=BoucWen.from_normalised(q, make),

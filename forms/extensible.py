@@ -209,6 +209,10 @@ class ExtensibleKinematics:
         """(q, q_t, [[j]], [[j]]_t) of forms/damping.py: q = t', [[j]] = [[t]]."""
         return d(t), d(t_t), jump(t, n), jump(t_t, n)
 
+    def bending_curvature(self, r, kappa=None):
+        """The bending measure's curvature vector: t' per unstretched length (IP only)."""
+        return d(unit_tangent(r))
+
     def bending_modulus(self, r, c):
         return bending_modulus(r, c)
 

@@ -15,7 +15,7 @@ import ufl
 
 from rawehelix.forms import mixed
 from rawehelix.forms.interior_penalty import bending, jump_d
-from rawehelix.forms.kinematics import d, internal_force, normal_part, stretch, tension
+from rawehelix.forms.kinematics import curvature, d, internal_force, normal_part, stretch, tension
 
 
 class PaperKinematics:
@@ -50,6 +50,10 @@ class PaperKinematics:
     def bending_measure(self, r, r_t, t, t_t, n):
         """(q, q_t, [[j]], [[j]]_t) of forms/damping.py: q = r'', [[j]] = [[r']]."""
         return d(r, 2), d(r_t, 2), jump_d(r, n), jump_d(r_t, n)
+
+    def bending_curvature(self, r, kappa=None):
+        """The bending measure's curvature vector: r'' (Eq. 34), or the mixed form's field."""
+        return curvature(r, kappa)
 
     def bending_modulus(self, r, c):
         """mu times the bending switch (the EI law needs the extensible kinematics)."""

@@ -6,10 +6,7 @@ the Simo-Reissner rod (forms/shearable.py).  Above forms and parameters, below s
 
 
 def rod_model(params):
-    """The model of a scene: ``model.kinematics = "shearable"`` the shearable rod,
-    otherwise the unshearable one (paper or extensible kinematics)."""
-    from rawehelix.models.shearable import ShearableRod
-    from rawehelix.models.unshearable import UnshearableRod
-    if params.model.kinematics == "shearable":
-        return ShearableRod(params)
-    return UnshearableRod(params)
+    """The model of a scene: its kinematics' (models/kinematics.py): the shearable
+    rod, or the unshearable one (paper or extensible kinematics)."""
+    from rawehelix.models import kinematics
+    return kinematics.of(params).rod_model(params)

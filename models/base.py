@@ -9,6 +9,9 @@ A solver asks the model instead of naming r, alpha, kappa or z:
   stored energy, the kinetic energy, the dissipation potential and the power
   of the non-variational terms;
 * the observables: tension, twist, curvature and the moments;
+* the first-order form (r, alpha and their rates as unknowns, :data:`PAIR_ROLES`):
+  :meth:`RodModel.pair_element`, :meth:`RodModel.residual_of_fields`, which a model
+  without one leaves to raise (its :meth:`RodModel.refusals` of "first_order" say why);
 * the end conditions, :meth:`RodModel.end_conditions`;
 * the capabilities: :meth:`RodModel.refuse` raises the one refusal of a
   component (or of the discretisation) for a solver that cannot run it.
@@ -17,17 +20,23 @@ A solver asks the model instead of naming r, alpha, kappa or z:
 from __future__ import annotations
 
 import abc
+import dataclasses
 from dataclasses import dataclass
 
 import ufl
 
 from rawehelix.errors import SceneError
 from rawehelix.forms import kinematics
+from rawehelix.forms.damping import NoneDamping
 
 #: the roles of a rod's fields; the unshearable rod has the first two always,
 #: "curvature" with the mixed bending form, "internal_twist" with hysteresis; the
 #: shearable rod (models/shearable.py) the first two and "director"
 ROLES = ("centre_line", "twist", "curvature", "internal_twist", "director")
+
+#: the fields of the first-order form (with their rates, :meth:`RodModel.pair_element`):
+#: no curvature, no z
+PAIR_ROLES = ("centre_line", "twist")
 
 #: the solvers a model is asked about (:meth:`RodModel.refuse`)
 SOLVERS = ("stationary", "second_order", "first_order", "modal")
@@ -81,6 +90,36 @@ class RodModel(abc.ABC):
     def residual(self, w, w_t, w_tt, test, c, degree: int, penalty, measures):
         """The full residual; ``w_tt`` None: no inertia, ``w_t`` None: at rest."""
 
+    def conservative(self, c):
+        """``c`` without the dissipative components: the residual of the stiffness."""
+        return dataclasses.replace(c, damping=NoneDamping())
+
+    # -- the first-order form: (r, alpha) and their rates as unknowns ------------------
+    def pair_element(self, cell, degree: int):
+        """The fields :data:`PAIR_ROLES` and their rates as one mixed element."""
+        raise NotImplementedError(f"{type(self).__name__} has no first-order form "
+                                  "(its refusals('first_order') say why)")
+
+    def residual_of_fields(self, f: dict, f_t: dict, f_tt: dict, tests, c, degree: int, penalty,
+                           measures):
+        """:meth:`residual` on fields, rates and accelerations by role (the
+        first-order form's live in its own space, :meth:`split_pair`); ``tests``
+        the tuple of test functions in the order of the fields."""
+        raise NotImplementedError(f"{type(self).__name__} has no first-order form "
+                                  "(its refusals('first_order') say why)")
+
+    def pair_index(self, role: str, rate: bool = False) -> int:
+        """The position of ``role``'s field (or of its rate) in :meth:`pair_element`."""
+        return PAIR_ROLES.index(role) + len(PAIR_ROLES) * rate
+
+    def split_pair(self, x) -> tuple[dict, dict]:
+        """(fields, rates) by role of a function (or test function) on :meth:`pair_element`."""
+        parts = ufl.split(x)
+        f, f_t = dict.fromkeys(ROLES), dict.fromkeys(ROLES)
+        for role in PAIR_ROLES:
+            f[role], f_t[role] = parts[self.pair_index(role)], parts[self.pair_index(role, True)]
+        return f, f_t
+
     @abc.abstractmethod
     def stored_energy(self, fields: dict, c, degree: int, penalty, measures):
         """U of the fields (:meth:`split`)."""
@@ -116,6 +155,10 @@ class RodModel(abc.ABC):
     @abc.abstractmethod
     def bending_moment(self, fields: dict, c):
         """The bending moment's magnitude (an observable, M g L0 units)."""
+
+    @abc.abstractmethod
+    def moment(self, fields: dict, c):
+        """The torsional moment / GJ (an observable)."""
 
     def ring_phase(self, fields: dict, c):
         """The phase psi of the section's members against the bending plane (an

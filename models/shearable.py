@@ -11,13 +11,10 @@ end (36), (70) on r(1); the zero-moment ends (37) are natural conditions on n.
 
 from __future__ import annotations
 
-import dataclasses
-
 import ufl
 
 from rawehelix import compat
 from rawehelix.forms import rod, shearable
-from rawehelix.forms.damping import NoneDamping
 from rawehelix.forms.kinematics import d
 from rawehelix.models.base import EndCondition, Refusal, RodModel
 from rawehelix.parameters import Parameters
@@ -56,9 +53,6 @@ class ShearableRod(RodModel):
             F += (ufl.inner(f_tt["centre_line"], tests[0]) + f_tt["twist"] * tests[1]) * dx
             F += shearable.rotary_inertia(f_tt["director"], tests[2], c, dx)
         return F
-
-    def conservative(self, c):
-        return dataclasses.replace(c, damping=NoneDamping())
 
     def stored_energy(self, fields: dict, c, degree: int, penalty, measures):
         return shearable.stored_energy(fields["centre_line"], fields["twist"], fields["director"],

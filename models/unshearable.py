@@ -19,19 +19,14 @@ and the end torques (Eqs. 38-39).
 
 from __future__ import annotations
 
-import dataclasses
-
 import ufl
 
 from rawehelix import compat
 from rawehelix.forms import energy, kinematics, rod
-from rawehelix.forms.damping import KelvinVoigt, NoneDamping
+from rawehelix.forms.damping import KelvinVoigt
 from rawehelix.forms.hysteresis import BoucWen
-from rawehelix.models.base import ROLES, EndCondition, Refusal, RodModel
+from rawehelix.models.base import EndCondition, Refusal, RodModel
 from rawehelix.parameters import Parameters
-
-#: the fields of the first-order form (with their rates): no curvature, no z
-PAIR_ROLES = ("centre_line", "twist")
 
 #: the first-order TS types are set up for (r, alpha) and its rates only
 MIXED_FIRST_ORDER = Refusal(
@@ -68,9 +63,6 @@ class UnshearableRod(RodModel):
 
     def residual_of_fields(self, f: dict, f_t: dict, f_tt: dict, tests, c, degree: int, penalty,
                            measures):
-        """:meth:`residual` on fields, rates and accelerations by role (the
-        first-order form's live in its own space, :meth:`split_pair`); ``tests``
-        the tuple of test functions in the order of the fields."""
         return rod.residual_of_fields(
             f["centre_line"], f["twist"], f_t["centre_line"], f_tt["centre_line"], f_tt["twist"],
             tests, c, degree, penalty, measures, kappa=f["curvature"],
@@ -80,22 +72,6 @@ class UnshearableRod(RodModel):
     def pair_element(self, cell, degree: int):
         """The fields (r, alpha) and their rates as one mixed element (compat.rod_pair_element)."""
         return compat.rod_pair_element(cell, degree)
-
-    def pair_index(self, role: str, rate: bool = False) -> int:
-        """The position of ``role``'s field (or of its rate) in :meth:`pair_element`."""
-        return PAIR_ROLES.index(role) + len(PAIR_ROLES) * rate
-
-    def split_pair(self, x) -> tuple[dict, dict]:
-        """(fields, rates) by role of a function (or test function) on :meth:`pair_element`."""
-        parts = ufl.split(x)
-        f, f_t = dict.fromkeys(ROLES), dict.fromkeys(ROLES)
-        for role in PAIR_ROLES:
-            f[role], f_t[role] = parts[self.pair_index(role)], parts[self.pair_index(role, True)]
-        return f, f_t
-
-    def conservative(self, c):
-        """``c`` without the dissipative components: the residual of the stiffness."""
-        return dataclasses.replace(c, damping=NoneDamping())
 
     def stored_energy(self, fields: dict, c, degree: int, penalty, measures):
         """U = elastic + gravity (forms/energy.py::potential)."""
@@ -128,11 +104,7 @@ class UnshearableRod(RodModel):
     def curvature(self, fields: dict, c):
         """The bending curvature |kappa| of the kinematics' bending measure: |r''| (the
         paper's, Eq. 34) or |t'| (the extensible kinematics, per unstretched length)."""
-        r = fields["centre_line"]
-        if c.kinematics.name == "extensible":
-            k = kinematics.d(kinematics.unit_tangent(r))
-        else:
-            k = kinematics.curvature(r, fields["curvature"])
+        k = c.kinematics.bending_curvature(fields["centre_line"], fields["curvature"])
         return ufl.sqrt(ufl.dot(k, k))
 
     def bending_moment(self, fields: dict, c):

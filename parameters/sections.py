@@ -192,6 +192,13 @@ GAMMA_TREATMENTS = ("regularised", "off")
 KINEMATICS = ("paper", "extensible", "shearable")
 
 
+def check_kinematics_name(name: str) -> None:
+    """Refuse a kinematics name that is none of :data:`KINEMATICS` (the scene's
+    ``model.kinematics``, the kinematics registry models/kinematics.py)."""
+    if name not in KINEMATICS:
+        raise ParameterError("model.kinematics", name, f"must be one of {KINEMATICS}")
+
+
 def check_kinematics(params) -> None:
     """What the extensible kinematics cannot run with (``params`` a whole scene)."""
     disc = params.discretisation
@@ -257,6 +264,5 @@ class Model:
             raise ParameterError("model.gamma", self.gamma, f"must be one of {GAMMA_TREATMENTS}")
         if self.reduction not in ("auto", "off"):
             raise ParameterError("model.reduction", self.reduction, "must be one of ('auto', 'off')")
-        if self.kinematics not in KINEMATICS:
-            raise ParameterError("model.kinematics", self.kinematics, f"must be one of {KINEMATICS}")
+        check_kinematics_name(self.kinematics)
         _positive("model", self, "gamma_eps")

@@ -52,9 +52,10 @@ class ShearableSolution(ExtensibleSolution):
 
 
 def not_applicable(params) -> str | None:
-    """Why this reference does not apply to a shearable scene, or None: it takes a
-    constant GA (helix.GA_N), not the members' (section.law = "tensegrity")."""
-    if params.model.kinematics == "shearable" and params.helix.GA_N is None:
+    """Why this reference does not apply to a shearable scene (the reference its
+    kinematics names, models/kinematics.py), or None: it takes a constant GA
+    (helix.GA_N), not the members' (section.law = "tensegrity")."""
+    if params.helix.GA_N is None:
         return ("the members' GA follows their force (section.law = 'tensegrity'); the "
                 "shearable shooting reference takes a constant GA (helix.GA_N)")
     return None

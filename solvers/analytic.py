@@ -23,6 +23,9 @@ import math
 
 import numpy as np
 
+from rawehelix.models.kinematics import get as kinematics_named
+from rawehelix.models.kinematics import paper_axial_strain  # noqa: F401 (the API's name)
+
 
 def _mu(q) -> float:
     return q.bending * q.mu
@@ -114,11 +117,9 @@ def cantilever_apparent_EI(EI, tension, length):
 
 
 def cantilever_transverse(tension, EI, EA, kinematics: str = "paper"):
-    """(T, EI) of the transverse equation under the end tension T_e (above)."""
-    if kinematics == "extensible":
-        stretch = 1 + np.asarray(tension, dtype=float) / EA
-        return tension / stretch, EI / stretch**2
-    return tension / (1 + paper_axial_strain(tension, EA)), EI
+    """(T, EI) of the transverse equation under the end tension T_e (above), as the
+    kinematics of that name has it (models/kinematics.py)."""
+    return kinematics_named(kinematics).cantilever_transverse(tension, EI, EA)
 
 
 def cantilever_intrinsic_EI(apparent_EI, tension, length):
@@ -132,6 +133,3 @@ def cantilever_intrinsic_EI(apparent_EI, tension, length):
                   1e-9 * apparent_EI, apparent_EI, xtol=1e-12 * apparent_EI)
 
 
-def paper_axial_strain(tension, EA):
-    """eps with EA eps (1 + eps) = T_e: the end strain of the paper's kinematics."""
-    return (np.sqrt(1 + 4 * np.asarray(tension, dtype=float) / EA) - 1) / 2

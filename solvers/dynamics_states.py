@@ -3,7 +3,7 @@ reading the last accepted one, and keeping the last good one across a failed ste
 
 The second-order form (TSALPHA2) holds the state in the model's space W (u, v);
 the first-order form in its own pair space (the fields and their rates,
-models/unshearable.py::pair_element): a state moves between the two field by
+models/base.py::RodModel.pair_element): a state moves between the two field by
 field, by role (the model's ``index`` and ``pair_index``).
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import dolfinx.fem
 
 from rawehelix import compat
-from rawehelix.models.unshearable import PAIR_ROLES
+from rawehelix.models.base import PAIR_ROLES
 from rawehelix.solvers.state import RodState
 
 

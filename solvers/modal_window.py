@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rawehelix.models.kinematics import get as kinematics_named
 from rawehelix.solvers import analytic
 
 #: the search disk holds the farthest wanted estimate with this margin (unless a
@@ -52,7 +53,8 @@ def estimates(q, tension: float, count: int, twist: bool = True,
       the motion (chord, j_E x chord, j_E), tests/test_modal.py;
     * Kelvin-Voigt (forms/damping.py): the retardation time x the mechanism's
       share of omega_n^2 (tests/test_damping.py): tau_a sigma k^2 + tau_b mu k^4
-      (longitudinal; the bending share with the paper's kinematics only),
+      (longitudinal; the bending share where the kinematics has it, the paper's:
+      models/kinematics.py, ``kinematics`` its name),
       tau_b mu k^4 (lateral), tau_t delta k^2 (torsional).
 
     An oscillating pair is (lambda, conj lambda), an overdamped one two real roots."""
@@ -65,7 +67,7 @@ def estimates(q, tension: float, count: int, twist: bool = True,
     omega = analytic.frequencies(q, tension, count, twist)
     bending = q.tau_bending * mu * k**4
     kelvin_voigt = {"longitudinal": q.tau_axial * q.sigma * k**2
-                    + (bending if kinematics == "paper" else 0.0),
+                    + (bending if kinematics_named(kinematics).bending_in_axial_damping else 0.0),
                     "lateral_in_plane": bending, "lateral_out_of_plane": bending,
                     "torsional": q.tau_torsion * q.delta * k**2}
     out = {}

@@ -21,6 +21,7 @@ from rawehelix import compat
 from rawehelix.solvers import fields
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
+from rawehelix.models import kinematics
 from rawehelix.parameters import Parameters
 from rawehelix.meshes import interval
 
@@ -28,9 +29,9 @@ from rawehelix.meshes import interval
 def planar_allowed(params: Parameters) -> bool:
     """The stationary scene is planar: its upper end lies in the x-z plane (and
     the bending form is the IP one: the mixed form's kappa field is not reduced
-    here; it runs on the full rod)."""
+    here; it runs on the full rod) and its kinematics reduces (models/kinematics.py)."""
     return (params.ends.circle_radius_m == 0 and params.discretisation.bending == "ip"
-            and params.model.kinematics != "shearable")  # its director is not reduced
+            and kinematics.of(params).planar_reduction)
 
 
 def embed(u):

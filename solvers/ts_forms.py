@@ -50,7 +50,7 @@ import dolfinx.fem
 from rawehelix import compat
 from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
-from rawehelix.models.unshearable import PAIR_ROLES
+from rawehelix.models.base import PAIR_ROLES
 from rawehelix.solvers.discrete import RodDiscretisation
 
 
@@ -264,7 +264,7 @@ class FirstOrder(_Formulation):
 
     def __init__(self, rod_: RodDiscretisation, bcs_second_order):
         model = rod_.model
-        model.refuse("first_order", rod_.params.name)  # models/unshearable.py
+        model.refuse("first_order", rod_.params.name)  # RodModel.refusals (models/)
         mesh = rod_.mesh
         self.W2 = compat.function_space(mesh, model.pair_element(mesh.ufl_cell(), rod_.degree))
         self.x = dolfinx.fem.Function(self.W2, name="state")
@@ -295,7 +295,7 @@ class FirstOrder(_Formulation):
         zero = dolfinx.fem.Function(self.V_r)
         self._set_top_functions(0.0, rod_.q)
         bcs = []
-        model = rod_.model  # the fields and their rates in W2 (models/unshearable.py)
+        model = rod_.model  # the fields and their rates in W2 (models/base.py::RodModel.split_pair)
         r_sub, r_t_sub = model.pair_index("centre_line"), model.pair_index("centre_line", True)
         twist_subs = (model.pair_index("twist"), model.pair_index("twist", True))
         for sub, values in ((r_sub, {"bottom": zero, "top": self.r_top}),

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
+from rawehelix.models import kinematics
 from rawehelix.parameters import Parameters
 
 #: the wall time one reference solve may take [s]; the shooting of a scene it models
@@ -39,10 +41,46 @@ class Check:
         return self.status == COMPARED
 
 
+@dataclass(frozen=True)
+class Reference:
+    """An independent stationary reference (references/): ``solve(normalised)`` its
+    solution, ``not_applicable(params)`` why it does not model a scene, or None."""
+
+    solve: Callable
+    not_applicable: Callable = lambda params: None
+
+
+def too_many_segments(params: Parameters) -> str | None:
+    """Why Sys. (67)'s shooting does not fit the budget, or None."""
+    from rawehelix.references import shooting
+    q = params.normalised()
+    if shooting.default_segments(q) > shooting.MAX_SEGMENTS:
+        return (f"Sys. (67)'s axial mode grows like exp(sqrt(sigma/mu)) = "
+                f"e^{math.sqrt(q.sigma / q.mu):.0f} along the rod: its shooting needs "
+                f"{shooting.default_segments(q)} segments, more than the {shooting.MAX_SEGMENTS} that fit "
+                f"the check's budget of {BUDGET_S:g} s (a larger helix.EI_Nm2 needs fewer)")
+    return None
+
+
+def references() -> dict[str, Reference]:
+    """The references by the name a kinematics gives them
+    (models/kinematics.py::Kinematics.reference)."""
+    from rawehelix.references import shooting, shooting_shear
+    return {"shooting": Reference(shooting.solve, too_many_segments),
+            "extensible_elastica": Reference(shooting.solve_extensible),
+            "shearable_elastica": Reference(shooting_shear.solve_shearable,
+                                            shooting_shear.not_applicable)}
+
+
+def reference_of(params: Parameters) -> Reference:
+    """The reference that the kinematics of ``params`` names."""
+    return references()[kinematics.of(params).reference]
+
+
 def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
     """Why no reference models the stationary state of ``params`` (``twisted``: the
     state carries the ends' torque), or None."""
-    from rawehelix.references import shooting, shooting_shear
+    from rawehelix.references import shooting
     law = params.value("section.law")
     if twisted:
         return ("the state is twisted by the ends' torque (torque.top_Nm), and the "
@@ -52,13 +90,8 @@ def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
                 "(helix.EA_N, helix.EI_Nm2)")
     if not params.model.bending:
         return "model.bending = false: the references need a bending stiffness"
-    q = params.normalised()
-    if params.model.kinematics == "paper" and shooting.default_segments(q) > shooting.MAX_SEGMENTS:
-        return (f"Sys. (67)'s axial mode grows like exp(sqrt(sigma/mu)) = "
-                f"e^{math.sqrt(q.sigma / q.mu):.0f} along the rod: its shooting needs "
-                f"{shooting.default_segments(q)} segments, more than the {shooting.MAX_SEGMENTS} that fit "
-                f"the check's budget of {BUDGET_S:g} s (a larger helix.EI_Nm2 needs fewer)")
-    return shooting.not_applicable(q) or shooting_shear.not_applicable(params)
+    return (reference_of(params).not_applicable(params)
+            or shooting.not_applicable(params.normalised()))
 
 
 def solve(params: Parameters, comm=None, twisted: bool = False,
@@ -66,12 +99,11 @@ def solve(params: Parameters, comm=None, twisted: bool = False,
     """The reference of ``params``' kinematics where it applies, stopped after
     ``budget_s`` of wall time.  With ``comm`` every rank solves it and all agree on
     the status (rank 0's words)."""
-    from rawehelix.references import shooting, shooting_shear
+    from rawehelix.references import shooting
     why = not_applicable(params, twisted)
     if why is not None:
         return Check(None, f"not applicable: {why}")
-    solve_reference = {"paper": shooting.solve, "extensible": shooting.solve_extensible,
-                       "shearable": shooting_shear.solve_shearable}[params.model.kinematics]
+    solve_reference = reference_of(params).solve
     reference, status = None, COMPARED
     try:
         with shooting.budget(budget_s):
