@@ -18,7 +18,7 @@ OUTSIDE = {"parameters", "tests", "docs", "scripts", "benchmarks", ".venv", "bui
 MARKER = re.compile(r"#\s*dispatch-ok:\s*\S")
 #: the patterns of a choice made by name or by probing
 PATTERNS = {
-    "scheme by name": re.compile(r"\bscheme\s*(==|!=)"),
+    "scheme by name": re.compile(r"\bscheme(\b|[\"']\])\s*(==|!=)"),  # also info["scheme"] ==
     "hasattr probe": re.compile(r"\bhasattr\("),
 }
 
@@ -68,6 +68,7 @@ def test_the_check_catches_a_name_test_and_accepts_a_justified_one(tmp_path):
         '# dispatch-ok: the line below, justified above it\n'
         'if scheme != "spline":\n    pass\n'
         'x = 1  # a comment: scheme == "fe" is not code\n'
-        'if hasattr(rod, "model"):\n    pass\n')
+        'if hasattr(rod, "model"):\n    pass\n'
+        'if info["scheme"] == "fe":\n    pass\n')
     found = [s for p in PATTERNS.values() for s in survivors(p, tmp_path, [Path("probe.py")])]
-    assert sorted(int(f.split(":")[1]) for f in found) == [1, 9], found
+    assert sorted(int(f.split(":")[1]) for f in found) == [1, 9, 11], found
