@@ -142,6 +142,7 @@ def scalar_space(mesh, family: str, degree: int):
 
 def atan2(y, x):
     """UFL's two-argument arctangent (atan_2 in UFL 2022; atan2 from UFL 2023.2)."""
+    # dispatch-ok: a library version probe, compat.py's one job
     return (ufl.atan2 if hasattr(ufl, "atan2") else ufl.atan_2)(y, x)
 
 
@@ -262,7 +263,7 @@ def petsc_option_used(name: str) -> bool:
     database: petsc4py 3.18 has no call for it, so PetscOptionsUsed of the
     libpetsc already loaded (ctypes), or ``Options.used`` where petsc4py has it."""
     from petsc4py import PETSc
-    if hasattr(PETSc.Options, "used"):
+    if hasattr(PETSc.Options, "used"):  # dispatch-ok: a library version probe (compat.py)
         return bool(PETSc.Options().used(name))
     flag = ctypes.c_int()
     err = _libpetsc().PetscOptionsUsed(None, name.encode(), ctypes.byref(flag))

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from rawehelix.forms.components import BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
 from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
 from rawehelix.forms.extensible import ExtensibleKinematics
@@ -23,6 +24,13 @@ KINEMATICS = {"paper": PaperKinematics, "extensible": ExtensibleKinematics,
 #: energy W (forms/energy.py).  Each is a class with from_normalised(q, make) (its
 #: null object when off); a new one is appended here.
 ENERGY_COMPONENTS = ()
+
+#: the components built from the normalised groups, by their field of Coefficients:
+#: ``build(q, make)`` gives the component, or its null object when the scene has it off
+COMPONENTS = {"damping": KelvinVoigt.from_normalised,
+              "bending_law": TensionDependentBending.from_normalised,
+              "hysteresis": BoucWen.from_normalised,
+              "section": section_law.from_normalised}
 
 
 @dataclass
@@ -49,19 +57,19 @@ class Coefficients:
     shear: Any = 0.0  # GA / (M g), the shearable rod's (parameters/shear.py)
     rotary: Any = 0.0  # its sections' rotary inertia EI / (EA L0^2), 0: none
     # the kinematics, a component chosen by model.kinematics (:data:`KINEMATICS`)
-    kinematics: Any = field(default_factory=PaperKinematics)
+    kinematics: Kinematics = field(default_factory=PaperKinematics)
     # structural damping, a component (forms/damping.py): KelvinVoigt, or the null
     # object NoneDamping that leaves the viscous terms out of the forms altogether
-    damping: Any = field(default_factory=NoneDamping)
+    damping: Damping = field(default_factory=NoneDamping)
     # the EI law, a component (forms/eilaw.py): TensionDependentBending, or the
     # null object ConstantBending (mu)
-    bending_law: Any = field(default_factory=ConstantBending)
+    bending_law: BendingLaw = field(default_factory=ConstantBending)
     # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
     # object NoneHysteresis (no z field, the elastic moment)
-    hysteresis: Any = field(default_factory=NoneHysteresis)
+    hysteresis: Hysteresis = field(default_factory=NoneHysteresis)
     # the section law, a component (forms/section_law.py): TensegritySection,
     # SaturatingSection, or the null object SolidSection (sigma, mu and the EI law)
-    section: Any = field(default_factory=section_law.SolidSection)
+    section: SectionLaw = field(default_factory=section_law.SolidSection)
     # the ENERGY_COMPONENTS of the scene
     extra: tuple = ()
 
@@ -77,9 +85,6 @@ class Coefficients:
             gamma_coupling=make(1.0 if model.gamma == "regularised" else 0.0),
             shear=make(q.shear_stiffness), rotary=make(q.rotary_inertia),
             kinematics=KINEMATICS[model.kinematics](),  # kinematics by name: the UFL half
-            damping=KelvinVoigt.from_normalised(q, make),
-            bending_law=TensionDependentBending.from_normalised(q, make),
-            hysteresis=BoucWen.from_normalised(q, make),
-            section=section_law.from_normalised(q, make),
+            **{name: build(q, make) for name, build in COMPONENTS.items()},
             extra=tuple(cls.from_normalised(q, make) for cls in ENERGY_COMPONENTS),
         )

@@ -6,7 +6,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from rawehelix.parameters import components, sections
+from rawehelix.parameters import components, end_components, sections
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.fingerprint import drop_later_switches
 from rawehelix.parameters.normalised import Normalised
@@ -37,9 +37,9 @@ class Parameters:
             object.__setattr__(self, "helix", dataclasses.replace(self.helix, **stiffness))
         if not self.model.twist:
             # model.twist = false removes the twist field: alpha = 0 everywhere
-            if self.torque.top_Nm != 0 or self.controller.active:
+            if end_components.torques(self):
                 raise ParameterError("model.twist", False,
-                                     "needs a torque-free scene (torque.top_Nm = 0, controller off): "
+                                     f"needs a torque-free scene ({end_components.torque_free()}): "
                                      "torque is carried by the twist, Eq. (31)")
             if self.discretisation.scheme != "fe":
                 raise ParameterError("model.twist", False, "is implemented by the FE scheme only")

@@ -197,6 +197,12 @@ class PeriodicOrbitProblem(abc.ABC):
     def resume_from(self, orbit: Orbit) -> None:
         """Take up the resolution of a stored branch's last point (a resumed trace)."""
 
+    def sections(self, X, f1_Hz: float, steps: int | None = None) -> list | None:
+        """The section along s over the orbit's period, [(t, section dict)] for its
+        limits block (studies/branch_limits.py); None: the problem has no fields along s
+        (the spline reference)."""
+        return None
+
     @abc.abstractmethod
     def norm(self, G, X) -> float:
         """|G| relative to X over the entries the Newton solves for."""

@@ -32,7 +32,7 @@ import dolfinx.fem
 
 from rawehelix import compat
 from rawehelix.forms import cantilever, kinematics
-from rawehelix.parameters import Parameters
+from rawehelix.parameters import Parameters, schemes
 from rawehelix.solvers import petsc_options
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.snes import NewtonSolver, SolverError
@@ -72,7 +72,7 @@ class CantileverSolver:
     """Newton for the clamped segment under end loads."""
 
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD):
-        if params.discretisation.bending != "ip" or params.discretisation.scheme != "fe":
+        if params.discretisation.bending != "ip" or not schemes.of(params).fe_assembled:
             raise ValueError("the cantilever is implemented for the FE scheme with "
                              "discretisation.bending = 'ip' (forms/cantilever.py)")
         self.params, self.q = params, params.normalised()

@@ -25,7 +25,7 @@ from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.state import RodState
 from rawehelix.forms import rod
 from rawehelix.models import rod_model
-from rawehelix.parameters import Parameters
+from rawehelix.parameters import Parameters, schemes
 from rawehelix.meshes import interval
 
 
@@ -40,9 +40,12 @@ def unit_tangent_of(centre_line, s, h: float = 1e-6):
 class RodDiscretisation:
     """Everything a solver needs to assemble Eqs. (30)-(31) on one mesh."""
 
+    #: the full rod (solvers/planar.py's PlanarRod is the reduced (x, z) one)
+    planar = False
+
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, pin_twist: bool = True):
         disc = params.discretisation
-        if disc.scheme != "fe":
+        if not schemes.of(params).fe_assembled:
             raise ValueError(f"discretisation.scheme = {disc.scheme!r}: this solver is the FE scheme")
         self.params = params
         self.q = params.normalised()

@@ -55,6 +55,11 @@ class FEBackend:
         #: an optional step hook with ``expect(t_out)`` (solvers/section_samples.py)
         self.section_sampler = None
 
+    def track_sections(self) -> None:
+        """Sample the section along s over the recorded periods (the limits block)."""
+        from rawehelix.solvers.section_samples import SectionSampler
+        self.section_sampler = SectionSampler(self.solver)
+
     def stationary(self) -> RodState:
         """The state the solver was built with: stationary, top at phase 0, at rest."""
         return self._stationary

@@ -25,9 +25,11 @@ A *backend* integrates the rod; it works in normalised units and provides
                                              (``Normalised.at_frequency``)
     backend.advance(state, t0, t1, t_out)    -> (state at t1, tension at s = 0 at t_out)
     backend.pack(state) -> dict of arrays;  backend.unpack(dict) -> state
-    backend.section_sampler (optional)       None, or solvers/section_samples.py's
+    backend.section_sampler                  None, or solvers/section_samples.py's
                                              SectionSampler: the section along s over
                                              the recorded periods (PointResult.sections)
+    backend.track_sections()                 set section_sampler (a no-op without
+                                             fields along s)
 
 Backends read and write no files: ``pack`` and ``unpack`` convert a state to
 and from plain arrays, which the caller may keep where it likes.
@@ -135,7 +137,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
             state, _ = backend.advance(state, t, t + period, np.array([t + period]))
             t += period
     maxima, minima, means, history = [], [], [], []
-    sampler = getattr(backend, "section_sampler", None)
+    sampler = backend.section_sampler
     periodic = slack = False
     for k in range(1, sweep.max_periods + 1):
         t_out = t + period * np.arange(1, n + 1) / n

@@ -40,6 +40,9 @@ def embed(u):
 
 
 class PlanarRod:
+    #: the reduced (x, z) rod, not the full rod of solvers/discrete.py (SectionProbe.of_rod)
+    planar = True
+
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD):
         if not planar_allowed(params):
             raise ValueError("the planar model needs the upper end in the x-z plane and "
@@ -74,6 +77,11 @@ class PlanarRod:
 
     def centre_line(self):
         return embed(self.w)
+
+    def get_state(self):
+        """None: the planar rod keeps no :class:`~rawehelix.solvers.state.RodState`
+        (StationaryResult.state; the full rod's is its fields)."""
+        return None
 
     def stationary_residual(self):
         alpha = dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(0.0))

@@ -60,7 +60,7 @@ class SectionProbe:
     def of_rod(cls, rod):
         """The probe of a stationary solver's rod (solvers/stationary.py): the full
         rod's fields, or the planar rod's (x, z) with alpha = 0 (solvers/planar.py)."""
-        if hasattr(rod, "model"):
+        if not rod.planar:
             return cls(rod.model, rod.model.split(rod.w), rod.c, rod.V_a)
         from rawehelix.solvers.planar import embed
         mesh = rod.mesh

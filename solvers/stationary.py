@@ -61,6 +61,7 @@ class StationarySolver:
         self.tension_expr = (tension(self.rod.centre_line(), self.rod.c.sigma) if planar  # (29)
                              else self.rod.model.tension(self.rod.model.split(self.rod.w),
                                                          self.rod.c))
+        self._mean_tension_form = None  # compiled on first use (mean_tension)
 
     def solve(self, first_guess=None) -> StationaryResult:
         """Solve from the chord (or ``first_guess``: s -> (n, 3) centre line)."""
@@ -77,14 +78,13 @@ class StationarySolver:
         self._check_taut(result)
         result.newton_iterations = its
         result.wall_s = time.perf_counter() - start
-        if hasattr(self.rod, "get_state"):
-            result.state = self.rod.get_state()
+        result.state = self.rod.get_state()  # None on the planar rod
         return result
 
     def mean_tension(self) -> float:
         """The mean of the tension along s, int_0^1 T ds~ (normalised, Eq. 29), in
         the current state; every rank gets it.  Collective."""
-        if not hasattr(self, "_mean_tension_form"):
+        if self._mean_tension_form is None:
             self._mean_tension_form = dolfinx.fem.form(self.tension_expr * ufl.dx(self.rod.mesh))
         local = dolfinx.fem.assemble_scalar(self._mean_tension_form)
         return float(self.rod.comm.allreduce(local, op=MPI.SUM))

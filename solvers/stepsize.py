@@ -35,6 +35,7 @@ import math
 from dataclasses import dataclass
 
 from rawehelix.errors import SceneError
+from rawehelix.parameters import schemes
 from rawehelix.solvers import analytic
 
 #: the largest omega dt a fixed step may have (2 pi / THETA_MAX ~ 6.3 steps per
@@ -78,7 +79,7 @@ def check(params, f1_Hz=None, fixed_steps: bool | None = None):
     moving = params.ends.circle_radius_m > 0 if f1_Hz is not None else params.normalised().moving_end
     if fixed_steps is None:
         fixed_steps = moving
-    if params.discretisation.scheme != "fe" or not (fixed_steps and moving):
+    if not schemes.of(params).fixed_time_step or not (fixed_steps and moving):
         return None
     values = [f1_Hz] if f1_Hz is None or isinstance(f1_Hz, (int, float)) else list(f1_Hz)
     worst = min((limit(params, f) for f in values), key=lambda lim: lim.dt_max_s)

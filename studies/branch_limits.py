@@ -281,8 +281,7 @@ class OrbitLimits:
         """The orbit's block (t from the period's phase 0)."""
         key = id(orbit)
         if key not in self._blocks:
-            sections = (self.m.sections(orbit.X, orbit.f1_Hz, steps=orbit.steps)
-                        if hasattr(self.m, "sections") else None)
+            sections = self.m.sections(orbit.X, orbit.f1_Hz, steps=orbit.steps)
             self._blocks[key] = (orbit, point_block(self.params, sections))
         return self._blocks[key][1]
 

@@ -89,13 +89,16 @@ def values_of(vary: Variable) -> list[float]:
     return [cast(vary.key, v) for v in np.linspace(vary.start, vary.stop, count)]
 
 
+def _has(holder, name: str) -> bool:
+    """``holder`` is a scene section (a dataclass) with a field ``name``."""
+    return dataclasses.is_dataclass(holder) and name in {f.name for f in dataclasses.fields(holder)}
+
+
 def params_at(params: Parameters, key: str, value) -> Parameters:
     """``params`` with the dotted scene key set (SceneError for a key the scene has not)."""
     section, _, name = key.partition(".")
-    holder = getattr(params, section, None)
-    if holder is None and hasattr(params.model, section):  # [damping], [section], ...
-        holder = getattr(params.model, section)
-    if holder is None or not name or not hasattr(holder, name):
+    holder = params if _has(params, section) else params.model  # [damping], ...: the model's
+    if not _has(holder, section) or not _has(getattr(holder, section), name):
         raise SceneError("--vary", key, "is not a scene key (example.toml lists them)")
     try:
         return params.replace(**{section: {name: value}})

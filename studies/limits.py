@@ -4,7 +4,7 @@ command returns a wrong number without saying so."""
 from __future__ import annotations
 
 from rawehelix.errors import SceneError
-from rawehelix.parameters import Parameters
+from rawehelix.parameters import Parameters, schemes
 
 
 def check_bending_resolution(params: Parameters, command: str):
@@ -14,7 +14,7 @@ def check_bending_resolution(params: Parameters, command: str):
     is not refused: its summary reports its own distance to the shooting
     reference, and Newton fails loudly where it cannot converge."""
     disc = params.discretisation
-    if disc.scheme == "fe" and disc.bending == "ip" and disc.elements > disc.ip_limit():
+    if schemes.of(params).fe_assembled and disc.bending == "ip" and disc.elements > disc.ip_limit():
         raise SceneError(params.name, "discretisation.elements",
                          f"{disc.elements} is past the limit N <= {disc.ip_limit()} of "
                          f"discretisation.bending = 'ip' at degree {disc.degree} for '{command}' "

@@ -273,8 +273,9 @@ def report(result: ModesResult) -> str:
     """What ``rawehelix modes`` prints: a header, the table, and a note on
     any family with fewer modes than asked for."""
     info = result.info
+    scheme = schemes.get(info["scheme"])
     disc = (f"N = {info['elements']}, p = {info['degree']} ({info['dofs']} dofs, "
-            if info["scheme"] == "fe" else f"N = {info['elements']} (")
+            if scheme.has_degree else f"N = {info['elements']} (")
     lines = [f"Modes of the stationary state, scheme {info['scheme']}, {disc}"
              f"{info['wall_s']:.2f} s), ascending frequency", format_table(result)]
     if any(m.family == OVERDAMPED for m in result):
@@ -284,7 +285,7 @@ def report(result: ModesResult) -> str:
         lines.append(f"note: fewer than {PER_FAMILY} oscillating modes found for "
                      f"{info['missing_families']}: try more elements (--elements)"
                      + (" or -rawehelix_pep_nev; a family may have no more oscillating modes "
-                        "(overdamped)" if info["scheme"] == "fe" else ""))
+                        "(overdamped)" if scheme.fe_assembled else ""))  # SLEPc's option
     return "\n".join(lines)
 
 

@@ -14,8 +14,10 @@ METHODS = ("shooting", "hb", "auto")
 def cannot(params: Parameters) -> str | None:
     """Why harmonic balance cannot trace ``params``'s orbits (None: it can): an
     internal variable or a free rotation breaks its unknowns."""
-    if params.discretisation.scheme != "fe":
-        return "the spline reference has a period map only (shooting)"
+    from rawehelix.studies import schemes
+    refusal = schemes.of(params).harmonic_balance_refusal
+    if refusal:
+        return refusal
     from rawehelix.solvers import harmonic_balance
     return harmonic_balance.cannot(params)
 

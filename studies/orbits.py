@@ -79,8 +79,9 @@ class OrbitsResult:
 
     @property
     def discretisation(self) -> str:
-        if self.scheme == "spline":
-            return f"spline N = {self.elements}, Radau"
+        scheme = schemes.get(self.scheme)
+        if not scheme.has_degree:  # the spline reference: N and its adaptive integrator
+            return f"{scheme.name} N = {self.elements}, {scheme.integrator}"
         if self.method == "hb":
             Hs = [p["accuracy"]["H"] for p in self.branch if "accuracy" in p] or [0]
             return (f"N = {self.elements}, p = {self.degree}, harmonic balance H = "

@@ -40,7 +40,16 @@ def _existing(path: Path) -> Path:
 
 
 def estimate_bytes(command: str, points: int = 0, extra_bytes: float = 0.0) -> float:
-    return OUTPUT_BYTES.get(command, 50 * MB) + BYTES_PER_POINT * points + extra_bytes
+    """The disk ``command`` writes [bytes]: :data:`OUTPUT_BYTES`, its points, ``extra_bytes``;
+    an internal error for a command registered without its estimate
+    (tests/test_resource_keys.py)."""
+    try:
+        base = OUTPUT_BYTES[command]
+    except KeyError:
+        raise KeyError(f"internal: command {command!r} has no output estimate in "
+                       f"studies/outdir.py OUTPUT_BYTES (registered: {sorted(OUTPUT_BYTES)})"
+                       ) from None
+    return base + BYTES_PER_POINT * points + extra_bytes
 
 
 def check(outdir, command: str, points: int = 0, option: str = "-o", extra_bytes: float = 0.0):

@@ -53,11 +53,13 @@ import math
 import os
 
 from rawehelix.errors import SceneError
-from rawehelix.parameters import Parameters
+from rawehelix.parameters import Parameters, schemes
+from rawehelix.parameters.schemes import FECore
 
 BASE_BYTES = 0.25e9  # Python, DOLFINx, PETSc, matplotlib: the smallest run's peak RSS
-#: bytes per FE unknown of each command's heaviest step (module docstring)
-BYTES_PER_DOF = {"stationary": 1.5e3, "dynamics": 1.5e3, "modes": 22e3}
+#: bytes per FE unknown of each command's heaviest step (module docstring; the scheme's
+#: memory_bytes, parameters/schemes.py, counts a run's working memory)
+BYTES_PER_DOF = FECore.BYTES_PER_UNKNOWN
 #: the step that sets each command's (and each study stage's) memory
 HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dynamics",
             "spin_up": "dynamics", "sweep": "dynamics", "converge": "modes",
@@ -68,7 +70,6 @@ HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dy
             # worst (modes) for the command as a whole
             "study": "modes", "calibrate": "modes",
             "extremes": "modes"}  # its cases' eigenproblems
-SPLINE_BYTES_PER_N2 = 4.5e3  # the spline scheme's dense matrices: bytes per N^2
 BYTES_PER_POINT = 2e3  # a sweep's, response's or study's record of one point
 SECONDS_PER_POINT = 0.01  # the least a point costs (a stationary solve at N = 2)
 WALL_LIMIT_S = 30 * 86400.0  # a count longer than this at the least cost is refused
@@ -90,24 +91,23 @@ def _gb(x: float) -> str:
     return f"{x / 1e9:.3g} GB" if x < 1e12 else f"{x / 1e12:,.0f} TB"
 
 
-def unknowns(params: Parameters, planar: bool = False) -> int:
-    """The FE unknowns of the rod: (r, alpha) in P_p, 4 components (2 on the
-    planar (x, z) rod), + 3 for the mixed form's curvature, + DG_(p-1) z for the
-    hysteretic torsion (compat.rod_element)."""
-    disc = params.discretisation
-    nodes = disc.degree * disc.elements + 1
-    comps = 2 if planar else 4 + 3 * (disc.bending == "mixed")
-    internal = disc.degree * disc.elements if params.model.torsion_hysteresis.active else 0
-    return comps * nodes + internal
+#: the FE unknowns of the rod (parameters/schemes.py::FECore.unknowns)
+unknowns = FECore().unknowns
+
+
+def heaviest(command: str) -> str:
+    """The step that sets ``command``'s memory (:data:`HEAVIEST`); an internal error
+    for a command registered without one (tests/test_resource_keys.py)."""
+    try:
+        return HEAVIEST[command]
+    except KeyError:
+        raise KeyError(f"internal: command {command!r} has no memory step in "
+                       f"studies/resources.py HEAVIEST (registered: {sorted(HEAVIEST)})") from None
 
 
 def estimate_bytes(params: Parameters, command: str) -> float:
     """The peak memory of ``command`` on ``params`` (all ranks together) [bytes]."""
-    disc = params.discretisation
-    if disc.scheme == "spline":
-        return BASE_BYTES + SPLINE_BYTES_PER_N2 * float(disc.elements) ** 2
-    step = HEAVIEST.get(command, "modes")
-    return BASE_BYTES + BYTES_PER_DOF[step] * unknowns(params)
+    return BASE_BYTES + schemes.of(params).memory_bytes(params, heaviest(command))[0]
 
 
 def check(params: Parameters, command: str, copies: int = 1):
@@ -115,19 +115,18 @@ def check(params: Parameters, command: str, copies: int = 1):
     when its estimate passes the machine's memory, or (orbits, FE) when the
     dense monodromy passes MAX_STATE; before anything is allocated."""
     disc = params.discretisation
+    scheme = schemes.of(params)
     need = copies * estimate_bytes(params, command)
     have = machine_bytes()
     if need > have:
-        how = ("the spline scheme's dense matrices, 4.5 kB N^2" if disc.scheme == "spline"
-               else f"{unknowns(params)} unknowns at "
-                    f"{BYTES_PER_DOF[HEAVIEST.get(command, 'modes')] / 1e3:g} kB each")
+        how = scheme.memory_bytes(params, heaviest(command))[1]
         raise SceneError(params.name, "discretisation.elements",
                          f"{disc.elements}: '{command}' needs about {_gb(need)} ({how}"
                          + (f", {copies} at once" if copies > 1 else "")
                          + f"), more than the {_gb(have)} this machine has (the limit: its "
                          f"physical memory; estimates in studies/resources.py); use fewer "
                          f"elements")
-    if command == "orbits" and disc.scheme == "fe":
+    if command == "orbits" and scheme.fe_assembled:  # the FE period map's dense monodromy
         from rawehelix.solvers.orbits import MAX_STATE
         n = unknowns(params)
         if 3 * n > MAX_STATE:
@@ -243,7 +242,7 @@ def check_sweep(params: Parameters, count: int, f1_max_Hz: float, key: str, copi
                 f"sweep.samples_per_period = {sw.samples_per_period:g}, sweep.record_periods = "
                 f"{sw.record_periods:g}, sweep.max_periods = {sw.max_periods:g}", need, have,
                 f"fewer points ({key}), samples or periods")
-    if params.discretisation.scheme == "fe" and f1_max_Hz is not None and \
+    if schemes.of(params).fixed_time_step and f1_max_Hz is not None and \
             0 < f1_max_Hz < math.inf:  # else refused by the sweep's own check of f1
         steps = count * sw.min_periods / (f1_max_Hz * params.time.dt_s)
         _refuse_wall("sweep.min_periods", f"{sw.min_periods:g}", f"{count:g} points of at least "
@@ -264,10 +263,9 @@ def orbit_size(params: Parameters, method: str = "hb") -> int:
     """The entries of an orbit's unknown X: harmonic balance's (2 H + 1) unknowns at its
     first H (H_START: it grows where the orbit needs it), shooting's state (3n), the
     spline scheme's 8 N."""
-    if params.discretisation.scheme == "spline":
-        return 8 * params.discretisation.elements
-    if method == "shooting":
-        return 3 * unknowns(params)
+    scheme = schemes.of(params)
+    if method == "shooting" or scheme.harmonic_balance_refusal:  # its period map's state
+        return scheme.period_state_size(params)
     from rawehelix.solvers.harmonic_balance import H_START
     return (2 * H_START + 1) * unknowns(params)
 

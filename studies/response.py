@@ -34,7 +34,7 @@ from mpi4py import MPI
 
 from rawehelix.families import FAMILY_LABELS
 from rawehelix.parameters import Parameters
-from rawehelix.studies import limits, writers
+from rawehelix.studies import limits, schemes, writers
 from rawehelix.studies.scene import SceneError
 
 #: the curves whose local maxima are peaks (ResponsePoint attributes)
@@ -72,7 +72,7 @@ class ResponseResult:
 
 def check(params: Parameters, command: str = "response"):
     """Refuse a scene the response cannot run (SceneError)."""
-    if params.discretisation.scheme != "fe":
+    if not schemes.of(params).fe_assembled:
         raise SceneError(params.name, "discretisation.scheme",
                          f"'{command}' linearises the FE scheme (--scheme fe)")
     if not params.ends.circle_radius_m > 0:

@@ -26,7 +26,7 @@ from mpi4py import MPI
 
 from rawehelix.families import LATERAL
 from rawehelix.parameters import SCHEMES, Parameters
-from rawehelix.parameters.numerics import check_scheme
+from rawehelix.parameters.schemes import CORES, FECore, SchemeCore, SplineCore, check_scheme
 
 
 @dataclass
@@ -44,13 +44,11 @@ class Spectrum:
     comm: object = None  # the communicator the result is broadcast on (None: computed on each)
 
 
-class Scheme:
-    """What a study needs of a discretisation scheme (one instance per name)."""
+class Scheme(SchemeCore):
+    """What a study needs of a discretisation scheme (one instance per name), beyond
+    the decisions of its core below the solvers (parameters/schemes.py: its degree,
+    time step, FE assembly, unknowns, memory, harmonic balance)."""
 
-    name: str
-    #: the run has a Lagrange degree p and a fixed time step dt (FE), or not (spline)
-    has_degree: bool
-    fixed_time_step: bool
     #: why ``rawehelix simulate`` refuses the scheme (None: it runs it)
     simulate_refusal: str | None = None
 
@@ -87,8 +85,7 @@ class Scheme:
         raise NotImplementedError
 
 
-class FE(Scheme):
-    name, has_degree, fixed_time_step = "fe", True, True
+class FE(FECore, Scheme):
 
     def stationary_tension_N(self, params):
         from rawehelix.solvers.stationary import StationarySolver
@@ -160,8 +157,7 @@ class FE(Scheme):
         return q.time_s(rows[:, 0]), q.spin_rpm(rows[:, 1:])
 
 
-class Spline(Scheme):
-    name, has_degree, fixed_time_step = "spline", False, False
+class Spline(SplineCore, Scheme):
     simulate_refusal = ("'simulate' runs the FE scheme (the spline reference is "
                         "solvers.spline_galerkin.dynamics)")
 
@@ -209,7 +205,8 @@ class Spline(Scheme):
 
 #: every scheme by name
 SCHEME_REGISTRY: dict[str, Scheme] = {s.name: s for s in (FE(), Spline())}
-assert tuple(SCHEME_REGISTRY) == SCHEMES, "the registry names the schemes of parameters.SCHEMES"
+assert tuple(SCHEME_REGISTRY) == SCHEMES == tuple(CORES), \
+    "the registry names the schemes of parameters.SCHEMES, each with its core"
 
 
 def get(name: str) -> Scheme:

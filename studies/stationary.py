@@ -13,7 +13,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import structure_limits, writers
+from rawehelix.studies import schemes, structure_limits, writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -133,7 +133,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     ``ends`` block gives both."""
     from rawehelix.studies import reference_check
 
-    if params.discretisation.scheme != "fe":
+    if not schemes.of(params).fe_assembled:
         raise SceneError(params.name, "discretisation.scheme",
                          "'stationary' runs the FE scheme; the spline reference's stationary "
                          "state is part of 'modes'")

@@ -39,7 +39,6 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
-from rawehelix.solvers.section_samples import SectionSampler
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import branch_limits, limits, schemes, writers
 from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
@@ -49,8 +48,8 @@ def make_backend(params: Parameters, comm, track: bool = True):
     """The integrator for the scene's scheme; with ``track``, and a backend that has
     the rod's fields along s (FE), it samples the section for the limits block."""
     backend = schemes.of(params).forced_backend(params, comm)
-    if track and hasattr(backend, "section_sampler"):
-        backend.section_sampler = SectionSampler(backend.solver)
+    if track:
+        backend.track_sections()
     return backend
 
 

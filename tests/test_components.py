@@ -54,3 +54,51 @@ def test_group_of_an_active_section_reaches_normalised():
     q = p.normalised()
     assert q.tau_axial == pytest.approx(0.5 / q.t_scale, rel=1e-15)
     assert p.model.damping.axial_s == 0.5 and p.value("damping.axial_s") == 0.5
+
+
+def _implementations():
+    """Every class of each component of forms/coefficients.py, null objects included."""
+    from rawehelix.forms import coefficients, damping, eilaw, hysteresis, section_law
+    from rawehelix.forms.components import BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw
+    return [(Kinematics, cls) for cls in coefficients.KINEMATICS.values()] + [
+        (Damping, damping.KelvinVoigt), (Damping, damping.NoneDamping),
+        (BendingLaw, eilaw.TensionDependentBending), (BendingLaw, eilaw.ConstantBending),
+        (Hysteresis, hysteresis.BoucWen), (Hysteresis, hysteresis.NoneHysteresis),
+        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.TensegritySection),
+        (SectionLaw, section_law.SaturatingSection)]
+
+
+@pytest.mark.parametrize("protocol, cls", _implementations(),
+                         ids=lambda x: getattr(x, "__name__", str(x)))
+def test_each_component_class_gives_its_protocol(protocol, cls):
+    """What the forms call on a component is declared (forms/components.py), and each
+    implementation, null object included, has it (typing.Protocol's runtime check
+    looks for every member)."""
+    members = [m for m in vars(protocol) if not m.startswith("_")] + \
+        list(getattr(protocol, "__annotations__", {}))
+    missing = [m for m in members if not hasattr(cls, m)]
+    assert missing == [], (cls.__name__, missing)
+
+
+@pytest.mark.parametrize("name, overrides", [
+    ("nominal_operation", {}),
+    ("mobile_end", {"damping.axial_s": 0.01, "torsion_hysteresis.rho": 0.5,
+                    "torsion_hysteresis.beta_m_n": 1.0}),
+    ("stationary_table2", {"section.law": "tensegrity", "model.kinematics": "extensible"}),
+])
+def test_the_coefficients_components_are_built_from_the_registry(name, overrides):
+    """Coefficients types each component by its protocol and builds them from
+    forms/coefficients.py::COMPONENTS (a new component: one entry there)."""
+    import typing
+    from rawehelix.forms import coefficients
+    p = scene.load(name, elements=2, overrides=overrides)
+    c = coefficients.Coefficients.from_normalised(p.normalised(), p.model)
+    hints = typing.get_type_hints(coefficients.Coefficients)
+    for field in [*coefficients.COMPONENTS, "kinematics"]:
+        assert getattr(hints[field], "_is_protocol", False), field
+        assert isinstance(getattr(c, field), hints[field]), field
+    assert type(c.damping).__name__ == ("KelvinVoigt" if p.model.damping.active
+                                        else "NoneDamping")
+    assert type(c.hysteresis).__name__ == ("BoucWen" if p.model.torsion_hysteresis.active
+                                           else "NoneHysteresis")
+    assert c.section.name == p.model.section.law

@@ -99,3 +99,23 @@ def test_the_disk_estimate_counts_the_points(tmp_path, monkeypatch, capsys, argv
     need = float(line.split("the about ")[1].split(" MB")[0])
     assert estimate_MB < need < 3 * estimate_MB, line
     assert not (tmp_path / "o").exists()
+
+
+def test_every_study_stage_has_its_memory_step():
+    """A study's or a calibration's point is checked stage by stage
+    (resources.check_quantities): each stage of studies/quantities.py has its row."""
+    from rawehelix.studies.quantities import STAGES
+    assert sorted(set(STAGES) - set(resources.HEAVIEST)) == []
+
+
+@pytest.mark.parametrize("lookup", [
+    lambda: resources.estimate_bytes(scene.load("mobile_end", elements=2), "no_such_command"),
+    lambda: resources.check(scene.load("mobile_end", scheme="spline", elements=2), "no_such_command"),
+    lambda: outdir.estimate_bytes("no_such_command"),
+])
+def test_an_unregistered_command_is_an_internal_error_not_a_default(lookup):
+    """No silent fall-back: a command without its rows is an internal error naming
+    the table and the command (it used to be estimated as 'modes' and 50 MB)."""
+    with pytest.raises(KeyError, match=r"internal: command 'no_such_command' has no .* in "
+                                       r"studies/(resources|outdir)\.py"):
+        lookup()

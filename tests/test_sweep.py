@@ -273,6 +273,7 @@ class DecayingOscillation:
         return state, T * (1 + self.noise * self.rng.standard_normal(t.size))
 
     pack = unpack = staticmethod(lambda s: s)
+    section_sampler = None  # the backend interface (solvers/periodic.py): no fields along s
 
 
 @pytest.mark.parametrize("tau_periods", [3.0, 10.0])

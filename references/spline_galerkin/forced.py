@@ -16,6 +16,10 @@ from .system import SplineGalerkin
 
 class SplineBackend:
     scheme = "spline"
+    section_sampler = None  # no fields along s to sample (solvers/periodic.py)
+
+    def track_sections(self) -> None:
+        """Nothing to track: the spline state has no section along s (the limits block)."""
 
     def __init__(self, q: Normalised, N: int, rtol: float = 1e-7, atol: float = 1e-9):
         self.q, self.N, self.rtol, self.atol = q, N, rtol, atol
