@@ -76,6 +76,7 @@ class Kinematics:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
+        # dispatch-ok: a subclass is checked for the decisions its definition must make
         undecided = [k for k in cls.DECISIONS if not hasattr(cls, k)]
         if undecided:
             raise TypeError(f"the kinematics {cls.__name__} does not decide {undecided} "
