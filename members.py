@@ -67,27 +67,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# the laws written once for numpy and UFL (section_math.py)
+from rawehelix.section_math import Cone, ramp_energy, smooth_ramp
+
 #: the limit criteria, in the order of :func:`first_limit`'s ties
 CRITERIA = ("slack", "breaking", "moment_saturation", "torsional_collapse")
-
-
-def smooth_ramp(e, w):
-    """<e>_w = (e + sqrt(e^2 + w^2)) / 2: max(e, 0) for w = 0, smooth for w > 0."""
-    e = np.asarray(e, dtype=float)
-    return 0.5 * (e + np.sqrt(e * e + w * w))
-
-
-def ramp_energy(e, w):
-    """Phi_w(e) = int_0^e <x>_w dx = (e^2 + e sqrt(e^2 + w^2) + w^2 ln((e + sqrt(e^2 + w^2)) / w)) / 4;
-    for w = 0, max(e, 0)^2 / 2.  (<x>_w ~ w^2 / (4 |x|) in the slack, so Phi_w falls like
-    w^2 ln|e| / 4 there: convex and nondecreasing, its offset from 0 below w^2.)"""
-    e = np.asarray(e, dtype=float)
-    if w == 0:
-        return 0.5 * np.maximum(e, 0.0) ** 2
-    root = np.sqrt(e * e + w * w)
-    # e + root loses digits for e << -w: there it is w^2 / (root - e)
-    plus = np.where(e >= 0, e + root, w * w / np.maximum(root - e, 1e-300))
-    return 0.25 * (e * e + e * root + w * w * np.log(plus / w))
 
 
 def critical_twist(R: float, l_t: float) -> float:
@@ -321,30 +305,15 @@ class ConeSection:
         if self.width < 0:
             raise ValueError(f"ConeSection.width = {self.width!r}: must be >= 0")
 
-    @property
-    def _DS(self):
-        cR = self.c * self.R
-        return 1 / self.EA + cR * cR / self.EI, self.EI + cR * cR * self.EA
-
-    def _xv(self, eps, kappa):
-        eps, kappa = np.asarray(eps, dtype=float), np.abs(np.asarray(kappa, dtype=float))
-        cR = self.c * self.R
-        return eps + cR * kappa, eps - self.EI * kappa / (cR * self.EA)
+    def _law(self) -> Cone:
+        return Cone(self.EA, self.EI, self.c * self.R, self.width)
 
     def energy(self, eps, kappa):
-        """W [N = J/m] per unit length (above)."""
-        D, S = self._DS
-        x, v = self._xv(eps, kappa)
-        cRA = self.c * self.R * self.EA
-        return ramp_energy(x, self.width) / D + cRA * cRA * ramp_energy(v, self.width) / S
+        """W [N = J/m] per unit length (above; :class:`Cone`, the FE rod's law too)."""
+        return self._law().W(np.asarray(eps, dtype=float), np.abs(np.asarray(kappa, dtype=float)))
 
     def resultants(self, eps, kappa) -> dict:
         """N = dW/d eps [N], M = dW/d kappa [N m] (the sign of kappa)."""
-        D, S = self._DS
-        x, v = self._xv(eps, kappa)
-        cR = self.c * self.R
-        cRA = cR * self.EA
-        px, pv = smooth_ramp(x, self.width), smooth_ramp(v, self.width)
-        N = px / D + cRA * cRA * pv / S
-        M = np.sign(np.asarray(kappa, dtype=float)) * (cR * px / D - cRA * self.EI * pv / S)
-        return {"N": N, "M": M}
+        kappa = np.asarray(kappa, dtype=float)
+        N, M = self._law().dW(np.asarray(eps, dtype=float), np.abs(kappa))
+        return {"N": N, "M": np.sign(kappa) * M}
