@@ -68,7 +68,7 @@ from dataclasses import dataclass
 import numpy as np
 
 # the laws written once for numpy and UFL (section_math.py)
-from rawehelix.section_math import Cone, ramp_energy, smooth_ramp
+from rawehelix.section_math import Cone, TetherRing, ramp_energy, smooth_ramp
 
 #: the limit criteria, in the order of :func:`first_limit`'s ties
 CRITERIA = ("slack", "breaking", "moment_saturation", "torsional_collapse")
@@ -138,18 +138,22 @@ class Members:
         psi the ring's phase (module docstring)."""
         return self.phi + np.asarray(psi, dtype=float)[..., None]
 
-    def _stretch(self, eps, kappa, tau, psi=0.0):
-        """(a, b, l): the axial and tangential advance per unit rod length, and
-        l = sqrt(a^2 + b^2), each of shape (..., n)."""
-        eps, kappa, tau = (np.asarray(x, dtype=float)[..., None] for x in (eps, kappa, tau))
-        a = 1 + eps - self.R * kappa * np.cos(self.phases(psi))
-        b = self.R * tau + math.tan(self.beta) + 0 * a
-        return a, b, np.sqrt(a * a + b * b)
+    def law(self) -> TetherRing:
+        """The tethers' law in SI numbers (section_math.py::TetherRing, the FE rod's too),
+        the twist read."""
+        return TetherRing(self.n, self.R, self.beta, self.k, self.e0, self.EA_b, self.e_b0,
+                          self.width, torsion=True)
+
+    def _state(self, eps, kappa, tau, psi):
+        """(eps, kappa, tau as arrays, the members' bends kappa cos(phi_m + psi), the phases)."""
+        eps, kappa, tau = (np.asarray(x, dtype=float) for x in (eps, kappa, tau))
+        phases = self.phases(psi)
+        return eps, kappa, tau, [kappa * np.cos(phases[..., i]) for i in range(self.n)], phases
 
     def strains(self, eps, kappa, tau=0.0, psi=0.0):
         """e_m (..., n): each member's strain, slack where <= 0."""
-        _, _, l = self._stretch(eps, kappa, tau, psi)
-        return math.cos(self.beta) * l - 1 + self.e0
+        eps, kappa, tau, bends, _ = self._state(eps, kappa, tau, psi)
+        return _members_axis(self.law().member_strains(eps, kappa, tau, bends))
 
     def forces(self, eps, kappa, tau=0.0, psi=0.0):
         """k <e_m>_w [N], (..., n)."""
@@ -157,23 +161,21 @@ class Members:
 
     def energy(self, eps, kappa, tau=0.0, psi=0.0):
         """W [N = J/m]: the members' and the bars' stored energy per unit rod length."""
-        e = self.strains(eps, kappa, tau, psi)
-        tethers = self.k / math.cos(self.beta) * ramp_energy(e, self.width).sum(axis=-1)
-        eps, tau = np.asarray(eps, dtype=float), np.asarray(tau, dtype=float)
-        return tethers + 0.5 * self.EA_b * (eps + self.e_b0) ** 2 + self.Q_b0 * tau
+        eps, kappa, tau, bends, _ = self._state(eps, kappa, tau, psi)
+        return self.law().W(eps, kappa, tau, bends)
 
     def resultants(self, eps, kappa, tau=0.0, psi=0.0) -> dict:
         """N [N], M [N m] (>= 0 for kappa >= 0 at psi = 0), Q [N m]: dW/d(eps, kappa, tau);
         and the ring's torque about the axis from its phase, dW/d psi [N m] (zero at
         psi = 0 by symmetry, and whenever every member is taut and linear)."""
-        a, b, l = self._stretch(eps, kappa, tau, psi)
-        f = self.forces(eps, kappa, tau, psi)  # de/d(.) = cos(beta) (a da + b db) / l; x 1/cos(beta)
-        phases = self.phases(psi)
-        N = (f * a / l).sum(axis=-1) + self.EA_b * (np.asarray(eps, dtype=float) + self.e_b0)
-        M = (f * a / l * (-self.R * np.cos(phases))).sum(axis=-1)
-        Q = (f * b / l * self.R).sum(axis=-1) + self.Q_b0
-        kappa = np.asarray(kappa, dtype=float)
-        W_psi = (f * a / l * self.R * kappa[..., None] * np.sin(phases)).sum(axis=-1)
+        eps, kappa, tau, bends, phases = self._state(eps, kappa, tau, psi)
+        forces = self.law().member_forces(eps, kappa, tau, bends)  # dW/da_m, its lever b / l
+        fa = _members_axis([x for x, _ in forces])
+        fb = _members_axis([x for _, x in forces])
+        N = fa.sum(axis=-1) + self.EA_b * (eps + self.e_b0)
+        M = (fa * (-self.R * np.cos(phases))).sum(axis=-1)
+        Q = (fb * self.R).sum(axis=-1) + self.Q_b0
+        W_psi = (fa * self.R * kappa[..., None] * np.sin(phases)).sum(axis=-1)
         return {"N": N, "M": M, "Q": Q, "W_psi": W_psi}
 
     def tangent(self, eps=0.0, kappa=0.0, tau=0.0, h: float = 1e-7) -> dict:
@@ -259,6 +261,11 @@ class Members:
         if self.ring_spacing_m is None:
             return np.full(np.shape(tau), np.nan)
         return self.ring_spacing_m * (np.asarray(tau, dtype=float) + math.tan(self.beta) / self.R)
+
+
+def _members_axis(per_member: list) -> np.ndarray:
+    """The members' values [x_0, ..., x_n-1] on a last axis (..., n)."""
+    return np.stack(np.broadcast_arrays(*per_member), axis=-1)
 
 
 def phase_spread(members: Members, eps: float, kappa: float, tau: float = 0.0,

@@ -7,8 +7,7 @@ for the FE rod's UFL and the numpy of the limits.
 * the registry refuses an unknown name once, with the list the scene's check gives;
 * the solid is a complete null object: it answers every question the product asks of
   a scene's section component;
-* the two aggregations of the tethers' law that remain (section_math.py::TetherRing
-  over a list of members, members.py::Members over an axis of phases) agree.
+* the law written once (section_math.py) is members.py's docstring's in numpy.
 (The UFL halves against numpy: tests/test_section_law.py.)
 """
 
@@ -24,7 +23,7 @@ import pytest
 from rawehelix import section_laws
 from rawehelix.parameters import ParameterError
 from rawehelix.parameters.section import LAWS, Section
-from rawehelix.section_math import NUMPY, TetherRing
+from rawehelix.section_math import ramp_energy
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the folders where a law's name may be tested: the scene's checks and what is not product
@@ -120,26 +119,27 @@ def test_the_solid_is_a_complete_null_object():
                 == list(inspect.signature(member).parameters)[:4]), name
 
 
-@pytest.mark.parametrize("lay, P0, EA_b, torsion", [(0.0, 0.0, 0.0, False), (20.0, 150.0, 2e4, True)])
-def test_the_ring_law_is_the_members_law(lay, P0, EA_b, torsion):
-    """TetherRing (the FE rod's law, here in numpy) and Members (the limits' law) give
-    the same W, N, M and Q at sampled strains, taut and slack (SI numbers in both)."""
+@pytest.mark.parametrize("lay, P0, EA_b", [(0.0, 0.0, 0.0), (20.0, 150.0, 2e4)])
+def test_the_written_once_law_is_members_docstring(lay, P0, EA_b):
+    """Members (numpy, through section_math.py::TetherRing, the FE rod's law too) gives
+    the members' strains of members.py's docstring at every phase, and W = sum_m
+    (k / cos beta) Phi_w(e_m) + EA_b / 2 (eps + e_b0)^2 + Q_b0 tau, taut and slack."""
     m = Section(law="tensegrity", lay_angle_deg=lay, self_stress_N=P0, bar_EA_N=EA_b,
                 tether_EA_N=6000.0, radius_m=0.5, slack_width=1e-4).members(_Helix())
-    ring = TetherRing(m.n, m.R, m.beta, m.k, m.e0, m.EA_b, m.e_b0, m.width, torsion=True, m=NUMPY)
+    cb, tb = np.cos(m.beta), np.tan(m.beta)
+    psi = np.array([0.0, 0.3])
     seen_slack = 0
     for eps in (-2e-3, 0.0, 1e-3, 5.5e-3):
         for kappa in (0.0, 0.005, 0.05, 0.3):
-            for tau in ((0.0, 0.02) if torsion else (0.0,)):
-                want = m.resultants(eps, kappa, tau)
-                N, M = ring.dW(eps, kappa, tau)
-                assert float(ring.W(eps, kappa, tau)) == pytest.approx(
-                    float(m.energy(eps, kappa, tau)), rel=1e-12, abs=1e-12)
-                assert float(N) == pytest.approx(float(want["N"]), rel=1e-12, abs=1e-9)
-                assert float(M) == pytest.approx(float(want["M"]), rel=1e-12, abs=1e-9)
-                assert float(ring.torque(eps, kappa, tau)) == pytest.approx(
-                    float(want["Q"]), rel=1e-12, abs=1e-9)
-                seen_slack += bool((m.strains(eps, kappa, tau) <= 0).any())
+            for tau in (0.0, 0.02):
+                phi = m.phi + psi[:, None]
+                e = cb * np.sqrt((1 + eps - m.R * kappa * np.cos(phi))**2 + (m.R * tau + tb)**2) \
+                    - 1 + m.e0
+                assert np.allclose(m.strains(eps, kappa, tau, psi), e, rtol=1e-13, atol=1e-15)
+                W = (m.k / cb * ramp_energy(e, m.width).sum(axis=-1)
+                     + 0.5 * m.EA_b * (eps + m.e_b0)**2 + m.Q_b0 * tau)
+                assert np.allclose(m.energy(eps, kappa, tau, psi), W, rtol=1e-13, atol=1e-12)
+                seen_slack += bool((e <= 0).any())
     assert seen_slack >= 3
 
 
