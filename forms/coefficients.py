@@ -60,7 +60,7 @@ class Coefficients:
     hysteresis: Any = field(default_factory=NoneHysteresis)
     # the section law, a component (forms/section_law.py, chosen by the registry
     # section_laws.py): NonlinearSection of its law, or the null object SolidSection
-    section: Any = field(default_factory=section_law.SolidSection)
+    section: section_law.SectionComponent = field(default_factory=section_law.SolidSection)
     # the ENERGY_COMPONENTS of the scene
     extra: tuple = ()
 

@@ -72,6 +72,7 @@ nothing; sigma eps would).
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import ufl
 
@@ -125,6 +126,35 @@ def ramp(e, w):
 def ramp_energy(e, w):
     """Phi_w(e) (section_math.py::ramp_energy) in UFL, w > 0."""
     return _ramp_energy(e, w, UFL_MATH)
+
+
+class SectionComponent(Protocol):
+    """What the rod's forms, models and solvers ask of a scene's section (``c.section``):
+    the null object :class:`SolidSection` and every law's :class:`NonlinearSection`
+    answer all of it (tests/test_section_laws.py)."""
+
+    torsion: bool  # the members carry the twist
+    ring_turns: bool  # the members' phase turns with alpha
+
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None): ...
+
+    def axial_force(self, r, c, tau=0, alpha=None): ...
+
+    def axial_force_at(self, eps, kappa, c): ...
+
+    def bending_moment_at(self, eps, kappa, mu, curvature): ...
+
+    def sheared_density(self, eps, g, k, r, c): ...
+
+    def shear_stiffness(self, eps, kappa, c): ...
+
+    def wall_moment(self, x, c, tau, alpha, mu): ...
+
+    def twist_moment(self, r, tau, c, alpha=None): ...
+
+    def twist_energy(self, tau, c): ...
+
+    def ring_phase(self, r, c, alpha): ...
 
 
 class HelixTorsion:

@@ -108,15 +108,21 @@ def _calls_on_the_section():
 
 
 def test_the_solid_is_a_complete_null_object():
-    """Every method the product calls on ``c.section`` is the solid's too, with the
-    same parameters as the member laws' (forms/section_law.py)."""
+    """Every method the product calls on ``c.section`` is declared by the component's
+    Protocol, and the solid (the null object) and the member laws' class both give
+    each with the Protocol's parameters (forms/section_law.py)."""
     sl = pytest.importorskip("rawehelix.forms.section_law")
     called = _calls_on_the_section()
     assert {"energy", "twist_moment", "wall_moment", "sheared_density"} <= called
-    for name in called:
-        solid, member = getattr(sl.SolidSection, name), getattr(sl.NonlinearSection, name)
-        assert (list(inspect.signature(solid).parameters)[:4]
-                == list(inspect.signature(member).parameters)[:4]), name
+    declared = {n for n, x in vars(sl.SectionComponent).items()
+                if inspect.isfunction(x) and not n.startswith("_")}
+    assert called <= declared, f"declare them in SectionComponent: {called - declared}"
+    for name in declared:
+        want = list(inspect.signature(getattr(sl.SectionComponent, name)).parameters)
+        for cls in (sl.SolidSection, sl.NonlinearSection):
+            assert list(inspect.signature(getattr(cls, name)).parameters) == want, (cls, name)
+    for cls in (sl.SolidSection, sl.NonlinearSection):
+        assert all(hasattr(cls, a) for a in sl.SectionComponent.__annotations__), cls
 
 
 @pytest.mark.parametrize("lay, P0, EA_b", [(0.0, 0.0, 0.0), (20.0, 150.0, 2e4)])
