@@ -34,6 +34,9 @@ class SectionLaw:
     nonlinear = False
     #: the law is C-infinity at any strain (no slack kink, however regularised)
     smooth = True
+    #: its resultants are the members' own: they have a phase (section.ring), may carry
+    #: the twist (section.torsion) and give the shearable rod's GA
+    members = False
 
     def normalised(self, q, make=float, m=NUMPY):
         """The law in the FE rod's units (``q`` the scene's Normalised; ``make`` wraps the
@@ -61,7 +64,7 @@ class SectionLaw:
 class Tensegrity(SectionLaw):
     """The members' own law (members.py)."""
 
-    name, nonlinear, smooth = "tensegrity", True, False
+    name, nonlinear, smooth, members = "tensegrity", True, False, True
 
     def normalised(self, q, make=float, m=NUMPY):
         # the lay angle and the member count shape the form and stay numbers

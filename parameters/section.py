@@ -64,11 +64,12 @@ class Section:
             raise ParameterError("section.torsion", self.torsion, f"must be one of {list(TORSIONS)}")
         if self.ring not in RINGS:
             raise ParameterError("section.ring", self.ring, f"must be one of {list(RINGS)}")
-        if self.ring == "turning" and self.law != "tensegrity":
+        members = section_laws.get(self.law).members  # the law's resultants are its members'
+        if self.ring == "turning" and not members:
             raise ParameterError("section.ring", self.ring,
                                  "only the tensegrity's members have a phase: set section.law = "
                                  "'tensegrity' or ring = 'worst'")
-        if self.torsion == "members" and self.law != "tensegrity":
+        if self.torsion == "members" and not members:
             raise ParameterError("section.torsion", self.torsion,
                                  "the members carry the twist only with section.law = 'tensegrity'")
         if not (0 <= self.lay_angle_deg < 60):

@@ -95,6 +95,13 @@ def test_each_law_says_what_is_decided_by_it():
     assert not solid.nonlinear and solid.smooth and solid.normalised(None) is None
     assert tensegrity.nonlinear and not tensegrity.smooth
     assert saturating.nonlinear and not saturating.smooth
+    # the members' own resultants: a phase, the twist, GA (the scene's checks read it)
+    assert [x.members for x in (solid, tensegrity, saturating)] == [False, True, False]
+    for law in (solid, saturating):
+        for key, value in (("ring", "turning"), ("torsion", "members")):
+            with pytest.raises(ParameterError, match=f"section.{key}"):
+                Section(law=law.name, **{key: value})
+    assert Section(law="tensegrity", ring="turning", torsion="members").ring == "turning"
 
 
 def _calls_on_the_section():
