@@ -169,14 +169,11 @@ class Members:
         and the ring's torque about the axis from its phase, dW/d psi [N m] (zero at
         psi = 0 by symmetry, and whenever every member is taut and linear)."""
         eps, kappa, tau, bends, phases = self._state(eps, kappa, tau, psi)
-        forces = self.law().member_forces(eps, kappa, tau, bends)  # dW/da_m, its lever b / l
-        fa = _members_axis([x for x, _ in forces])
-        fb = _members_axis([x for _, x in forces])
-        N = fa.sum(axis=-1) + self.EA_b * (eps + self.e_b0)
-        M = (fa * (-self.R * np.cos(phases))).sum(axis=-1)
-        Q = (fb * self.R).sum(axis=-1) + self.Q_b0
-        W_psi = (fa * self.R * kappa[..., None] * np.sin(phases)).sum(axis=-1)
-        return {"N": N, "M": M, "Q": Q, "W_psi": W_psi}
+        N, M1, M2, Q = self.law().resultants(
+            eps, kappa, tau, bends,
+            [(np.cos(phases[..., i]), np.sin(phases[..., i])) for i in range(self.n)])
+        # dW/d psi: member m's bend kappa cos(phi_m + psi) turns by -kappa sin(...) d psi
+        return {"N": N, "M": M1, "Q": Q, "W_psi": -kappa * M2}
 
     def tangent(self, eps=0.0, kappa=0.0, tau=0.0, h: float = 1e-7) -> dict:
         """The tangent moduli EA = dN/d eps, EI = dM/d kappa, GJ = dQ/d tau at a state

@@ -109,11 +109,20 @@ class TetherRing:
                  self.k * smooth_ramp(e, self.width, self.m) * b / l)
                 for a, b, l, e in self._members(eps, kappa, tau, bends)]
 
+    def resultants(self, eps, kappa, tau=0, bends=None, phases=None):
+        """(N, M1, M2, Q): N = dW/d eps, the moment (M1, M2) = -R sum_m dW/da_m (cos, sin)
+        of member m's phase in the members' frame (M1 = dW/d kappa) and Q = dW/d tau;
+        ``phases`` [(cos, sin)] per member, phi_m's unless given (a ring's phase psi)."""
+        forces = self.member_forces(eps, kappa, tau, bends)
+        phases = [(math.cos(p), math.sin(p)) for p in self.phi] if phases is None else phases
+        N = self.EA_b * (eps + self.e_b0) + sum(fa for fa, _ in forces)
+        M1 = sum(-self.R * c * fa for (c, _), (fa, _) in zip(phases, forces))
+        M2 = sum(-self.R * s * fa for (_, s), (fa, _) in zip(phases, forces))
+        return N, M1, M2, self.Q_b0 + sum(self.R * fb for _, fb in forces)
+
     def dW(self, eps, kappa, tau=0, bends=None):
         """(N, M) of members.py::Members.resultants (M at the worst phase)."""
-        N, M = self.EA_b * (eps + self.e_b0), 0
-        for phi, (fa, _) in zip(self.phi, self.member_forces(eps, kappa, tau, bends)):
-            N, M = N + fa, M - fa * self.R * math.cos(phi)
+        N, M, _, _ = self.resultants(eps, kappa, tau, bends)
         return N, M
 
     def shear_stiffness(self, eps, kappa, helix_GA):
@@ -126,7 +135,7 @@ class TetherRing:
 
     def torque(self, eps, kappa, tau, bends=None):
         """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
-        return self.Q_b0 + sum(self.R * fb for _, fb in self.member_forces(eps, kappa, tau, bends))
+        return self.resultants(eps, kappa, tau, bends)[3]
 
 
 class Cone:

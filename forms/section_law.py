@@ -304,11 +304,8 @@ class NonlinearSection(HelixTorsion):
             eps, q, kappa = self.strains(r, c)
             return c.bending * self.dW(eps, kappa, tau)[1] / kappa * q
         eps, kappa, bends = self.member_state(r, c, alpha)
-        forces = self.law.member_forces(eps, kappa, tau, bends)
+        _, M1, M2, _ = self.law.resultants(eps, kappa, tau, bends)
         d1, d2 = self.directors(r, alpha)
-        R = self.law.R
-        M1 = sum(-R * math.cos(phi) * fa for phi, (fa, _) in zip(self.law.phi, forces))
-        M2 = sum(-R * math.sin(phi) * fa for phi, (fa, _) in zip(self.law.phi, forces))
         return c.bending * (M1 * d1 + M2 * d2)
 
     def axial_force(self, r, c, tau=0, alpha=None):
