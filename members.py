@@ -68,7 +68,7 @@ from dataclasses import dataclass
 import numpy as np
 
 # the laws written once for numpy and UFL (section_math.py)
-from rawehelix.section_math import Cone, TetherRing, ramp_energy, smooth_ramp
+from rawehelix.section_math import Cone, TetherRing, ramp_energy, ring_shear_stiffness, smooth_ramp
 
 #: the limit criteria, in the order of :func:`first_limit`'s ties
 CRITERIA = ("slack", "breaking", "moment_saturation", "torsional_collapse")
@@ -209,8 +209,7 @@ class Members:
         tension's geometric share); the bars on the axis turn with the section and add
         nothing.  :meth:`sheared_energy` checks it by differences."""
         f = self.P0 if tether_force_N is None else tether_force_N
-        cb, sb = math.cos(self.beta), math.sin(self.beta)
-        return self.n * cb * (self.k * sb * sb + f * (1 + cb * cb)) / 2
+        return ring_shear_stiffness(self.n, self.beta, self.k, f)
 
     def sheared_energy(self, gamma, tether_force_N: float | None = None):
         """The tethers' energy per unit length [J/m] at the shear strain gamma (along d1)

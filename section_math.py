@@ -64,6 +64,13 @@ def ramp_energy(e, w, m=NUMPY):
     return 0.25 * (e * e + e * root + w * w * m.ln(plus / w))
 
 
+def ring_shear_stiffness(n: int, beta: float, k, f):
+    """GA = n cos(beta) [k sin^2 beta + f (1 + cos^2 beta)] / 2 of a ring of n tethers of
+    stiffness k at the force f each (members.py::Members.shear_stiffness derives it)."""
+    cb, sb = math.cos(beta), math.sin(beta)
+    return n * cb * (k * sb * sb + f * (1 + cb * cb)) / 2
+
+
 class TetherRing:
     """The tethers' law W(eps, kappa, tau) of the module docstring, written once for the
     FE rod (normalised numbers or UFL constants, ``m`` = UFL_MATH: forms/section_law.py)
@@ -128,10 +135,9 @@ class TetherRing:
     def shear_stiffness(self, eps, kappa, helix_GA):
         """GA = n cos(beta) [k sin^2 beta + f (1 + cos^2 beta)] / 2 at the members' mean
         force f = mean_m k <e_m>_w (members.py::Members.shear_stiffness), not the helix's."""
-        cb, sb = math.cos(self.beta), math.sin(self.beta)
         f = sum(self.k * smooth_ramp(e, self.width, self.m)
                 for e in self.member_strains(eps, kappa)) / self.n
-        return self.n * cb * (self.k * sb * sb + f * (1 + cb * cb)) / 2
+        return ring_shear_stiffness(self.n, self.beta, self.k, f)
 
     def torque(self, eps, kappa, tau, bends=None):
         """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
