@@ -67,27 +67,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# the laws written once for numpy and UFL (section_math.py)
+from rawehelix.section_math import Cone, TetherRing, ramp_energy, ring_shear_stiffness, smooth_ramp
+
 #: the limit criteria, in the order of :func:`first_limit`'s ties
 CRITERIA = ("slack", "breaking", "moment_saturation", "torsional_collapse")
-
-
-def smooth_ramp(e, w):
-    """<e>_w = (e + sqrt(e^2 + w^2)) / 2: max(e, 0) for w = 0, smooth for w > 0."""
-    e = np.asarray(e, dtype=float)
-    return 0.5 * (e + np.sqrt(e * e + w * w))
-
-
-def ramp_energy(e, w):
-    """Phi_w(e) = int_0^e <x>_w dx = (e^2 + e sqrt(e^2 + w^2) + w^2 ln((e + sqrt(e^2 + w^2)) / w)) / 4;
-    for w = 0, max(e, 0)^2 / 2.  (<x>_w ~ w^2 / (4 |x|) in the slack, so Phi_w falls like
-    w^2 ln|e| / 4 there: convex and nondecreasing, its offset from 0 below w^2.)"""
-    e = np.asarray(e, dtype=float)
-    if w == 0:
-        return 0.5 * np.maximum(e, 0.0) ** 2
-    root = np.sqrt(e * e + w * w)
-    # e + root loses digits for e << -w: there it is w^2 / (root - e)
-    plus = np.where(e >= 0, e + root, w * w / np.maximum(root - e, 1e-300))
-    return 0.25 * (e * e + e * root + w * w * np.log(plus / w))
 
 
 def critical_twist(R: float, l_t: float) -> float:
@@ -154,18 +138,22 @@ class Members:
         psi the ring's phase (module docstring)."""
         return self.phi + np.asarray(psi, dtype=float)[..., None]
 
-    def _stretch(self, eps, kappa, tau, psi=0.0):
-        """(a, b, l): the axial and tangential advance per unit rod length, and
-        l = sqrt(a^2 + b^2), each of shape (..., n)."""
-        eps, kappa, tau = (np.asarray(x, dtype=float)[..., None] for x in (eps, kappa, tau))
-        a = 1 + eps - self.R * kappa * np.cos(self.phases(psi))
-        b = self.R * tau + math.tan(self.beta) + 0 * a
-        return a, b, np.sqrt(a * a + b * b)
+    def law(self) -> TetherRing:
+        """The tethers' law in SI numbers (section_math.py::TetherRing, the FE rod's too),
+        the twist read."""
+        return TetherRing(self.n, self.R, self.beta, self.k, self.e0, self.EA_b, self.e_b0,
+                          self.width, torsion=True)
+
+    def _state(self, eps, kappa, tau, psi):
+        """(eps, kappa, tau as arrays, the members' bends kappa cos(phi_m + psi), the phases)."""
+        eps, kappa, tau = (np.asarray(x, dtype=float) for x in (eps, kappa, tau))
+        phases = self.phases(psi)
+        return eps, kappa, tau, [kappa * np.cos(phases[..., i]) for i in range(self.n)], phases
 
     def strains(self, eps, kappa, tau=0.0, psi=0.0):
         """e_m (..., n): each member's strain, slack where <= 0."""
-        _, _, l = self._stretch(eps, kappa, tau, psi)
-        return math.cos(self.beta) * l - 1 + self.e0
+        eps, kappa, tau, bends, _ = self._state(eps, kappa, tau, psi)
+        return _members_axis(self.law().member_strains(eps, kappa, tau, bends))
 
     def forces(self, eps, kappa, tau=0.0, psi=0.0):
         """k <e_m>_w [N], (..., n)."""
@@ -173,24 +161,19 @@ class Members:
 
     def energy(self, eps, kappa, tau=0.0, psi=0.0):
         """W [N = J/m]: the members' and the bars' stored energy per unit rod length."""
-        e = self.strains(eps, kappa, tau, psi)
-        tethers = self.k / math.cos(self.beta) * ramp_energy(e, self.width).sum(axis=-1)
-        eps, tau = np.asarray(eps, dtype=float), np.asarray(tau, dtype=float)
-        return tethers + 0.5 * self.EA_b * (eps + self.e_b0) ** 2 + self.Q_b0 * tau
+        eps, kappa, tau, bends, _ = self._state(eps, kappa, tau, psi)
+        return self.law().W(eps, kappa, tau, bends)
 
     def resultants(self, eps, kappa, tau=0.0, psi=0.0) -> dict:
         """N [N], M [N m] (>= 0 for kappa >= 0 at psi = 0), Q [N m]: dW/d(eps, kappa, tau);
         and the ring's torque about the axis from its phase, dW/d psi [N m] (zero at
         psi = 0 by symmetry, and whenever every member is taut and linear)."""
-        a, b, l = self._stretch(eps, kappa, tau, psi)
-        f = self.forces(eps, kappa, tau, psi)  # de/d(.) = cos(beta) (a da + b db) / l; x 1/cos(beta)
-        phases = self.phases(psi)
-        N = (f * a / l).sum(axis=-1) + self.EA_b * (np.asarray(eps, dtype=float) + self.e_b0)
-        M = (f * a / l * (-self.R * np.cos(phases))).sum(axis=-1)
-        Q = (f * b / l * self.R).sum(axis=-1) + self.Q_b0
-        kappa = np.asarray(kappa, dtype=float)
-        W_psi = (f * a / l * self.R * kappa[..., None] * np.sin(phases)).sum(axis=-1)
-        return {"N": N, "M": M, "Q": Q, "W_psi": W_psi}
+        eps, kappa, tau, bends, phases = self._state(eps, kappa, tau, psi)
+        N, M1, M2, Q = self.law().resultants(
+            eps, kappa, tau, bends,
+            [(np.cos(phases[..., i]), np.sin(phases[..., i])) for i in range(self.n)])
+        # dW/d psi: member m's bend kappa cos(phi_m + psi) turns by -kappa sin(...) d psi
+        return {"N": N, "M": M1, "Q": Q, "W_psi": -kappa * M2}
 
     def tangent(self, eps=0.0, kappa=0.0, tau=0.0, h: float = 1e-7) -> dict:
         """The tangent moduli EA = dN/d eps, EI = dM/d kappa, GJ = dQ/d tau at a state
@@ -226,8 +209,7 @@ class Members:
         tension's geometric share); the bars on the axis turn with the section and add
         nothing.  :meth:`sheared_energy` checks it by differences."""
         f = self.P0 if tether_force_N is None else tether_force_N
-        cb, sb = math.cos(self.beta), math.sin(self.beta)
-        return self.n * cb * (self.k * sb * sb + f * (1 + cb * cb)) / 2
+        return ring_shear_stiffness(self.n, self.beta, self.k, f)
 
     def sheared_energy(self, gamma, tether_force_N: float | None = None):
         """The tethers' energy per unit length [J/m] at the shear strain gamma (along d1)
@@ -277,6 +259,11 @@ class Members:
         return self.ring_spacing_m * (np.asarray(tau, dtype=float) + math.tan(self.beta) / self.R)
 
 
+def _members_axis(per_member: list) -> np.ndarray:
+    """The members' values [x_0, ..., x_n-1] on a last axis (..., n)."""
+    return np.stack(np.broadcast_arrays(*per_member), axis=-1)
+
+
 def phase_spread(members: Members, eps: float, kappa: float, tau: float = 0.0,
                  phases: int = 64) -> dict:
     """How much the fixed phase (a member on the bending plane) matters: the range of
@@ -321,30 +308,15 @@ class ConeSection:
         if self.width < 0:
             raise ValueError(f"ConeSection.width = {self.width!r}: must be >= 0")
 
-    @property
-    def _DS(self):
-        cR = self.c * self.R
-        return 1 / self.EA + cR * cR / self.EI, self.EI + cR * cR * self.EA
-
-    def _xv(self, eps, kappa):
-        eps, kappa = np.asarray(eps, dtype=float), np.abs(np.asarray(kappa, dtype=float))
-        cR = self.c * self.R
-        return eps + cR * kappa, eps - self.EI * kappa / (cR * self.EA)
+    def _law(self) -> Cone:
+        return Cone(self.EA, self.EI, self.c * self.R, self.width)
 
     def energy(self, eps, kappa):
-        """W [N = J/m] per unit length (above)."""
-        D, S = self._DS
-        x, v = self._xv(eps, kappa)
-        cRA = self.c * self.R * self.EA
-        return ramp_energy(x, self.width) / D + cRA * cRA * ramp_energy(v, self.width) / S
+        """W [N = J/m] per unit length (above; :class:`Cone`, the FE rod's law too)."""
+        return self._law().W(np.asarray(eps, dtype=float), np.abs(np.asarray(kappa, dtype=float)))
 
     def resultants(self, eps, kappa) -> dict:
         """N = dW/d eps [N], M = dW/d kappa [N m] (the sign of kappa)."""
-        D, S = self._DS
-        x, v = self._xv(eps, kappa)
-        cR = self.c * self.R
-        cRA = cR * self.EA
-        px, pv = smooth_ramp(x, self.width), smooth_ramp(v, self.width)
-        N = px / D + cRA * cRA * pv / S
-        M = np.sign(np.asarray(kappa, dtype=float)) * (cR * px / D - cRA * self.EI * pv / S)
-        return {"N": N, "M": M}
+        kappa = np.asarray(kappa, dtype=float)
+        N, M = self._law().dW(np.asarray(eps, dtype=float), np.abs(kappa))
+        return {"N": N, "M": np.sign(kappa) * M}

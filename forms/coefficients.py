@@ -67,8 +67,8 @@ class Coefficients:
     # hysteretic torsion, a component (forms/hysteresis.py): BoucWen, or the null
     # object NoneHysteresis (no z field, the elastic moment)
     hysteresis: Hysteresis = field(default_factory=NoneHysteresis)
-    # the section law, a component (forms/section_law.py): TensegritySection,
-    # SaturatingSection, or the null object SolidSection (sigma, mu and the EI law)
+    # the section law, a component (forms/section_law.py, chosen by the registry
+    # section_laws.py): NonlinearSection of its law, or the null object SolidSection
     section: SectionLaw = field(default_factory=section_law.SolidSection)
     # the ENERGY_COMPONENTS of the scene
     extra: tuple = ()

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
+from rawehelix.forms.section_law import SectionComponent
+
 
 @runtime_checkable
 class Kinematics(Protocol):
@@ -55,32 +57,9 @@ class Hysteresis(Protocol):
         """z's equation."""
 
 
-@runtime_checkable
-class SectionLaw(Protocol):
-    """The section law (forms/section_law.py): TensegritySection, SaturatingSection,
-    or the null SolidSection."""
-
-    name: str
-    torsion: bool
-    ring_turns: bool
-
-    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None):
-        """The stored energy of the section's law."""
-
-    def axial_force(self, r, c, tau=0, alpha=None):
-        """N."""
-
-    def twist_moment(self, r, tau, c, alpha=None):
-        """The twisting moment / GJ of Eq. (31)."""
-
-    def ring_phase(self, r, c, alpha):
-        """The ring's phase psi against the bending plane."""
-
-    def twist_energy(self, tau, c):
-        """The twist's stored energy per length."""
-
-    def shear_stiffness(self, eps, kappa, c):
-        """GA~ at the strains."""
+#: the section law's protocol is written beside the laws it describes
+#: (forms/section_law.py::SectionComponent, the registry's UFL half)
+SectionLaw = SectionComponent
 
 
 __all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw"]

@@ -6,12 +6,17 @@ Normalised as forms/energy.py (energies in M g L0, so W per length in M g; eps a
 the members' strains dimensionless, kappa = |t'| per unstretched length in 1/L0;
 parameters/section.py::normalise gives R~ = R / L0, k~ = k / (M g), EA_b~ = EA_b / (M g)).
 
+The law is chosen by name once, in the registry section_laws.py, whose object gives
+its numbers (``SectionLaw.normalised``: section_math.py::TetherRing or Cone, the same
+definition the numpy limits use, written here with :data:`UFL_MATH`); this module
+wraps them in the rod's strains:
+
 * :class:`SolidSection` (``"solid"``, the null object): the paper's section,
   sigma/2 eps^2 + mu(eps)/2 |t'|^2 with the EI law if any; it returns
   forms/extensible.py::stored_energy unchanged, the same UFL, so every default number
   is the same bit for bit.
-* :class:`TensegritySection` (``"tensegrity"``): the members of members.py, written
-  in UFL on the normalised quantities (the one definition is members.py's docstring):
+* :class:`NonlinearSection` of ``"tensegrity"``: the members of members.py, in UFL
+  on the normalised quantities (the one definition is section_math.py::TetherRing):
 
       W = sum_m (k / cos beta) Phi_w(e_m) + EA_b / 2 (eps + e_b0)^2,
       e_m = cos(beta) sqrt((1 + eps - R kappa cos phi_m)^2 + tan(beta)^2) - 1 + e0,
@@ -31,7 +36,7 @@ parameters/section.py::normalise gives R~ = R / L0, k~ = k / (M g), EA_b~ = EA_b
   kappa_i = t'.d_i (the worst phase's kappa cos(phi_m) otherwise), the moment is
   M1 d1 + M2 d2, and W depends on alpha: the twist equation gains
   (delta / beta) dW/d alpha (forms/rod.py), zero while every member is taut.
-* :class:`SaturatingSection` (``"saturating"``, the fallback): the conjugate of the
+* :class:`NonlinearSection` of ``"saturating"`` (the fallback, section_math.py::Cone): the conjugate of the
   complementary energy N^2/(2 EA) + M^2/(2 EI) on the cone |M| <= c R N.  With
   rho = c R, A = EA, B = EI, D = 1/A + rho^2/B, g = eps + rho kappa (the cone's ray)
   and h = eps - B kappa / (rho A) (the taut region is h >= 0) the three pieces of
@@ -67,13 +72,17 @@ nothing; sigma eps would).
 from __future__ import annotations
 
 import math
+from typing import Protocol, runtime_checkable
 
 import ufl
 
+from rawehelix import section_laws
 from rawehelix.compat import atan2
 from rawehelix.forms.extensible import bending_modulus, stored_energy, strain
 from rawehelix.forms.interior_penalty import jump
 from rawehelix.forms.kinematics import d, unit_tangent
+from rawehelix.section_math import ramp_energy as _ramp_energy
+from rawehelix.section_math import smooth_ramp
 
 #: j_E, the turning ring's reference direction (normal to every chord, forms/rod.py's frame)
 J_E = ufl.as_vector((0.0, 1.0, 0.0))
@@ -82,17 +91,71 @@ J_E = ufl.as_vector((0.0, 1.0, 0.0))
 KAPPA_ETA = 1.0e-10
 
 
+class UflMath:
+    """section_math.py::NumpyMath's names in UFL: the laws of members.py written once."""
+
+    sqrt = staticmethod(ufl.sqrt)
+    ln = staticmethod(ufl.ln)
+    cos = staticmethod(ufl.cos)
+
+    @staticmethod
+    def array(x):
+        return x
+
+    @staticmethod
+    def select_nonneg(x, then, otherwise):
+        return ufl.conditional(ufl.ge(x, 0), then, otherwise)
+
+    @staticmethod
+    def divisor(x):
+        return x  # the conditional takes one branch
+
+    @staticmethod
+    def unregularised(w) -> bool:
+        return False  # the FE rod's width is > 0 (section.slack_width)
+
+
+UFL_MATH = UflMath()
+
+
 def ramp(e, w):
-    """<e>_w = (e + sqrt(e^2 + w^2)) / 2 (members.py::smooth_ramp) in UFL."""
-    return 0.5 * (e + ufl.sqrt(e * e + w * w))
+    """<e>_w = (e + sqrt(e^2 + w^2)) / 2 (section_math.py::smooth_ramp) in UFL."""
+    return smooth_ramp(e, w, UFL_MATH)
 
 
 def ramp_energy(e, w):
-    """Phi_w(e) (members.py::ramp_energy) in UFL, w > 0: (e^2 + e root + w^2 ln(plus / w)) / 4,
-    plus = e + root, taken as w^2 / (root - e) for e < 0 where e + root loses digits."""
-    root = ufl.sqrt(e * e + w * w)
-    plus = ufl.conditional(ufl.ge(e, 0), e + root, w * w / (root - e))
-    return 0.25 * (e * e + e * root + w * w * ufl.ln(plus / w))
+    """Phi_w(e) (section_math.py::ramp_energy) in UFL, w > 0."""
+    return _ramp_energy(e, w, UFL_MATH)
+
+
+@runtime_checkable
+class SectionComponent(Protocol):
+    """What the rod's forms, models and solvers ask of a scene's section (``c.section``):
+    the null object :class:`SolidSection` and every law's :class:`NonlinearSection`
+    answer all of it (tests/test_section_laws.py)."""
+
+    torsion: bool  # the members carry the twist
+    ring_turns: bool  # the members' phase turns with alpha
+
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None): ...
+
+    def axial_force(self, r, c, tau=0, alpha=None): ...
+
+    def axial_force_at(self, eps, kappa, c): ...
+
+    def bending_moment_at(self, eps, kappa, mu, curvature): ...
+
+    def sheared_density(self, eps, g, k, r, c): ...
+
+    def shear_stiffness(self, eps, kappa, c): ...
+
+    def wall_moment(self, x, c, tau, alpha, mu): ...
+
+    def twist_moment(self, r, tau, c, alpha=None): ...
+
+    def twist_energy(self, tau, c): ...
+
+    def ring_phase(self, r, c, alpha): ...
 
 
 class HelixTorsion:
@@ -113,16 +176,10 @@ class HelixTorsion:
         """The twist's stored energy per length, beta/2 tau^2 (forms/energy.py)."""
         return 0.5 * c.beta * tau**2
 
-    def shear_stiffness(self, eps, kappa, c):
-        """GA~ of the shearable rod (forms/shearable.py) at the strains: the scene's
-        helix.GA_N, unless the section's members give it."""
-        return c.shear
-
 
 class SolidSection(HelixTorsion):
-    """The paper's section (the null object): forms/extensible.py::stored_energy."""
-
-    name = "solid"
+    """The paper's section (the null object): forms/extensible.py::stored_energy, and
+    the solid's answer to every question a member law answers."""
 
     def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None):
         return stored_energy(r, c.sigma, bending_modulus(r, c), alpha_ip, dx, dS,
@@ -132,19 +189,57 @@ class SolidSection(HelixTorsion):
         """N = sigma eps (Eq. 29), without the EI law's 1/2 mu'(eps) kappa^2."""
         return c.sigma * strain(r)
 
+    def axial_force_at(self, eps, kappa, c):
+        """N at the stretch eps (the shearable rod's Gamma_3): sigma eps."""
+        return c.sigma * eps
+
+    def bending_moment_at(self, eps, kappa, mu, curvature):
+        """|M| at the strains: the kinematics' mu times the curvature |d3'| (unregularised)."""
+        return mu * curvature
+
+    def sheared_density(self, eps, g, k, r, c):
+        """The shearable rod's elastic energy per length (forms/shearable.py) without the
+        gauge: sigma/2 Gamma_3^2 + GA~/2 |Gamma_s|^2 + mu/2 |d3'|^2 (helix.GA_N)."""
+        return (0.5 * c.sigma * eps ** 2 + 0.5 * c.shear * ufl.dot(g, g)
+                + 0.5 * c.bending_law.modulus(r, c) * ufl.dot(k, k))
+
+    def shear_stiffness(self, eps, kappa, c):
+        """GA~ of the shearable rod: the scene's helix.GA_N."""
+        return c.shear
+
+    def wall_moment(self, x, c, tau, alpha, mu):
+        """(the wall's bending modulus, its moment dW/dt' or None: mu t') of the clamped
+        cantilever (forms/cantilever.py::clamp_energy): the kinematics' mu."""
+        return mu, None
+
 
 class NonlinearSection(HelixTorsion):
-    """A section energy W(eps, kappa) with its IP node terms (module docstring);
-    subclasses give :meth:`W`, :meth:`dW` (W_eps, W_kappa) and ``taut_bending``."""
+    """A section energy W(eps, kappa) with its IP node terms (module docstring): ``law``
+    the registry's numbers (section_laws.py: section_math.py::TetherRing or Cone in UFL)."""
 
-    name = ""
-    taut_bending = 0.0
+    def __init__(self, law):
+        self.law = law
+        self.torsion, self.ring_turns = law.torsion, law.ring_turns
+        self.taut_bending = law.taut_bending
 
-    def W(self, eps, kappa, tau=0):
-        raise NotImplementedError
+    def W(self, eps, kappa, tau=0, bends=None):
+        return self.law.W(eps, kappa, tau, bends)
 
-    def dW(self, eps, kappa, tau=0):
-        raise NotImplementedError
+    def dW(self, eps, kappa, tau=0, bends=None):
+        """(N, M) = dW/d(eps, kappa) (M at the worst phase)."""
+        return self.law.dW(eps, kappa, tau, bends)
+
+    def member_strains(self, eps, kappa, tau=0, bends=None):
+        return self.law.member_strains(eps, kappa, tau, bends)
+
+    def torque(self, eps, kappa, tau, bends=None):
+        """Q = dW/d tau (the members' torque)."""
+        return self.law.torque(eps, kappa, tau, bends)
+
+    def shear_stiffness(self, eps, kappa, c):
+        """GA~ of the shearable rod (forms/shearable.py) at the strains: the members' at
+        their mean force, or the scene's helix.GA_N."""
+        return self.law.shear_stiffness(eps, kappa, c.shear)
 
     @staticmethod
     def curvature(q):
@@ -155,52 +250,6 @@ class NonlinearSection(HelixTorsion):
         """(eps, q = bending switch x t', kappa)."""
         q = c.bending * d(unit_tangent(r))
         return strain(r), q, self.curvature(q)
-
-    def moment(self, r, c, tau=0, alpha=None):
-        """dW/dt' = W_kappa t' / kappa (with the bending switch)."""
-        eps, q, kappa = self.strains(r, c)
-        return c.bending * self.dW(eps, kappa, tau)[1] / kappa * q
-
-    def axial_force(self, r, c, tau=0, alpha=None):
-        """N = dW/d eps."""
-        eps, _, kappa = self.strains(r, c)
-        return self.dW(eps, kappa, tau)[0]
-
-    def cell_energy(self, r, c, tau=0, alpha=None):
-        """W per length at the rod's strains."""
-        eps, _, kappa = self.strains(r, c)
-        return self.W(eps, kappa, tau)
-
-    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None):
-        """int W dx - sum {{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2; ``tau`` the
-        twist (held fixed in the centre line's variation), read if :attr:`torsion`;
-        ``alpha`` the twist angle, read if :attr:`ring_turns` (None: 0)."""
-        n = ufl.FacetNormal(dS.ufl_domain())
-        tau = 0 if tau is None else tau  # read by the members' law only if it carries the twist
-        jump_t = jump(unit_tangent(r), n)
-        m = self.moment(r, c, tau, alpha)
-        avg_m = 0.5 * (m("+") + m("-"))  # {{dW/dt'}}
-        EI_t = c.bending * self.taut_bending
-        return (self.cell_energy(r, c, tau, alpha) * dx
-                + (-ufl.dot(avg_m, jump_t) + 0.5 * alpha_ip * EI_t * ufl.dot(jump_t, jump_t)) * dS)
-
-
-class TensegritySection(NonlinearSection):
-    """The members (module docstring); numbers or constants, normalised."""
-
-    name = "tensegrity"
-
-    def __init__(self, n: int, R, beta: float, k, e0, EA_b, e_b0, width, torsion: bool = False,
-                 ring_turns: bool = False):
-        self.n, self.R, self.beta, self.k, self.e0 = n, R, beta, k, e0
-        self.EA_b, self.e_b0, self.width, self.torsion = EA_b, e_b0, width, torsion
-        self.ring_turns = ring_turns
-        # the bars' torque at zero strain, -n P0 R sin(beta) (members.py::Members.Q_b0)
-        self.Q_b0 = -n * k * e0 * R * math.sin(beta)
-        self.phi = [2 * math.pi * m / n for m in range(n)]
-        cb, sb = math.cos(beta), math.sin(beta)
-        # K R^2 / 2, K = n (k cos^3 beta + P0 cos beta sin^2 beta), P0 = k e0 (members.py)
-        self.taut_bending = n * k * cb * (cb * cb + e0 * sb * sb) * R * R / 2
 
     # -- the turning ring: the members' phase from the directors ----------------------
     @staticmethod
@@ -233,70 +282,31 @@ class TensegritySection(NonlinearSection):
         return (0 if alpha is None else alpha) - theta
 
     def bends(self, r, c, alpha=None):
-        """kappa_m, member m's curvature: cos(phi_m) kappa_1 + sin(phi_m) kappa_2 with
-        kappa_i = q.d_i the curvatures in the directors' frame (the turning ring), or
-        kappa cos(phi_m)."""
-        _, q, kappa = self.strains(r, c)
+        """kappa_m, member m's curvature for a turning ring: cos(phi_m) kappa_1 +
+        sin(phi_m) kappa_2 with kappa_i = q.d_i the curvatures in the directors' frame;
+        None otherwise (the law's kappa cos(phi_m))."""
         if not self.ring_turns:
-            return [kappa * math.cos(phi) for phi in self.phi]
+            return None
+        _, q, _ = self.strains(r, c)
         d1, d2 = self.directors(r, alpha)
         k1, k2 = ufl.dot(q, d1), ufl.dot(q, d2)
-        return [math.cos(phi) * k1 + math.sin(phi) * k2 for phi in self.phi]
-
-    # -- the law ------------------------------------------------------------------------
-    def _members(self, eps, kappa, tau=0, bends=None):
-        """[(a_m, b, l_m, e_m)] of members.py::Members._stretch and strains (tau = 0 unless
-        the members carry the twist; ``bends`` the members' curvatures, kappa cos phi_m
-        unless given)."""
-        cb, tb = math.cos(self.beta), math.tan(self.beta)
-        b = self.R * tau + tb if self.torsion else tb
-        bends = [kappa * math.cos(phi) for phi in self.phi] if bends is None else bends
-        out = []
-        for bend in bends:
-            a = 1 + eps - self.R * bend
-            l = ufl.sqrt(a * a + b * b) if self.torsion or tb != 0 else a  # a > 0: the stretch
-            out.append((a, b, l, cb * l - 1 + self.e0))
-        return out
-
-    def member_strains(self, eps, kappa, tau=0, bends=None):
-        return [e for *_, e in self._members(eps, kappa, tau, bends)]
-
-    def W(self, eps, kappa, tau=0, bends=None):
-        tethers = sum(ramp_energy(e, self.width) for *_, e in self._members(eps, kappa, tau, bends))
-        W = self.k / math.cos(self.beta) * tethers + 0.5 * self.EA_b * (eps + self.e_b0)**2
-        return W + self.Q_b0 * tau if self.torsion else W
-
-    def member_forces(self, eps, kappa, tau=0, bends=None):
-        """[(f_m a_m / l_m, b / l_m)]: dW/da_m and the members' share of the torque's lever."""
-        return [(self.k * ramp(e, self.width) * a / l, self.k * ramp(e, self.width) * b / l)
-                for a, b, l, e in self._members(eps, kappa, tau, bends)]
-
-    def dW(self, eps, kappa, tau=0, bends=None):
-        """(N, M) of members.py::Members.resultants (M at the worst phase)."""
-        N, M = self.EA_b * (eps + self.e_b0), 0
-        for phi, (fa, _) in zip(self.phi, self.member_forces(eps, kappa, tau, bends)):
-            N, M = N + fa, M - fa * self.R * math.cos(phi)
-        return N, M
+        return [math.cos(phi) * k1 + math.sin(phi) * k2 for phi in self.law.phi]
 
     def member_state(self, r, c, alpha=None):
         """(eps, kappa, the members' curvatures of :meth:`bends`) at the rod's strains."""
         eps, _, kappa = self.strains(r, c)
         return eps, kappa, self.bends(r, c, alpha)
 
-    def cell_energy(self, r, c, tau=0, alpha=None):
-        eps, kappa, bends = self.member_state(r, c, alpha)
-        return self.W(eps, kappa, tau, bends)
-
+    # -- the law at the rod's strains -------------------------------------------------
     def moment(self, r, c, tau=0, alpha=None):
         """dW/dt' (with the bending switch): W_kappa t' / kappa, or for the turning ring
         M1 d1 + M2 d2, M_i = -R sum_m (dW/da_m) (cos, sin)(phi_m)."""
         if not self.ring_turns:
-            return super().moment(r, c, tau)
+            eps, q, kappa = self.strains(r, c)
+            return c.bending * self.dW(eps, kappa, tau)[1] / kappa * q
         eps, kappa, bends = self.member_state(r, c, alpha)
-        forces = self.member_forces(eps, kappa, tau, bends)
+        _, M1, M2, _ = self.law.resultants(eps, kappa, tau, bends)
         d1, d2 = self.directors(r, alpha)
-        M1 = sum(-self.R * math.cos(phi) * fa for phi, (fa, _) in zip(self.phi, forces))
-        M2 = sum(-self.R * math.sin(phi) * fa for phi, (fa, _) in zip(self.phi, forces))
         return c.bending * (M1 * d1 + M2 * d2)
 
     def axial_force(self, r, c, tau=0, alpha=None):
@@ -304,67 +314,57 @@ class TensegritySection(NonlinearSection):
         eps, kappa, bends = self.member_state(r, c, alpha)
         return self.dW(eps, kappa, tau, bends)[0]
 
-    def shear_stiffness(self, eps, kappa, c):
-        """GA~ = n cos(beta) [k sin^2 beta + f (1 + cos^2 beta)] / 2 at the members' mean
-        force f = mean_m k <e_m>_w (members.py::Members.shear_stiffness: the members'
-        energy to second order in the shear strain, all taut)."""
-        cb, sb = math.cos(self.beta), math.sin(self.beta)
-        f = sum(self.k * ramp(e, self.width) for e in self.member_strains(eps, kappa)) / self.n
-        return self.n * cb * (self.k * sb * sb + f * (1 + cb * cb)) / 2
-
-    def torque(self, eps, kappa, tau, bends=None):
-        """Q = dW/d tau = sum_m k <e_m>_w R b / l_m + Q_b0 (members.py::Members.resultants)."""
-        return self.Q_b0 + sum(self.R * fb for _, fb in self.member_forces(eps, kappa, tau, bends))
+    def cell_energy(self, r, c, tau=0, alpha=None):
+        """W per length at the rod's strains."""
+        eps, kappa, bends = self.member_state(r, c, alpha)
+        return self.W(eps, kappa, tau, bends)
 
     def twist_moment(self, r, tau, c, alpha=None):
         """The twisting moment / GJ of Eq. (31): Q / beta with the members' torque, or tau."""
         if not self.torsion:
             return super().twist_moment(r, tau, c)
         eps, kappa, bends = self.member_state(r, c, alpha)
-        return self.torque(eps, kappa, tau, bends) / c.beta
+        return self.law.torque(eps, kappa, tau, bends) / c.beta
 
     def twist_energy(self, tau, c):
         """beta/2 tau^2, or 0: the members' W holds the twist's energy."""
         return 0 if self.torsion else super().twist_energy(tau, c)
 
+    def energy(self, r, c, alpha_ip, dx, dS, tau=None, alpha=None):
+        """int W dx - sum {{dW/dt'}}.[[t]] + alpha_ip/2 {{EI_t}} |[[t]]|^2; ``tau`` the
+        twist (held fixed in the centre line's variation), read if :attr:`torsion`;
+        ``alpha`` the twist angle, read if :attr:`ring_turns` (None: 0)."""
+        n = ufl.FacetNormal(dS.ufl_domain())
+        tau = 0 if tau is None else tau  # read by the members' law only if it carries the twist
+        jump_t = jump(unit_tangent(r), n)
+        m = self.moment(r, c, tau, alpha)
+        avg_m = 0.5 * (m("+") + m("-"))  # {{dW/dt'}}
+        EI_t = c.bending * self.taut_bending
+        return (self.cell_energy(r, c, tau, alpha) * dx
+                + (-ufl.dot(avg_m, jump_t) + 0.5 * alpha_ip * EI_t * ufl.dot(jump_t, jump_t)) * dS)
 
-class SaturatingSection(NonlinearSection):
-    """The cone law (module docstring): A = sigma, B = mu, rho = c R~."""
+    # -- the null object's questions ---------------------------------------------------
+    def axial_force_at(self, eps, kappa, c):
+        """N = dW/d eps at the strains."""
+        return self.dW(eps, kappa)[0]
 
-    name = "saturating"
+    def bending_moment_at(self, eps, kappa, mu, curvature):
+        """M = dW/d kappa at the strains (not the kinematics' mu)."""
+        return self.dW(eps, kappa)[1]
 
-    def __init__(self, A, B, rho, width):
-        self.A, self.B, self.rho, self.width = A, B, rho, width
-        self.taut_bending = B
+    def sheared_density(self, eps, g, k, r, c):
+        """W(Gamma_3, |bending switch x d3'|) + GA~/2 |Gamma_s|^2, GA~ the section's."""
+        kappa = self.curvature(c.bending * k)
+        return self.W(eps, kappa) + 0.5 * self.shear_stiffness(eps, kappa, c) * ufl.dot(g, g)
 
-    def _gh(self, eps, kappa):
-        return eps + self.rho * kappa, eps - self.B * kappa / (self.rho * self.A)
-
-    def W(self, eps, kappa, tau=0):
-        A, B, rho = self.A, self.B, self.rho
-        g, h = self._gh(eps, kappa)
-        return (A * B * ramp_energy(g, self.width)
-                + (rho * A)**2 * ramp_energy(h, self.width)) / (B + rho * rho * A)
-
-    def dW(self, eps, kappa, tau=0):
-        A, B, rho = self.A, self.B, self.rho
-        g, h = self._gh(eps, kappa)
-        G, H = ramp(g, self.width), ramp(h, self.width)
-        return ((A * B * G + (rho * A)**2 * H) / (B + rho * rho * A),
-                rho * A * B * (G - H) / (B + rho * rho * A))
+    def wall_moment(self, x, c, tau, alpha, mu):
+        """The wall's taut bending modulus and the law's moment dW/dt' (forms/cantilever.py)."""
+        return c.bending * self.taut_bending, self.moment(x, c, tau, alpha)
 
 
 def from_normalised(q, make=float):
-    """The section law of :class:`rawehelix.parameters.Normalised`: the solid (null
-    object) unless ``section_law`` names another; ``make`` wraps the numbers a solver
-    may change (the lay angle and the member count shape the form and stay numbers)."""
-    if q.section_law == "tensegrity":
-        return TensegritySection(q.section_tethers, make(q.section_radius), q.section_lay_angle,
-                                 make(q.section_stiffness), make(q.section_prestrain),
-                                 make(q.section_bar_stiffness), make(q.section_bar_prestrain),
-                                 make(q.section_width), torsion=q.section_torsion,
-                                 ring_turns=q.section_ring_turns)
-    if q.section_law == "saturating":
-        return SaturatingSection(make(q.sigma), make(q.mu),
-                                 make(q.section_saturation * q.section_radius), make(q.section_width))
-    return SolidSection()
+    """The section law of :class:`rawehelix.parameters.Normalised` (the registry's,
+    section_laws.py): the solid (null object) unless its law has an energy of its own;
+    ``make`` wraps the numbers a solver may change."""
+    law = section_laws.get(q.section_law)
+    return NonlinearSection(law.normalised(q, make, UFL_MATH)) if law.nonlinear else SolidSection()

@@ -128,12 +128,7 @@ def elastic_density(r, n, c):
     (forms/section_law.py: the members' GA at their mean force, or helix.GA_N)."""
     g, k = shear_strain(r, n), bending_strain(n)
     gauge = 0.5 * GAUGE * c.sigma * (ufl.sqrt(ufl.dot(n, n)) - 1) ** 2
-    if c.section.name == "solid":
-        return (0.5 * c.sigma * stretch_strain(r, n) ** 2 + 0.5 * c.shear * ufl.dot(g, g)
-                + 0.5 * c.bending_law.modulus(r, c) * ufl.dot(k, k) + gauge)
-    eps, kappa = section_strains(r, n, c)
-    return (c.section.W(eps, kappa) + 0.5 * c.section.shear_stiffness(eps, kappa, c) * ufl.dot(g, g)
-            + gauge)
+    return c.section.sheared_density(stretch_strain(r, n), g, k, r, c) + gauge
 
 
 def stored_energy(r, alpha, n, c, dx):

@@ -77,9 +77,8 @@ class ShearableRod(RodModel):
     def tension(self, fields: dict, c):
         """N = sigma Gamma_3, the axial force along d3 (Eq. 29 with the stretch r'.d3 - 1);
         with a member section law N = dW/d Gamma_3 of the members (at zero shear)."""
-        if c.section.name == "solid":
-            return c.sigma * shearable.stretch_strain(fields["centre_line"], fields["director"])
-        return c.section.dW(*shearable.section_strains(fields["centre_line"], fields["director"], c))[0]
+        eps, kappa = shearable.section_strains(fields["centre_line"], fields["director"], c)
+        return c.section.axial_force_at(eps, kappa, c)
 
     def twist(self, fields: dict, c):
         """K_3 = alpha'."""
@@ -92,9 +91,10 @@ class ShearableRod(RodModel):
 
     def bending_moment(self, fields: dict, c):
         """mu |d3'|, or the members' M = dW/d kappa."""
-        if c.section.name == "solid":
-            return c.kinematics.bending_modulus(fields["centre_line"], c) * self.curvature(fields, c)
-        return c.section.dW(*shearable.section_strains(fields["centre_line"], fields["director"], c))[1]
+        eps, kappa = shearable.section_strains(fields["centre_line"], fields["director"], c)
+        return c.section.bending_moment_at(
+            eps, kappa, c.kinematics.bending_modulus(fields["centre_line"], c),
+            self.curvature(fields, c))
 
     def moment(self, fields: dict, c):
         """The torsional moment / GJ: K_3."""

@@ -16,12 +16,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from rawehelix import section_laws
 from rawehelix.members import Members
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 
-#: "saturating" is the fallback law of issue 29 (members.py::ConeSection): the solid's
-#: EA and EI inside the cone |M| <= c N R of a tension-only section, convex
-LAWS = ("solid", "tensegrity", "saturating")
+#: the section laws' names, the registry's (section_laws.py): "saturating" is the fallback
+#: law of issue 29 (members.py::ConeSection), the solid's EA and EI inside the cone
+#: |M| <= c N R of a tension-only section, convex
+LAWS = section_laws.NAMES
 #: who carries the twist: the scene's GJ ("helix") or the members ("members", tensegrity only)
 TORSIONS = ("helix", "members")
 #: the ring's phase against the bending plane (members.py): "worst", a member on the
@@ -53,8 +55,8 @@ class Section:
     ring: str = "worst"  # the ring's phase: "worst" (a member on the bending plane) or "turning" (with alpha)
 
     def __post_init__(self):
-        if self.law not in LAWS:
-            raise ParameterError("section.law", self.law, f"must be one of {list(LAWS)}")
+        if section_laws.refusal(self.law):
+            raise ParameterError("section.law", self.law, section_laws.refusal(self.law))
         if isinstance(self.tethers, bool) or not isinstance(self.tethers, int) or self.tethers < 3:
             raise ParameterError("section.tethers", self.tethers,
                                  "must be an integer >= 3 (a ring of tethers)")
@@ -62,11 +64,12 @@ class Section:
             raise ParameterError("section.torsion", self.torsion, f"must be one of {list(TORSIONS)}")
         if self.ring not in RINGS:
             raise ParameterError("section.ring", self.ring, f"must be one of {list(RINGS)}")
-        if self.ring == "turning" and self.law != "tensegrity":
+        members = section_laws.get(self.law).members  # the law's resultants are its members'
+        if self.ring == "turning" and not members:
             raise ParameterError("section.ring", self.ring,
                                  "only the tensegrity's members have a phase: set section.law = "
                                  "'tensegrity' or ring = 'worst'")
-        if self.torsion == "members" and self.law != "tensegrity":
+        if self.torsion == "members" and not members:
             raise ParameterError("section.torsion", self.torsion,
                                  "the members carry the twist only with section.law = 'tensegrity'")
         if not (0 <= self.lay_angle_deg < 60):
@@ -95,8 +98,9 @@ class Section:
 
     @property
     def active(self) -> bool:
-        """A law other than the solid (the paper's model) is on."""
-        return self.law != "solid"
+        """A law other than the solid (the paper's model) is on: the section's energy is
+        the law's own (section_laws.py)."""
+        return section_laws.get(self.law).nonlinear
 
     def members(self, helix, width: float | None = None) -> Members:
         """The :class:`~rawehelix.members.Members` of this section on ``helix`` (SI);

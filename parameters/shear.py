@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from rawehelix import section_laws
 from rawehelix.parameters.checks import ParameterError
 
 #: its normalised group (parameters/scene.py::GROUP_KEYS), as sigma = EA / (M g), Eq. (27)
@@ -64,7 +65,7 @@ def check(params) -> None:
         raise ParameterError("model.kinematics", "shearable",
                              "is implemented by the FE scheme (discretisation.scheme = 'fe', "
                              "bending = 'ip', its default) only")
-    members = model.section.law == "tensegrity"
+    members = section_laws.get(model.section.law).members  # the members' own GA
     if helix.GA_N is None and not members:
         raise ParameterError("helix.GA_N", None,
                              f"the shearable rod needs the shear stiffness GA [N] (or "

@@ -86,10 +86,8 @@ class CantileverSolver:
         alpha = r.model.split(w)["twist"]
         tau = kinematics.twist(x, alpha, c.gamma_eps, c.gamma_coupling)  # (34)
         mu = c.kinematics.bending_modulus(x, c)  # with the EI law: mu(eps), forms/eilaw.py
-        moment = None
-        if c.section.name != "solid":  # a section law's wall moment dW/dt' (forms/section_law.py)
-            mu = c.bending * c.section.taut_bending
-            moment = c.section.moment(x, c, tau, alpha)
+        # a section law's taut modulus and wall moment dW/dt' (forms/section_law.py), or mu t'
+        mu, moment = c.section.wall_moment(x, c, tau, alpha, mu)
         U = (cantilever.clamp_energy(x, axis, mu, c.kinematics, r.degree, r.penalty, ds, moment)
              + cantilever.end_load_potential(x, self.force, ds))
         F = r.stationary_residual() + ufl.derivative(U, w, r.test)

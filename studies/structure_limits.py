@@ -29,7 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rawehelix.members import CRITERIA, ConeSection, Members
+from rawehelix import section_laws
+from rawehelix.members import CRITERIA, Members
 
 
 #: what each criterion measures (a kind's first's ``quantity``): its name and unit
@@ -45,7 +46,8 @@ class Tracker:
     """The extremes of the members' state over the sections and times it is given."""
 
     def __init__(self, members: Members, law: str = "solid", cone=None, ring: str = "worst"):
-        self.members, self.law, self.cone = members, law, cone  # cone: the saturating law's
+        self.members, self.law, self.cone = members, law, cone  # cone: the law's numpy resultants
+        self.section_law = section_laws.get(law)  # what the law decides (section_laws.py)
         self.ring = ring  # the ring's phase: "worst" (psi = 0) or "turning" (the probe's psi)
         self._min = self._max = self._ratio = self._twist = None
         self._slack = 0.0
@@ -67,24 +69,13 @@ class Tracker:
     def forces(self, N, M, Q, eps=None, kappa=None, tau=None, psi=0.0):
         """The members' forces (..., n) [N] and their slack mask (``psi`` the ring's phase
         of a turning ring, members.py)."""
-        m = self.members
-        if self.law == "tensegrity":
-            e = m.strains(eps, kappa, tau, psi)
-            return m.forces(eps, kappa, tau, psi), e <= 0
-        f = m.linear_forces(N, M, Q)
-        return f, f <= 0
+        return self.section_law.member_forces(self.members, N, M, Q, eps, kappa, tau, psi)
 
     def law_resultants(self, N, M, eps, kappa, tau, psi=0.0):
         """(N, M) of the section law: the members' or the cone's own resultants at the
         strains (the model's tension and bending-moment observables are the solid's,
         sigma eps and EI kappa); the solid's given N and M otherwise."""
-        if self.law == "tensegrity":
-            r = self.members.resultants(eps, kappa, tau, psi)
-            return r["N"], np.abs(r["M"])
-        if self.law == "saturating":
-            r = self.cone.resultants(eps, kappa)
-            return r["N"], np.abs(r["M"])
-        return N, M
+        return self.section_law.resultants(self.members, self.cone, N, M, eps, kappa, tau, psi)
 
     def moment_ratio(self, N, M):
         """|M| / (N R) per section (0 where N <= 0) and the mask of N > 0."""
@@ -218,10 +209,7 @@ def of_params(params) -> Tracker:
     """A tracker of a scene's ``[section]`` members and law."""
     section, helix = params.model.section, params.helix
     members = section.members(helix)
-    cone = None
-    if section.law == "saturating":  # forms/section_law.py::SaturatingSection's constants
-        cone = ConeSection(EA=helix.EA_N, EI=helix.EI_Nm2, R=members.R, c=members.saturation,
-                           width=section.slack_width)
+    cone = section_laws.get(section.law).limits_law(section, helix, members)
     return Tracker(members, section.law, cone, section.ring)
 
 

@@ -64,8 +64,7 @@ def _implementations():
         (Damping, damping.KelvinVoigt), (Damping, damping.NoneDamping),
         (BendingLaw, eilaw.TensionDependentBending), (BendingLaw, eilaw.ConstantBending),
         (Hysteresis, hysteresis.BoucWen), (Hysteresis, hysteresis.NoneHysteresis),
-        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.TensegritySection),
-        (SectionLaw, section_law.SaturatingSection)]
+        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.NonlinearSection)]
 
 
 @pytest.mark.parametrize("protocol, cls", _implementations(),
