@@ -80,12 +80,13 @@ def reference_of(params: Parameters) -> Reference:
 def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
     """Why no reference models the stationary state of ``params`` (``twisted``: the
     state carries the ends' torque), or None."""
+    from rawehelix import section_laws
     from rawehelix.references import shooting
     law = params.value("section.law")
     if twisted:
         return ("the state is twisted by the ends' torque (torque.top_Nm), and the "
                 "references are torque-free, planar rods")
-    if law != "solid":
+    if section_laws.get(law).nonlinear:
         return (f"section.law = {law!r}: the references model the solid section "
                 "(helix.EA_N, helix.EI_Nm2)")
     if not params.model.bending:

@@ -100,4 +100,7 @@ def test_the_coefficients_components_are_built_from_the_registry(name, overrides
                                         else "NoneDamping")
     assert type(c.hysteresis).__name__ == ("BoucWen" if p.model.torsion_hysteresis.active
                                            else "NoneHysteresis")
-    assert c.section.name == p.model.section.law
+    from rawehelix import section_laws
+    from rawehelix.forms import section_law
+    assert isinstance(c.section, section_law.SolidSection) \
+        == (not section_laws.get(p.model.section.law).nonlinear)
