@@ -41,7 +41,8 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits import harmonics, hill
-from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem
+from rawehelix.periodic_orbits.continuation import FLOOR_FACTOR
+from rawehelix.periodic_orbits.problem import FREE_ROTATION, Orbit, PeriodicOrbitProblem
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.rod_operator import RodOperator
 from rawehelix.solvers.sparse_lu import LU
@@ -60,13 +61,18 @@ START_RETRIES = 2  # the first orbit's search, H raised this many times where it
 
 def cannot(params: Parameters) -> str | None:
     """Why harmonic balance cannot trace ``params``'s orbits (None: it can)."""
+    if params.normalised().steady_torque().k1 == 0.0:
+        return FREE_ROTATION
     if params.model.torsion_hysteresis.active:
         return ("the hysteretic torsion's internal twist is non-smooth and hardly moves over "
-                "a period (its multipliers are 1 - O(beta x twist travel): shooting carries it)")
-    if params.normalised().steady_torque().k1 == 0.0:
-        return ("without the controller's integral action (k1 = 0) the twist's rotation is "
-                "free, a family of orbits")
+                "a period (its multipliers are 1 - O(beta x twist travel): shooting carries "
+                "it): use --method shooting (or auto)")
     return None
+
+
+class Diverged(SolverError):
+    """Newton's correction at round-off with |G| far above its tolerance: the scene
+    holds no orbit that double precision resolves, at any H."""
 
 
 class HarmonicBalance(PeriodicOrbitProblem):
@@ -81,7 +87,7 @@ class HarmonicBalance(PeriodicOrbitProblem):
                               "windows on separate ranks")
         why = cannot(params)
         if why:
-            raise SolverError(f"harmonic balance: {why}; use --method shooting")
+            raise SolverError(f"harmonic balance: {why}")
         self.params = params
         self.op = op = RodOperator(params, comm, solver)
         self.q_base = params.normalised().steady_torque()
@@ -272,11 +278,13 @@ class HarmonicBalance(PeriodicOrbitProblem):
         while True:
             try:
                 X, its, res = self._start(X, f1_Hz, H, tol, max_it)
+            except Diverged:
+                raise  # more harmonics do not help
             except SolverError as err:
                 retries += 1  # too few harmonics may hold no orbit: twice more, then say so
                 if steps or H >= self.H_max or retries > START_RETRIES:
                     raise SolverError(f"{err} (tried H up to {H}: a non-smooth law, such as "
-                                      f"the members' slack, needs many harmonics; "
+                                      f"the members' slack, needs many harmonics: try "
                                       f"--method shooting)") from None
                 H = self._more(H)
                 X = self.embed(X0, H)
@@ -313,7 +321,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
                 except SolverError:
                     raise SolverError(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: no orbit "
                                       f"found by a homotopy in the end's amplitude (a fold at "
-                                      f"{done:.3g} of it); start from a nearby orbit") from None
+                                      f"{done:.3g} of it); start the --f1 window where the "
+                                      f"response is small, away from a resonance") from None
             X, done, total = X_to, to, total + its
         return X, total, res
 
@@ -329,8 +338,15 @@ class HarmonicBalance(PeriodicOrbitProblem):
             lu = LU(J)
             step = lu.solve(G)
             if np.linalg.norm(step) <= STEP_TOL * max(1.0, np.linalg.norm(X)):
-                lu.destroy()  # X is exact to round-off: G is at its floor
-                return X, its, res
+                lu.destroy()  # X is exact to round-off: G is at its floor, if that is small
+                if res <= FLOOR_FACTOR * tol:
+                    return X, its, res
+                chord = self.params.helix.EA_N * self.params.ends.elongation
+                raise Diverged(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: Newton's "
+                               f"correction is at round-off while |G|/|X| = {res:.3g} > "
+                               f"{FLOOR_FACTOR * tol:g}, so no orbit to double precision "
+                               f"(the chord's tension EA x ends.elongation is {chord:.3g} N); "
+                               f"check the scene's ends.elongation and stiffnesses")
             frac = 1.0
             # Deuflhard's natural monotonicity: the simplified Newton correction at the
             # trial (the same LU) shorter than the step; |G| itself is no merit function
@@ -349,8 +365,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
             else:
                 lu.destroy()
                 raise SolverError(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: no descent "
-                                  f"along the Newton step (|G|/|X| = {res:.3g}); start nearer "
-                                  f"the orbit")
+                                  f"along the Newton step (|G|/|X| = {res:.3g}); start the --f1 "
+                                  f"window where the response is small")
             lu.destroy()
             X, last = trial, res
         raise SolverError(f"harmonic balance did not converge at f1 = {f1_Hz} Hz, H = {H}, in "

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
+from rawehelix.periodic_orbits.problem import FREE_ROTATION
 
 METHODS = ("shooting", "hb", "auto")
 
@@ -15,7 +16,8 @@ def cannot(params: Parameters) -> str | None:
     """Why harmonic balance cannot trace ``params``'s orbits (None: it can): an
     internal variable or a free rotation breaks its unknowns."""
     if params.discretisation.scheme != "fe":
-        return "the spline reference has a period map only (shooting)"
+        return ("the spline reference has a period map only: use --method shooting, or "
+                "--scheme fe for harmonic balance")
     from rawehelix.solvers import harmonic_balance
     return harmonic_balance.cannot(params)
 
@@ -36,10 +38,12 @@ def choose(params: Parameters, method: str) -> tuple[str, str]:
     refused (bad input)."""
     if method not in METHODS:
         raise SceneError("--method", method, f"must be one of {METHODS}")
+    if params.normalised().steady_torque().k1 == 0.0:  # neither method: the way out
+        raise SceneError("--method", method, FREE_ROTATION)
     why = wrong_tool(params)
     if method == "hb" and cannot(params):
         raise SceneError("--method", method, f"harmonic balance is the wrong tool here: "
-                         f"{cannot(params)}; use --method shooting (or auto)")
+                         f"{cannot(params)}")
     if method == "auto":
         if why:
             return "shooting", f"auto: shooting, as {why}"

@@ -260,6 +260,8 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
                  on_point=store.save if store else None)
     limits = branch_limits.OrbitLimits(m, params)  # one period more an orbit (AlphaMap.sections)
     entries = [limits.entry(o) for o in traced.points]
+    if traced.stopped:  # a point that was not an orbit ended the window early
+        about["stopped"] = traced.stopped
     about["orbits"] = traced.points  # for the envelope (not in the summary)
     return entries, traced.folds, traced.bifurcations, traced.peaks, about
 
