@@ -39,7 +39,7 @@ from mpi4py import MPI
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits.bifurcations import critical, stability_changes
-from rawehelix.studies import branch_limits, envelope_curves, orbits, writers
+from rawehelix.studies import branch_limits, envelope_curves, forcing, orbit_method, orbits, writers
 from rawehelix.studies.sampling import Variable
 
 DEFAULT_VALUES = 5  # ticks when --vary gives no COUNT
@@ -181,8 +181,11 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
     if not (0 < f1_lo < f1_hi):
         raise SceneError("--f1", f"{f1_lo}:{f1_hi}", "must be LO:HI with 0 < LO < HI [Hz]")
     values = values_of(vary)
-    for v in values:
-        params_at(params, vary.key, v)  # every value checked before any work
+    for v in values:  # every value checked before any work
+        at = params_at(params, vary.key, v)
+        forcing.require(at, "envelope", where=f"--vary {vary.key}={v}" if vary.key
+                        == "ends.circle_radius_m" else None)
+        orbit_method.choose(at, method)
     start = time.perf_counter()
     mine, error = [], None
     for k in range(comm.rank, len(values), comm.size):

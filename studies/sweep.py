@@ -41,7 +41,7 @@ from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.section_samples import SectionSampler
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import branch_limits, limits, schemes, writers
+from rawehelix.studies import branch_limits, forcing, limits, schemes, writers
 from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
 from rawehelix.studies.scene import SceneError
 
@@ -199,6 +199,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     call resumes a stopped sweep (see the module docstring); without it the
     sweep writes nothing.  Returns the :class:`SweepResult` (summary on every rank)."""
     start = time.perf_counter()
+    forcing.require(params, "sweep")
     limits.check_bending_resolution(params, "sweep")
     frequencies = validate_frequencies(params.sweep.frequencies() if f1_Hz is None else f1_Hz)
     stepsize.check(params, frequencies)  # FE: fixed steps resolve the forcing and omega_L
