@@ -342,6 +342,7 @@ class Branch:
             self.state = State(tau=tau_new, A=A, gf=gf, w=self.w.copy(), ds=ds, fresh=refreshed,
                                natural=natural or min(its, prev.newton_iterations) >= SLOW)
             self.points.append(orbit)
+            prev.release()  # only the newest point's tangent is taken again
             if on_point:
                 on_point(orbit, events, self.state)
             if progress:
