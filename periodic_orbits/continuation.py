@@ -308,7 +308,8 @@ class Branch:
                 st.natural = True  # a failed corrector: try the next step at fixed f1
                 if st.ds < self.ds_min:
                     raise SolverError(f"continuation: the corrector failed at f1 = "
-                                      f"{prev.f1_Hz:.4f} Hz with the smallest step {self.ds_min}")
+                                      f"{prev.f1_Hz:.4f} Hz with the smallest step "
+                                      f"{self.ds_min}; try the other --method")
                 continue
             X, f1, its, res, samples, refreshed = got
             # the guards' verdicts (all of them: each keeps what it measured)

@@ -370,7 +370,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
             lu.destroy()
             X, last = trial, res
         raise SolverError(f"harmonic balance did not converge at f1 = {f1_Hz} Hz, H = {H}, in "
-                          f"{max_it} iterations (|G|/|X| = {last:.3g} > {tol:g})")
+                          f"{max_it} iterations (|G|/|X| = {last:.3g} > {tol:g}); start the --f1 "
+                          f"window where the response is small, or try --method shooting")
 
     def finish(self, X, f1_Hz, iterations, residual, start, resolution=None) -> Orbit:
         H = self._H(X, resolution)

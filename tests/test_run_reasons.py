@@ -372,3 +372,27 @@ def test_sweep_says_what_still_moves(tmp_path):
     why = point["not_periodic"]
     assert why["moving"][0]["part"] == "the twist's rotation rate"
     assert any("--set controller.k1=0.5" in a for a in why["advice"])
+
+
+# -- memory: what a long branch keeps --------------------------------------------------------
+def test_a_dropped_lu_is_destroyed():
+    """petsc4py 3.18 leaves a dropped object to PETSc's garbage: an LU (its MUMPS
+    factor) dropped by the continuation grew HB's Fig. 8 by ~7 MB a point at N = 4."""
+    import scipy.sparse as sparse
+    from rawehelix.solvers.sparse_lu import LU
+    lu = LU(sparse.eye(50, format="csr") * 2.0)
+    assert lu.solve(np.ones(50)) == pytest.approx(0.5)
+    ksp, A = lu.ksp, lu.A
+    del lu
+    assert ksp.handle == 0 and A.handle == 0
+
+
+def test_a_branch_keeps_the_matrices_of_its_newest_point_only():
+    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.studies.orbits import branch
+    hb = HarmonicBalance(scene.load("mobile_end", elements=4))
+    points = branch(hb).trace(hb.orbit(hb.X_stationary, 10.0), 9.0, direction=-1.0,
+                              max_points=3)
+    assert len(points) == 3
+    assert all(p.jacobian is None and p.G is None for p in points[:-1])
+    assert points[-1].jacobian is not None
