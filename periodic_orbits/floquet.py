@@ -130,6 +130,11 @@ class PeriodMap(PeriodicOrbitProblem):
         return gf
 
     def jacobian(self, orbit: Orbit) -> np.ndarray:
+        """The Newton matrix at ``orbit``: of its monodromy, or of a tangent period
+        again where the branch has released it (``Orbit.release``)."""
+        if orbit.monodromy is None:
+            orbit.monodromy = self.period(orbit.X, orbit.f1_Hz, tangent=True,
+                                          steps=orbit.steps)[2]
         return self.newton_matrix(orbit.monodromy)
 
     def norm(self, G, X) -> float:

@@ -93,7 +93,9 @@ class Orbit:
 
     def release(self):
         """Drop the matrices only the branch's newest point needs (its tangent's): a
-        branch kept every point's, 1.1 MB a point at N = 4 by harmonic balance."""
+        branch kept every point's, 1.1 MB a point at N = 4 by harmonic balance.  A
+        trace started again from a released point has them evaluated again
+        (``PeriodicOrbitProblem.jacobian``)."""
         self.monodromy = self.jacobian = self.G = None
 
     @property

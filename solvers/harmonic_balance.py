@@ -242,6 +242,10 @@ class HarmonicBalance(PeriodicOrbitProblem):
         return (G_at(f1_Hz + h) - G_at(f1_Hz - h)) / (2 * h)
 
     def jacobian(self, orbit: Orbit):
+        """dG/dX at ``orbit``, evaluated again where the branch has released it."""
+        if orbit.jacobian is None:
+            orbit.jacobian = self.residual(orbit.X, orbit.f1_Hz, jacobian=True,
+                                           resolution=orbit.steps)[2]
         return orbit.jacobian
 
     def factor(self, K):

@@ -185,10 +185,11 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
     maxima, minima, means, history = [], [], [], []
     sampler = getattr(backend, "section_sampler", None)
     parts = getattr(backend, "parts", None)  # the state's parts, to say what still moves
-    ends = [None, parts(state) if parts else None]  # at the last two periods' ends
     periodic = slack = False
-    measure = None
+    measure = before = None
     for k in range(1, sweep.max_periods + 1):
+        if parts and k == sweep.max_periods:  # the last period's start, if it is not periodic
+            before = parts(state)
         t_out = t + period * np.arange(1, n + 1) / n
         state, tension = backend.advance(state, t, t + period, t_out)
         if not np.all(np.isfinite(tension)):
@@ -201,8 +202,6 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         slack = slack or minima[-1] <= 0
         history.append((t_out, tension, sampler.take() if sampler is not None else None))
         history = history[-sweep.record_periods:]
-        if parts:
-            ends = [ends[1], parts(state)]
         measure = transient(maxima, minima, means, sweep.periodic_tolerance, sweep.record_periods)
         if progress:
             progress(k, measure)
@@ -222,6 +221,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         sections=None if sampler is None else sampler.sections(
             [kept for h in history for kept in h[2]]))
     if not periodic:
+        ends = (before, parts(state)) if before is not None else None
         result.unsettled = unsettled(q, measure, ends, sweep, result.periods)
     return result, state, t
 
@@ -230,7 +230,7 @@ def unsettled(q: Normalised, measure: Transient | None, ends, sweep: Sweep,
               periods: int) -> dict:
     """Why a point is not periodic, in SI: the periodicity test's measure on the
     tension at s = 0 (the part it judges), the state's parts by how much they still
-    move a period (``ends``: their values at the last two periods' ends, or None),
+    move a period (``ends``: their values at the last period's start and end, or None),
     and the periods the transient would still need at its decay rate."""
     scale = float(q.tension_N(1.0))
     out = {"judged": "T max and T min at s = 0, from one period to the next",
@@ -246,7 +246,7 @@ def unsettled(q: Normalised, measure: Transient | None, ends, sweep: Sweep,
                     else measure.remainder * scale,
                     "periods_to_settle": measure.periods_to_settle()})
         out["reason"] = ("not decaying" if measure.remainder is None else "decaying too slowly")
-    if ends[0] is not None and ends[1] is not None:
+    if ends is not None:
         out["moving"] = [{"part": name, "change_per_period": change}
                          for name, change in moving_parts(*ends)]
     return out

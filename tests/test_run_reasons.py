@@ -396,3 +396,8 @@ def test_a_branch_keeps_the_matrices_of_its_newest_point_only():
     assert len(points) == 3
     assert all(p.jacobian is None and p.G is None for p in points[:-1])
     assert points[-1].jacobian is not None
+    # a trace started again from a released point evaluates its Jacobian again and
+    # takes the same step
+    again = branch(hb).trace(points[0], 9.0, direction=-1.0, max_points=2)
+    assert again[1].f1_Hz == pytest.approx(points[1].f1_Hz, abs=1e-9)
+    assert again[1].tension_max_N == pytest.approx(points[1].tension_max_N, rel=1e-9)
