@@ -41,9 +41,10 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits import harmonics, hill
-from rawehelix.periodic_orbits.continuation import FLOOR_FACTOR
 from rawehelix.periodic_orbits.problem import FREE_ROTATION, Orbit, PeriodicOrbitProblem
+from rawehelix.solvers import hb_newton
 from rawehelix.solvers.dynamics import DynamicsSolver
+from rawehelix.solvers.hb_newton import Diverged
 from rawehelix.solvers.rod_operator import RodOperator
 from rawehelix.solvers.sparse_lu import LU
 from rawehelix.solvers.snes import SolverError
@@ -53,8 +54,6 @@ TAIL_TOL = 1e-8  # the highest harmonic's share of the oscillation's energy, at 
 FINE = 256  # samples of T(0) per period for its extremes (a smooth signal's maximum
 # is then missed by (pi / 256)^2 / 2 = 8e-5 of its oscillation at the highest harmonic)
 SHIFTS = 2  # the least damped exponents of the averaged system used as Hill shifts
-BACKTRACK_MIN = 1.0 / 64  # the shortest fraction of a Newton step tried
-STEP_TOL = 1e-12  # a Newton correction this small (relative to X): converged at G's floor
 HOMOTOPY_MIN = 1.0 / 64  # the shortest step in the end's amplitude (HarmonicBalance._start)
 START_RETRIES = 2  # the first orbit's search, H raised this many times where it fails
 
@@ -68,11 +67,6 @@ def cannot(params: Parameters) -> str | None:
                 "a period (its multipliers are 1 - O(beta x twist travel): shooting carries "
                 "it): use --method shooting (or auto)")
     return None
-
-
-class Diverged(SolverError):
-    """Newton's correction at round-off with |G| far above its tolerance: the scene
-    holds no orbit that double precision resolves, at any H."""
 
 
 class HarmonicBalance(PeriodicOrbitProblem):
@@ -331,51 +325,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
         return X, total, res
 
     def _newton(self, X, f1_Hz, H, tol, max_it, amplitude=1.0, plain=False):
-        """Newton at fixed f1 and H, damped by natural monotonicity (``plain``: every
-        step whole while G stays finite)."""
-        last = np.inf
-        for its in range(1, max_it + 1):
-            G, _, J = self.residual(X, f1_Hz, jacobian=True, resolution=H, amplitude=amplitude)
-            res = self.norm(G, X)
-            if res <= tol:
-                return X, its, res
-            lu = LU(J)
-            step = lu.solve(G)
-            if np.linalg.norm(step) <= STEP_TOL * max(1.0, np.linalg.norm(X)):
-                lu.destroy()  # X is exact to round-off: G is at its floor, if that is small
-                if res <= FLOOR_FACTOR * tol:
-                    return X, its, res
-                chord = self.params.helix.EA_N * self.params.ends.elongation
-                raise Diverged(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: Newton's "
-                               f"correction is at round-off while |G|/|X| = {res:.3g} > "
-                               f"{FLOOR_FACTOR * tol:g}, so no orbit to double precision "
-                               f"(the chord's tension EA x ends.elongation is {chord:.3g} N); "
-                               f"check the scene's ends.elongation and stiffnesses")
-            frac = 1.0
-            # Deuflhard's natural monotonicity: the simplified Newton correction at the
-            # trial (the same LU) shorter than the step; |G| itself is no merit function
-            # here, where the axial rows' scale (sigma) dwarfs the others'
-            while frac >= BACKTRACK_MIN:
-                trial = X - frac * step
-                G_t = self.residual(trial, f1_Hz, resolution=H, amplitude=amplitude)[0]
-                finite = bool(np.all(np.isfinite(G_t)))
-                if plain and finite:
-                    break
-                bar = lu.solve(G_t) if finite else np.full_like(step, np.inf)
-                if np.linalg.norm(bar) < (1 - frac / 4) * np.linalg.norm(step) \
-                        or self.norm(G_t, trial) <= tol:
-                    break
-                frac /= 2
-            else:
-                lu.destroy()
-                raise SolverError(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: no descent "
-                                  f"along the Newton step (|G|/|X| = {res:.3g}); start the --f1 "
-                                  f"window where the response is small")
-            lu.destroy()
-            X, last = trial, res
-        raise SolverError(f"harmonic balance did not converge at f1 = {f1_Hz} Hz, H = {H}, in "
-                          f"{max_it} iterations (|G|/|X| = {last:.3g} > {tol:g}); start the --f1 "
-                          f"window where the response is small, or try --method shooting")
+        """Newton at fixed f1 and H (solvers/hb_newton.py)."""
+        return hb_newton.newton(self, X, f1_Hz, H, tol, max_it, amplitude, plain)
 
     def finish(self, X, f1_Hz, iterations, residual, start, resolution=None) -> Orbit:
         H = self._H(X, resolution)

@@ -149,7 +149,7 @@ CAMEL = re.compile(r"\b[A-Z][a-z0-9]+(?:[A-Z][a-z0-9]+)+\b")
 ATTRIBUTE = re.compile(r"\b[A-Za-z_]\w*\.[a-z_]\w*\(|\b[A-Z]\w+\.[a-z_]\w+\b")
 REFUSERS = ["studies/orbit_method.py", "studies/orbits.py", "studies/envelope.py",
             "studies/forcing.py", "studies/sweep.py", "studies/sweep_advice.py",
-            "solvers/harmonic_balance.py", "solvers/periodic.py",
+            "solvers/harmonic_balance.py", "solvers/hb_newton.py", "solvers/periodic.py",
             "references/spline_galerkin/orbits.py", *sorted(
                 str(p.relative_to(ROOT)) for p in (ROOT / "periodic_orbits").glob("*.py"))]
 
