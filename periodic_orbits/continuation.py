@@ -130,6 +130,7 @@ class Branch:
         self.ds, self.ds_min, self.ds_max, self.tol, self.max_it = ds, ds_min, ds_max, tol, max_it
         self.observable, self.guards = observable, tuple(guards)
         self.points: list[Orbit] = []
+        self.stopped: str | None = None  # why the trace ended before its window's end
         self.folds: list[dict] = []
         self.bifurcations: list[dict] = []
         self.peaks: list[dict] = []
@@ -226,8 +227,23 @@ class Branch:
             log.debug("natural step to %.6f Hz failed: %s", f1, err)
             return None
 
+    def valid(self, orbit: Orbit) -> bool:
+        """A point is an orbit only if its residual is within the tolerance (or within
+        FLOOR_FACTOR of it, |G|'s round-off floor: the corrector's own test)."""
+        return bool(orbit.residual <= FLOOR_FACTOR * self.tol)
+
+    def invalid(self, orbit: Orbit, first: bool = False) -> str:
+        """Why ``orbit`` is not a point of the branch (the run's stop reason)."""
+        ends = "the branch has no point" if first else "the branch ends at the point before it"
+        return (f"at f1 = {orbit.f1_Hz:.5g} Hz the residual |G|/|X| = {orbit.residual:.3g} is "
+                f"above its tolerance {FLOOR_FACTOR * self.tol:g}: not an orbit, so {ends}; "
+                f"check the scene (its forces' scales), or try the other --method")
+
     def start(self, first: Orbit, direction: float = 1.0):
-        """The first point and its tangent in ``direction`` of f1."""
+        """The first point and its tangent in ``direction`` of f1 (SolverError if the
+        first point is not an orbit: :meth:`valid`)."""
+        if not self.valid(first):
+            raise SolverError(f"continuation: {self.invalid(first, first=True)}")
         n = first.X.size
         tau = np.zeros(n + 1)
         tau[-1] = direction
@@ -292,7 +308,8 @@ class Branch:
                 st.natural = True  # a failed corrector: try the next step at fixed f1
                 if st.ds < self.ds_min:
                     raise SolverError(f"continuation: the corrector failed at f1 = "
-                                      f"{prev.f1_Hz:.4f} Hz with the smallest step {self.ds_min}")
+                                      f"{prev.f1_Hz:.4f} Hz with the smallest step "
+                                      f"{self.ds_min}; try the other --method")
                 continue
             X, f1, its, res, samples, refreshed = got
             # the guards' verdicts (all of them: each keeps what it measured)
@@ -320,9 +337,13 @@ class Branch:
             elif its >= 7:
                 ds = max(self.ds_min, ds / 1.5)
             ds = self._cap(self.points + [orbit], tau_new[-1], ds, st.ds)
+            if not self.valid(orbit):  # not a point: the branch ends before it, and says why
+                self.stopped = self.invalid(orbit)
+                break
             self.state = State(tau=tau_new, A=A, gf=gf, w=self.w.copy(), ds=ds, fresh=refreshed,
                                natural=natural or min(its, prev.newton_iterations) >= SLOW)
             self.points.append(orbit)
+            prev.release()  # only the newest point's tangent is taken again
             if on_point:
                 on_point(orbit, events, self.state)
             if progress:

@@ -47,7 +47,7 @@ import time
 import numpy as np
 
 from rawehelix.errors import SolverError
-from rawehelix.periodic_orbits.problem import (DenseLU, Orbit,  # noqa: F401  (Orbit re-exported)
+from rawehelix.periodic_orbits.problem import (FREE_ROTATION, DenseLU, Orbit,  # noqa: F401
                                                PeriodicOrbitProblem)
 
 BACKTRACK_MIN = 1.0 / 32  # the shortest fraction of a Newton step the shooting tries
@@ -57,6 +57,11 @@ SLOW_RATE = 0.1
 #: the same for the linear monodromy (PeriodMap.linear_monodromy), which costs about one
 #: period of the map to build, a tenth of a fresh monodromy (N = 8, 4.34 Hz; 1/50 at 0.6 Hz)
 LINEAR_RATE = 0.5
+
+
+#: what to try where shooting finds no orbit (its refusals' way out, on the command line)
+WAY_OUT = ("try --method hb (harmonic balance, where the scene's laws allow it), or start "
+           "the --f1 window where the response is small, away from a resonance")
 
 
 class Broyden:
@@ -101,9 +106,7 @@ class PeriodMap(PeriodicOrbitProblem):
     # -- the periodic-orbit problem (periodic_orbits/problem.py) ---------------------------
     def continuable(self):
         if not self.controller:
-            raise SolverError("continuation: a scene without the controller's integral action "
-                              "(k1 = 0) has a free twist rotation; continue it at fixed f1 steps "
-                              "(AlphaMap.orbit) instead")
+            raise SolverError(f"orbits: {FREE_ROTATION}")
 
     def resolution(self, f1_Hz: float) -> int:
         return self.steps_per_period(f1_Hz)
@@ -127,6 +130,11 @@ class PeriodMap(PeriodicOrbitProblem):
         return gf
 
     def jacobian(self, orbit: Orbit) -> np.ndarray:
+        """The Newton matrix at ``orbit``: of its monodromy, or of a tangent period
+        again where the branch has released it (``Orbit.release``)."""
+        if orbit.monodromy is None:
+            orbit.monodromy = self.period(orbit.X, orbit.f1_Hz, tangent=True,
+                                          steps=orbit.steps)[2]
         return self.newton_matrix(orbit.monodromy)
 
     def norm(self, G, X) -> float:
@@ -262,15 +270,15 @@ class PeriodMap(PeriodicOrbitProblem):
                     continue
                 if frac < BACKTRACK_MIN:  # half the Newton step, down to this
                     raise SolverError(f"orbits: shooting at f1 = {f1_Hz} Hz found no descent "
-                                      f"along its Newton step (|G|/|X| = {last:.3g}); start "
-                                      f"nearer the orbit (a lower f1, or more lead-in periods)")
+                                      f"along its Newton step (|G|/|X| = {last:.3g}); "
+                                      f"{WAY_OUT}")
                 frac /= 2
                 X, delta = X0_ - frac * step[:-1], d0 - frac * step[-1]
                 back = (X0_, d0, step, frac, fresh)
                 continue
             if G is None:
                 raise SolverError(f"orbits: the period map failed from the shooting's "
-                                  f"start at f1 = {f1_Hz} Hz")
+                                  f"start at f1 = {f1_Hz} Hz; {WAY_OUT}")
             if res <= tol:
                 X = self.settle(X, G)
                 break
@@ -297,7 +305,7 @@ class PeriodMap(PeriodicOrbitProblem):
             X, delta = X - step[:-1], delta - step[-1]
         else:
             raise SolverError(f"orbits: shooting did not converge at f1 = {f1_Hz} Hz in "
-                              f"{max_it} iterations (|G|/|X| = {res:.3g} > {tol:g})")
+                              f"{max_it} iterations (|G|/|X| = {res:.3g} > {tol:g}); {WAY_OUT}")
         return self.orbit_through(X, f1_Hz, delta, its, res, start, steps)
 
     def orbit_through(self, X, f1_Hz, delta, its, res, start, steps=None) -> Orbit:

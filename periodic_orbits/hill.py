@@ -315,10 +315,11 @@ def averaged_exponents(M_samples, C_samples, K_samples, free, count: int) -> lis
     multipliers are the largest on a stable orbit."""
     M, C, K = (_restrict(_mean(samples), free) for samples in (M_samples, C_samples, K_samples))
     m = M.shape[0]
-    A = np.block([[np.zeros((m, m)), np.eye(m)],
-                  [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-    lam = np.linalg.eigvals(A)
-    lam = lam[lam.imag > 1e-9]
+    # the pencil (A, B), not B^-1 A: M is singular where unknowns carry no inertia (the
+    # mixed bending's moments), whose exponents are infinite and dropped
+    Z, I = np.zeros((m, m)), np.eye(m)
+    lam = scipy.linalg.eigvals(np.block([[Z, I], [-K, -C]]), np.block([[I, Z], [Z, M]]))
+    lam = lam[np.isfinite(lam) & (lam.imag > 1e-9)]
     return list(lam[np.argsort(-lam.real)][:count])
 
 

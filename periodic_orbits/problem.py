@@ -52,6 +52,17 @@ import numpy as np
 import scipy.linalg
 
 
+#: what a scene without the controller's integral action (k1 = 0, Eq. 40) gets from
+#: ``orbits`` and ``envelope``, with the command-line way out (one line): its twist's
+#: rotation is free, a family of orbits, so no isolated orbit exists to continue in f1
+#: by either method; the shipped forced scenes' gain is k1 = 0.5
+FREE_ROTATION = ("without the controller's integral action (k1 = 0, Eq. 40) the twist's "
+                 "rotation is free, a family of orbits that no method can continue in f1: add "
+                 "to the scene '[controller]' with 'k1 = 0.5' (the shipped scenes' gain), or "
+                 "run with --set controller.k1=0.5; 'rawehelix sweep' integrates in time and "
+                 "needs no controller")
+
+
 @dataclasses.dataclass
 class Orbit:
     """A periodic orbit at one f1 (normalised state, SI outputs)."""
@@ -79,6 +90,13 @@ class Orbit:
     jacobian: object = dataclasses.field(default=None, repr=False)
     #: the resolution's own accuracy at the orbit (harmonic balance: H, samples, tail)
     accuracy: dict = dataclasses.field(default_factory=dict)
+
+    def release(self):
+        """Drop the matrices only the branch's newest point needs (its tangent's): a
+        branch kept every point's, 1.1 MB a point at N = 4 by harmonic balance.  A
+        trace started again from a released point has them evaluated again
+        (``PeriodicOrbitProblem.jacobian``)."""
+        self.monodromy = self.jacobian = self.G = None
 
     @property
     def max_multiplier(self) -> float:

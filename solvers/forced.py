@@ -54,6 +54,7 @@ class FEBackend:
         self._last = None  # (the state the last advance returned, the motion it ran)
         #: an optional step hook with ``expect(t_out)`` (solvers/section_samples.py)
         self.section_sampler = None
+        self._part_dofs = None  # (centre line, twist) dofs, for :meth:`parts`
 
     def track_sections(self) -> None:
         """Sample the section along s over the recorded periods (the limits block)."""
@@ -120,6 +121,23 @@ class FEBackend:
         values = np.array([v for _, v in samples])
         tension = np.interp(np.asarray(t_out), times, values) if len(times) else np.full(len(t_out), np.nan)
         return self._end(solver.state()), tension
+
+    def parts(self, state: RodState) -> dict:
+        """The state's parts whose change over a period says what is still moving
+        (solvers/periodic.py, ``unsettled``), normalised: the twist without its mean
+        (a spinning helix's twist grows by the rotation a period) and the rates."""
+        if self._part_dofs is None:
+            rod = self.solver.rod
+            self._part_dofs = (rod.dofs("centre_line"), rod.dofs("twist"))
+        r, a = self._part_dofs
+        out = {"the centre line": state.w[r]}
+        if a.size:
+            out["the twist about its mean"] = state.w[a] - state.w[a].mean()
+        if state.w_t is not None:
+            out["the centre line's velocity"] = state.w_t[r]
+            if a.size:
+                out["the twist's rotation rate"] = state.w_t[a]
+        return out
 
     @staticmethod
     def pack(state: RodState) -> dict:

@@ -41,8 +41,10 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits import harmonics, hill
-from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem
+from rawehelix.periodic_orbits.problem import FREE_ROTATION, Orbit, PeriodicOrbitProblem
+from rawehelix.solvers import hb_newton
 from rawehelix.solvers.dynamics import DynamicsSolver
+from rawehelix.solvers.hb_newton import Diverged
 from rawehelix.solvers.rod_operator import RodOperator
 from rawehelix.solvers.sparse_lu import LU
 from rawehelix.solvers.snes import SolverError
@@ -52,20 +54,18 @@ TAIL_TOL = 1e-8  # the highest harmonic's share of the oscillation's energy, at 
 FINE = 256  # samples of T(0) per period for its extremes (a smooth signal's maximum
 # is then missed by (pi / 256)^2 / 2 = 8e-5 of its oscillation at the highest harmonic)
 SHIFTS = 2  # the least damped exponents of the averaged system used as Hill shifts
-BACKTRACK_MIN = 1.0 / 64  # the shortest fraction of a Newton step tried
-STEP_TOL = 1e-12  # a Newton correction this small (relative to X): converged at G's floor
 HOMOTOPY_MIN = 1.0 / 64  # the shortest step in the end's amplitude (HarmonicBalance._start)
 START_RETRIES = 2  # the first orbit's search, H raised this many times where it fails
 
 
 def cannot(params: Parameters) -> str | None:
     """Why harmonic balance cannot trace ``params``'s orbits (None: it can)."""
+    if params.normalised().steady_torque().k1 == 0.0:
+        return FREE_ROTATION
     if params.model.torsion_hysteresis.active:
         return ("the hysteretic torsion's internal twist is non-smooth and hardly moves over "
-                "a period (its multipliers are 1 - O(beta x twist travel): shooting carries it)")
-    if params.normalised().steady_torque().k1 == 0.0:
-        return ("without the controller's integral action (k1 = 0) the twist's rotation is "
-                "free, a family of orbits")
+                "a period (its multipliers are 1 - O(beta x twist travel): shooting carries "
+                "it): use --method shooting (or auto)")
     return None
 
 
@@ -81,7 +81,7 @@ class HarmonicBalance(PeriodicOrbitProblem):
                               "windows on separate ranks")
         why = cannot(params)
         if why:
-            raise SolverError(f"harmonic balance: {why}; use --method shooting")
+            raise SolverError(f"harmonic balance: {why}")
         self.params = params
         self.op = op = RodOperator(params, comm, solver)
         self.q_base = params.normalised().steady_torque()
@@ -236,6 +236,10 @@ class HarmonicBalance(PeriodicOrbitProblem):
         return (G_at(f1_Hz + h) - G_at(f1_Hz - h)) / (2 * h)
 
     def jacobian(self, orbit: Orbit):
+        """dG/dX at ``orbit``, evaluated again where the branch has released it."""
+        if orbit.jacobian is None:
+            orbit.jacobian = self.residual(orbit.X, orbit.f1_Hz, jacobian=True,
+                                           resolution=orbit.steps)[2]
         return orbit.jacobian
 
     def factor(self, K):
@@ -272,11 +276,13 @@ class HarmonicBalance(PeriodicOrbitProblem):
         while True:
             try:
                 X, its, res = self._start(X, f1_Hz, H, tol, max_it)
+            except Diverged:
+                raise  # more harmonics do not help
             except SolverError as err:
                 retries += 1  # too few harmonics may hold no orbit: twice more, then say so
                 if steps or H >= self.H_max or retries > START_RETRIES:
                     raise SolverError(f"{err} (tried H up to {H}: a non-smooth law, such as "
-                                      f"the members' slack, needs many harmonics; "
+                                      f"the members' slack, needs many harmonics: try "
                                       f"--method shooting)") from None
                 H = self._more(H)
                 X = self.embed(X0, H)
@@ -313,48 +319,14 @@ class HarmonicBalance(PeriodicOrbitProblem):
                 except SolverError:
                     raise SolverError(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: no orbit "
                                       f"found by a homotopy in the end's amplitude (a fold at "
-                                      f"{done:.3g} of it); start from a nearby orbit") from None
+                                      f"{done:.3g} of it); start the --f1 window where the "
+                                      f"response is small, away from a resonance") from None
             X, done, total = X_to, to, total + its
         return X, total, res
 
     def _newton(self, X, f1_Hz, H, tol, max_it, amplitude=1.0, plain=False):
-        """Newton at fixed f1 and H, damped by natural monotonicity (``plain``: every
-        step whole while G stays finite)."""
-        last = np.inf
-        for its in range(1, max_it + 1):
-            G, _, J = self.residual(X, f1_Hz, jacobian=True, resolution=H, amplitude=amplitude)
-            res = self.norm(G, X)
-            if res <= tol:
-                return X, its, res
-            lu = LU(J)
-            step = lu.solve(G)
-            if np.linalg.norm(step) <= STEP_TOL * max(1.0, np.linalg.norm(X)):
-                lu.destroy()  # X is exact to round-off: G is at its floor
-                return X, its, res
-            frac = 1.0
-            # Deuflhard's natural monotonicity: the simplified Newton correction at the
-            # trial (the same LU) shorter than the step; |G| itself is no merit function
-            # here, where the axial rows' scale (sigma) dwarfs the others'
-            while frac >= BACKTRACK_MIN:
-                trial = X - frac * step
-                G_t = self.residual(trial, f1_Hz, resolution=H, amplitude=amplitude)[0]
-                finite = bool(np.all(np.isfinite(G_t)))
-                if plain and finite:
-                    break
-                bar = lu.solve(G_t) if finite else np.full_like(step, np.inf)
-                if np.linalg.norm(bar) < (1 - frac / 4) * np.linalg.norm(step) \
-                        or self.norm(G_t, trial) <= tol:
-                    break
-                frac /= 2
-            else:
-                lu.destroy()
-                raise SolverError(f"harmonic balance at f1 = {f1_Hz} Hz, H = {H}: no descent "
-                                  f"along the Newton step (|G|/|X| = {res:.3g}); start nearer "
-                                  f"the orbit")
-            lu.destroy()
-            X, last = trial, res
-        raise SolverError(f"harmonic balance did not converge at f1 = {f1_Hz} Hz, H = {H}, in "
-                          f"{max_it} iterations (|G|/|X| = {last:.3g} > {tol:g})")
+        """Newton at fixed f1 and H (solvers/hb_newton.py)."""
+        return hb_newton.newton(self, X, f1_Hz, H, tol, max_it, amplitude, plain)
 
     def finish(self, X, f1_Hz, iterations, residual, start, resolution=None) -> Orbit:
         H = self._H(X, resolution)

@@ -66,13 +66,16 @@ class PointResult:
     #: [(t, Probes.section() dict)] (normalised) over the recorded periods; None: the
     #: backend has no section sampler (not in the entry: studies/sweep_limits.py)
     sections: list | None = None
+    #: why the point is not periodic (:func:`unsettled`); None: it is
+    unsettled: dict | None = None
 
     def entry(self) -> dict:
         """The summary.json entry."""
         return {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
                 "tension_min_N": self.tension_min_N, "tension_mean_N": self.tension_mean_N,
                 "periods": self.periods, "periodic": self.periodic, "slack": self.slack,
-                "wall_s": self.wall_s, "start": self.start}
+                "wall_s": self.wall_s, "start": self.start,
+                **({"not_periodic": self.unsettled} if self.unsettled else {})}
 
 
 #: names the test of :func:`settled` in a sweep checkpoint's fingerprint: a
@@ -91,6 +94,49 @@ OSCILLATION_FLOOR = 1.0e-6
 ROUNDOFF = 1.0e-10
 
 
+@dataclass
+class Transient:
+    """What :func:`settled` measured over its last 3 blocks of periods (in the units of
+    the tension it was given): the largest per-period change of T max or T min over
+    the last block, its decay a period ``ratio`` (None: not measurable, a block without
+    change), the bound on what remains ``remainder`` (None: not decaying, r >= 1), and
+    what the tolerance allows."""
+
+    change: float
+    ratio: float | None
+    remainder: float | None
+    allowed: float
+    settled: bool
+
+    def periods_to_settle(self) -> int | None:
+        """More periods until the remainder, decaying by ``ratio`` a period, is within
+        the allowance (None: not decaying, or already within)."""
+        if self.settled or self.remainder is None or not self.ratio or self.allowed <= 0:
+            return None
+        return math.ceil(math.log(self.allowed / self.remainder) / math.log(self.ratio))
+
+
+def transient(maxima, minima, means, tolerance: float, periods: int) -> Transient | None:
+    """The periodicity test's measure (:func:`settled`); None: fewer than its
+    3 ``periods`` + 1 periods."""
+    need = 3 * periods + 1
+    if len(maxima) < need:
+        return None
+    hi, lo, mean = (np.asarray(v[-need:], dtype=float) for v in (maxima, minima, means))
+    allowed = tolerance * max(hi[-1] - lo[-1], OSCILLATION_FLOOR * abs(mean[-1]))
+    change = np.maximum(np.abs(np.diff(hi)), np.abs(np.diff(lo)))
+    block = change.reshape(3, periods).max(axis=1)
+    last = float(block[-1])
+    if last <= ROUNDOFF * abs(mean[-1]):
+        return Transient(last, None, 0.0, allowed, True)
+    if block[0] == 0.0 or block[1] == 0.0:
+        return Transient(last, None, None, allowed, False)
+    r = float(max(block[1] / block[0], block[2] / block[1]) ** (1.0 / periods))
+    remainder = last * r / (1.0 - r) if r < 1.0 else None
+    return Transient(last, r, remainder, allowed,
+                     bool(remainder is not None and remainder <= allowed))
+
+
 def settled(maxima, minima, means, tolerance: float, periods: int) -> bool:
     """True if what remains of the transient after the last period is at most
     ``tolerance`` x max(T max - T min, OSCILLATION_FLOOR x |mean T|).
@@ -105,26 +151,28 @@ def settled(maxima, minima, means, tolerance: float, periods: int) -> bool:
     ``periods`` (several periods a block: one small change alone can be the flat
     top of a slow beat).  A response whose changes do not shrink (r >= 1) has
     not settled, unless they are round-off (at most ROUNDOFF x |mean T|)."""
-    need = 3 * periods + 1
-    if len(maxima) < need:
-        return False
-    hi, lo, mean = (np.asarray(v[-need:], dtype=float) for v in (maxima, minima, means))
-    scale = max(hi[-1] - lo[-1], OSCILLATION_FLOOR * abs(mean[-1]))
-    change = np.maximum(np.abs(np.diff(hi)), np.abs(np.diff(lo)))
-    block = change.reshape(3, periods).max(axis=1)
-    if block[-1] <= ROUNDOFF * abs(mean[-1]):
-        return True
-    if block[0] == 0.0 or block[1] == 0.0:
-        return False
-    r = max(block[1] / block[0], block[2] / block[1]) ** (1.0 / periods)
-    return bool(r < 1.0 and block[-1] * r / (1.0 - r) <= tolerance * scale)
+    measure = transient(maxima, minima, means, tolerance, periods)
+    return measure is not None and measure.settled
+
+
+def moving_parts(before: dict, after: dict) -> list[tuple[str, float]]:
+    """The parts of the state (a backend's ``parts``: name -> array) by their change
+    over the last period relative to their size, largest first."""
+    changes = []
+    for name, x1 in after.items():
+        x0 = before[name]
+        size = max(float(np.max(np.abs(x1), initial=0.0)), 1e-300)
+        changes.append((name, float(np.max(np.abs(x1 - x0), initial=0.0)) / size))
+    return sorted(changes, key=lambda c: -c[1])
 
 
 def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start: float,
-                      sweep: Sweep, lead_in: bool):
-    """Integrate at f1 from ``state`` at normalised time ``t_start``.
+                      sweep: Sweep, lead_in: bool, progress=None):
+    """Integrate at f1 from ``state`` at normalised time ``t_start``; ``progress(k,
+    measure)`` after each judged period k (``measure``: :func:`transient`'s, or None).
 
-    Returns (PointResult, final state, final normalised time)."""
+    Returns (PointResult, final state, final normalised time); a point that is not
+    periodic carries the measure that refused it (``PointResult.unsettled``)."""
     start_wall = time.perf_counter()
     q = q_base.at_frequency(f1_Hz, t_start)
     backend.set_frequency(f1_Hz, t_start)
@@ -138,8 +186,12 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
             t += period
     maxima, minima, means, history = [], [], [], []
     sampler = backend.section_sampler
+    parts = getattr(backend, "parts", None)  # the state's parts, to say what still moves
     periodic = slack = False
+    measure = before = None
     for k in range(1, sweep.max_periods + 1):
+        if parts and k == sweep.max_periods:  # the last period's start, if it is not periodic
+            before = parts(state)
         t_out = t + period * np.arange(1, n + 1) / n
         state, tension = backend.advance(state, t, t + period, t_out)
         if not np.all(np.isfinite(tension)):
@@ -152,8 +204,10 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         slack = slack or minima[-1] <= 0
         history.append((t_out, tension, sampler.take() if sampler is not None else None))
         history = history[-sweep.record_periods:]
-        if k >= sweep.min_periods and settled(maxima, minima, means, sweep.periodic_tolerance,
-                                              sweep.record_periods):
+        measure = transient(maxima, minima, means, sweep.periodic_tolerance, sweep.record_periods)
+        if progress:
+            progress(k, measure)
+        if k >= sweep.min_periods and measure is not None and measure.settled:
             periodic = True
             break
     t_rec = np.concatenate([h[0] for h in history])
@@ -168,4 +222,33 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         series_t_s=q.time_s(t_rec), series_tension_N=T_rec,
         sections=None if sampler is None else sampler.sections(
             [kept for h in history for kept in h[2]]))
+    if not periodic:
+        ends = (before, parts(state)) if before is not None else None
+        result.unsettled = unsettled(q, measure, ends, sweep, result.periods)
     return result, state, t
+
+
+def unsettled(q: Normalised, measure: Transient | None, ends, sweep: Sweep,
+              periods: int) -> dict:
+    """Why a point is not periodic, in SI: the periodicity test's measure on the
+    tension at s = 0 (the part it judges), the state's parts by how much they still
+    move a period (``ends``: their values at the last period's start and end, or None),
+    and the periods the transient would still need at its decay rate."""
+    scale = float(q.tension_N(1.0))
+    out = {"judged": "T max and T min at s = 0, from one period to the next",
+           "periods": periods, "tolerance": sweep.periodic_tolerance}
+    if measure is None:
+        out["periods_to_judge"] = 3 * sweep.record_periods + 1
+        out["reason"] = (f"too few periods to judge: the test needs 3 x sweep.record_periods "
+                         f"+ 1 = {out['periods_to_judge']}")
+    else:
+        out.update({"change_N": measure.change * scale, "allowed_N": measure.allowed * scale,
+                    "decay_per_period": measure.ratio,
+                    "remainder_N": None if measure.remainder is None
+                    else measure.remainder * scale,
+                    "periods_to_settle": measure.periods_to_settle()})
+        out["reason"] = ("not decaying" if measure.remainder is None else "decaying too slowly")
+    if ends is not None:
+        out["moving"] = [{"part": name, "change_per_period": change}
+                         for name, change in moving_parts(*ends)]
+    return out

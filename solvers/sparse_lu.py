@@ -48,3 +48,10 @@ class LU:
     def destroy(self):
         self.ksp.destroy()
         self.A.destroy()
+
+    def __del__(self):
+        # petsc4py 3.18 leaves a dropped object to PETSc's garbage, freed only by
+        # PETSc.garbage_cleanup: the continuation's dropped LUs (MUMPS factors) grew
+        # harmonic balance's Fig. 8 by ~7 MB a point at N = 4 (issue 41)
+        if not PETSc.Sys.isFinalized():
+            self.destroy()

@@ -42,7 +42,7 @@ from mpi4py import MPI
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits.bifurcations import critical, stability_changes
-from rawehelix.studies import branch_limits, envelope_curves, orbits, writers
+from rawehelix.studies import branch_limits, envelope_curves, forcing, orbit_method, orbits, writers
 from rawehelix.studies.orbits_store import OrbitsStoreError
 from rawehelix.studies.sampling import Variable
 
@@ -230,8 +230,11 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
                              "stationary' prints the elongation each ends.tension_N gives")
         params = params.replace(ends={"elongation": params.ends.elongation})
     values = values_of(vary)
-    for v in values:
-        params_at(params, vary.key, v)  # every value checked before any work
+    for v in values:  # every value checked before any work
+        at = params_at(params, vary.key, v)
+        forcing.require(at, "envelope", where=f"--vary {vary.key}={v}" if vary.key
+                        == "ends.circle_radius_m" else None)
+        orbit_method.choose(at, method)
     lock = None
     if outdir is not None:
         from rawehelix.studies.sweep_store import fingerprint

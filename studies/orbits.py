@@ -45,8 +45,9 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import branch_limits, schemes, writers
+from rawehelix.studies import branch_limits, forcing, schemes, writers
 from rawehelix.studies.orbits_report import report  # noqa: F401  (the command's text)
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
@@ -268,6 +269,8 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
                  on_point=store.save if store else None)
     limits = branch_limits.OrbitLimits(m, params)  # one period more an orbit (AlphaMap.sections)
     entries = [limits.entry(o) for o in traced.points]
+    if traced.stopped:  # a point that was not an orbit ended the window early
+        about["stopped"] = traced.stopped
     about["orbits"] = traced.points  # for the envelope (not in the summary)
     return entries, traced.folds, traced.bifurcations, traced.peaks, about
 
@@ -290,7 +293,15 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
             and np.isfinite(f1_start_Hz + f1_stop_Hz)):
         raise SolverError(f"orbits: the f1 window {f1_start_Hz}:{f1_stop_Hz} must be two "
                           f"different finite frequencies > 0 [Hz]")
-    refuse_turning_ring(params)  # before any output
+    forcing.require(params, "orbits")  # before any output
+    if isinstance(max_points, bool) or not (isinstance(max_points, int) and max_points >= 1):
+        raise SceneError("--max-points", str(max_points), "must be an integer >= 1 (the most "
+                         "points of each rank's window)")
+    if tension_step is not None and not 0 < tension_step < 1:
+        raise SceneError("--tension-step", str(tension_step), "must be a fraction in (0, 1): "
+                         f"the largest relative change of T max between two points (default "
+                         f"{TENSION_STEP})")
+    refuse_turning_ring(params)
     method, method_reason = orbit_method.choose(params, method)
     tension_step = TENSION_STEP if tension_step is None else tension_step
     superharmonics = tuple(SUPERHARMONIC_ORDERS if superharmonics is None else superharmonics)

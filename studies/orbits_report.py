@@ -28,6 +28,9 @@ def report(result) -> str:
     for w in s["windows"]:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
+        if "stopped" in w:
+            lines.append(f"  stopped early, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: "
+                         f"{w['stopped']}")
     defects = [p["defects"] for p in s["branch"] if "defects" in p]
     if defects:  # carried entries (hysteretic torsion: z, periodic_orbits/floquet.py)
         internal = [p["internal_multipliers"] for p in s["branch"]

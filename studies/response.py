@@ -34,7 +34,7 @@ from mpi4py import MPI
 
 from rawehelix.families import FAMILY_LABELS
 from rawehelix.parameters import Parameters
-from rawehelix.studies import limits, schemes, writers
+from rawehelix.studies import forcing, limits, schemes, writers
 from rawehelix.studies.scene import SceneError
 
 #: the curves whose local maxima are peaks (ResponsePoint attributes)
@@ -75,10 +75,7 @@ def check(params: Parameters, command: str = "response"):
     if not schemes.of(params).fe_assembled:
         raise SceneError(params.name, "discretisation.scheme",
                          f"'{command}' linearises the FE scheme (--scheme fe)")
-    if not params.ends.circle_radius_m > 0:
-        raise SceneError(params.name, "ends.circle_radius_m",
-                         f"must be > 0 for '{command}': the response is to the upper end's "
-                         f"circle of radius R1 (Eq. 70)")
+    forcing.require(params, command)
     if params.discretisation.elements < 2:
         raise SceneError(params.name, "discretisation.elements",
                          f"must be >= 2 for '{command}': the midpoint must be an interior node")

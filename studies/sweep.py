@@ -29,6 +29,7 @@ with T(t) near 10 Hz in a panel of its own).
 from __future__ import annotations
 
 import logging
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,7 +41,7 @@ from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import branch_limits, limits, schemes, writers
+from rawehelix.studies import branch_limits, forcing, limits, schemes, sweep_advice, writers
 from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
 from rawehelix.studies.scene import SceneError
 
@@ -68,9 +69,10 @@ def validate_frequencies(f1_Hz) -> list[float]:
 
 
 def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=None,
-              track: bool = True) -> int:
+              track: bool = True, show_progress: bool = False) -> int:
     """Run one rank's contiguous chunk with continuation; return the points computed.
-    ``track``: each point's limits block over its recorded periods (branch_limits.py)."""
+    ``track``: each point's limits block over its recorded periods (branch_limits.py);
+    ``show_progress``: a bar of the periods within each point (:class:`PeriodBar`)."""
     log = log or logging.getLogger("rawehelix").info
 
     def backend_factory():
@@ -94,7 +96,9 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
         else:
             lead_in = False
         try:
-            result, state, t = periodic_response(backend, q, f1, state, t, params.sweep, lead_in)
+            with PeriodBar(f1, params.sweep, show_progress) as bar:
+                result, state, t = periodic_response(backend, q, f1, state, t, params.sweep,
+                                                     lead_in, progress=bar)
         except (SolverError, FloatingPointError, RuntimeError) as err:
             # the point is recorded as failed; the next one starts afresh
             entry = {"f1_Hz": f1, "tension_max_N": None, "tension_min_N": None,
@@ -108,6 +112,8 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
             continue
         block = (branch_limits.point_block(params, result.sections) if track
                  else branch_limits.absent("not recorded (tracking off)"))
+        if result.unsettled is not None:  # why, and what to try (studies/sweep_advice.py)
+            result.unsettled["advice"] = sweep_advice.advice(params, result.unsettled, f1)
         store.save(f1, {"entry": branch_limits.with_block(result.entry(), block),
                         "period_maxima_N": result.period_maxima_N,
                         "period_minima_N": result.period_minima_N,
@@ -121,7 +127,42 @@ def run_chunk(params: Parameters, store, chunk: list[float], backend=None, log=N
             f"{result.wall_s:6.1f} s ({result.start}){flag}"
             + (f", M/(NR) max {block['moment_ratio_max']['value']:.3f}"
                if isinstance(block.get("moment_ratio_max"), dict) else ""))
+        if result.unsettled is not None:
+            for line in sweep_advice.lines(params, result.unsettled, f1):
+                log(line)
     return computed
+
+
+class PeriodBar:
+    """Periods done of ``sweep.max_periods`` at one f1 and the periodicity test's
+    measure (what remains of the transient over what is allowed), as a tqdm bar on
+    a terminal (``show``), cleared when the point ends; nothing otherwise (a log
+    file gets the point's one line).  Entered, it is periodic_response's
+    ``progress``."""
+
+    def __init__(self, f1: float, sweep: Sweep, show: bool):
+        self.f1, self.sweep, self.show, self.bar = f1, sweep, show, None
+
+    def __enter__(self):
+        if self.show:
+            from tqdm import tqdm
+            self.bar = tqdm(total=self.sweep.max_periods, unit="period", leave=False,
+                            desc=f"  f1 = {self.f1:6.2f} Hz",
+                            bar_format="{desc}: {n}/{total} periods{postfix} |{bar}| "
+                                       "[{elapsed}<{remaining}]")
+        return self if self.bar is not None else None
+
+    def __call__(self, k: int, measure):
+        self.bar.update(k - self.bar.n)
+        if measure is not None:
+            left = ("not decaying" if measure.remainder is None
+                    else f"{measure.remainder / max(measure.allowed, 1e-300):.3g}")
+            self.bar.set_postfix_str(f"remainder / allowed {left}", refresh=False)
+
+    def __exit__(self, *exc):
+        if self.bar is not None:
+            self.bar.close()
+        return False
 
 
 #: estimated forcing periods for one point to become periodic after
@@ -199,6 +240,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     call resumes a stopped sweep (see the module docstring); without it the
     sweep writes nothing.  Returns the :class:`SweepResult` (summary on every rank)."""
     start = time.perf_counter()
+    forcing.require(params, "sweep")
     limits.check_bending_resolution(params, "sweep")
     frequencies = validate_frequencies(params.sweep.frequencies() if f1_Hz is None else f1_Hz)
     stepsize.check(params, frequencies)  # FE: fixed steps resolve the forcing and omega_L
@@ -216,7 +258,8 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
         rank_log = (lambda m, _log=rank_log: _log(f"[rank {comm.rank}]{m}"))
     if mine:
         rank_log(f"  chunk {mine[0]:.2f}-{mine[-1]:.2f} Hz ({len(mine)} points)")
-    computed = run_chunk(params, store, mine, log=rank_log, track=track)
+    show = sys.stderr.isatty() and comm.size == 1  # a terminal, not a log file (or ranks)
+    computed = run_chunk(params, store, mine, log=rank_log, track=track, show_progress=show)
     computed = comm.allreduce(computed, op=MPI.SUM)
     records = store.all_records(comm)
     result = SweepResult(params, [], rank=comm.rank)
@@ -337,6 +380,12 @@ def report(result: SweepResult) -> str:
                       ("slack_Hz", "slack (T <= 0)"), ("failed_Hz", "failed (see summary.json)")):
         if s[key]:
             lines.append(f"  {what}: f1 = {', '.join(f'{f:g}' for f in s[key])} Hz")
+    unsettled = [p for p in s["points"] if p.get("not_periodic")]
+    if unsettled:  # the first one's reason and advice (each point's: summary.json)
+        first = unsettled[0]
+        lines.append(f"  at f1 = {first['f1_Hz']:g} Hz: {sweep_advice.reason(first['not_periodic'])}")
+        lines += [f"    try: {a}" for a in first["not_periodic"].get("advice", [])]
+        lines.append("    (each point's reason and advice: points[].not_periodic in summary.json)")
     if "limits_first_by_kind" in s:
         lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"])
     return "\n".join(lines)

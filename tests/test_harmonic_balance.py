@@ -107,8 +107,11 @@ def test_auto_picks_by_the_stated_rule():
     plain = rh.load_scene("mobile_end", elements=4)
     assert orbit_method.choose(plain, "auto")[0] == "hb"
     members = plain.replace(section={"law": "tensegrity"}, model={"kinematics": "extensible"})
-    method, why = orbit_method.choose(members, "auto")
-    assert method == "shooting" and "slack" in why
+    method, why = orbit_method.choose(members, "auto")  # HB runs there (issue 41)
+    assert method == "hb" and "warning" in why and "slack" in why
+    assert orbit_method.choose(hysteretic := plain.replace(
+        torsion_hysteresis={"rho": 0.5, "beta_m_n": 1.0}), "auto")[0] == "shooting"
+    assert "--method shooting" in orbit_method.choose(hysteretic, "auto")[1]
     method, why = orbit_method.choose(members, "hb")  # runs when asked for, with a warning
     assert method == "hb" and "warning" in why and "slack" in why
     hysteretic = plain.replace(torsion_hysteresis={"rho": 0.5, "beta_m_n": 1.0})

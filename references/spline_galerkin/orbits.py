@@ -48,6 +48,7 @@ from scipy.integrate import solve_ivp
 from rawehelix.parameters import Parameters
 from rawehelix.errors import SolverError
 from rawehelix.periodic_orbits.floquet import PeriodMap
+from rawehelix.periodic_orbits.problem import FREE_ROTATION
 
 from . import stationary
 from .dynamics import initial_state
@@ -72,7 +73,7 @@ class SplineMap(PeriodMap):
         self.size = n = system.size
         self.controller = self.q_base.k1 != 0.0
         if not self.controller:
-            raise SolverError("orbits (spline): needs the controller's integral action (k1 > 0)")
+            raise SolverError(f"orbits (spline): {FREE_ROTATION}")
         self.keep = np.delete(np.arange(n), system.i_m0)  # X = x without m0
         # dm0/dX: k1 at alpha_0 (and k2 at alpha_0' with the rate state)
         self.dm0 = np.zeros(n - 1)
