@@ -74,7 +74,8 @@ class FECore(SchemeCore):
 class SplineCore(SchemeCore):
     name, has_degree, fixed_time_step, fe_assembled = "spline", False, False, False
     integrator = "Radau"
-    harmonic_balance_refusal = "the spline reference has a period map only (shooting)"
+    harmonic_balance_refusal = ("the spline reference has a period map only: use --method shooting, "
+                                "or --scheme fe for harmonic balance")
     BYTES_PER_N2 = 4.5e3  # its dense matrices: bytes per N^2 (studies/resources.py)
 
     def unknowns(self, params, planar=False):

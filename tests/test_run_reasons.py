@@ -253,6 +253,8 @@ class _Backend:
     """T = 1 + a(t) sin(w t): a(t) = a (1 + excess r^k) after k periods, or a sustained
     beat (``beat``); no parts."""
 
+    section_sampler = None  # the backends' interface: no fields along s
+
     def __init__(self, q, r=0.99, beat=0.0):
         self.q, self.r, self.beat = q, r, beat
 
