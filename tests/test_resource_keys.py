@@ -7,7 +7,8 @@ registered command has its rows in the estimate tables."""
 import pytest
 
 from rawehelix.cli.commands import COMMANDS
-from rawehelix.studies import outdir, resources, scene
+from rawehelix.studies.store import outdir
+from rawehelix.studies import resources, scene
 from tests.test_refusals import assert_refused
 
 SIM = ["simulate", "nominal_operation", "--elements", "4"]
