@@ -8,7 +8,7 @@ overrides, as ``--set`` takes them) it measures, through the public API only
   reproduces Table 3 with), the first mode of each family: frequency and
   decay rate;
 * ``simulate``: Sec. 5.2 (``nominal_operation``): the settling time into the
-  2 % band (the summary's ``settling_time_s``, studies/metrics.py) and the
+  2 % band (the summary's ``settling_time_s``, studies/analysis/metrics.py) and the
   peak |ground torque|;
 * ``sweep``: the same resonance by the paper's brute-force sweep
   (``rh.sweep`` on SWEEP_F1, continued upward): where the upper branch

@@ -20,8 +20,8 @@ import os
 import time
 from pathlib import Path
 
-from rawehelix.studies import paper
-from rawehelix.studies.report import (TABLE3_HEADER, Figure, Section, Table, cell, table3_rows,
+from rawehelix.studies.present import paper
+from rawehelix.studies.present.report import (TABLE3_HEADER, Figure, Section, Table, cell, table3_rows,
                                       write_report)
 
 # Around the FE N = 8 resonance (12.5 Hz, then the drop at 13 Hz: docs/sweep/fe_N8):

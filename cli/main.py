@@ -24,7 +24,7 @@ refuses, is bad input (``--petsc-unused warn``: a warning only), as is an
 unknown ``--option``.  ``-v`` shows more (``-vv`` everything).  Bad input
 exits with status 2 and one message naming file, key and what is allowed;
 nothing is written (the output folder, the memory and the disk a run needs
-are checked before it starts: studies/outdir.py, studies/resources.py).  A
+are checked before it starts: studies/store/outdir.py, studies/resources.py).  A
 failed solve exits with status 1.  A study with failed points, a
 calibration that missed a target by more than its tolerance, or a fit
 (calibrate, labtest --fit) whose data could not determine its parameters,
@@ -128,7 +128,8 @@ def _interrupted(command: str, outdir, comm) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     from rawehelix.cli import argv as argv_split
-    from rawehelix.studies import logs, outdir as outdir_check, outdir_lock
+    from rawehelix.studies import logs
+    from rawehelix.studies.store import outdir as outdir_check, outdir_lock
 
     argv = sys.argv[1:] if argv is None else argv
     parser = _parser()

@@ -217,7 +217,7 @@ class PeriodicOrbitProblem(abc.ABC):
 
     def sections(self, X, f1_Hz: float, steps: int | None = None) -> list | None:
         """The section along s over the orbit's period, [(t, section dict)] for its
-        limits block (studies/branch_limits.py); None: the problem has no fields along s
+        limits block (studies/analysis/branch_limits.py); None: the problem has no fields along s
         (the spline reference)."""
         return None
 

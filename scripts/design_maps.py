@@ -10,7 +10,7 @@ from pathlib import Path
 
 import rawehelix as rh
 from rawehelix.studies import envelope
-from rawehelix.studies.envelope_figure import envelope_png, panels_png
+from rawehelix.studies.present.envelope_figure import envelope_png, panels_png
 
 OUT = Path(__file__).resolve().parents[1] / "docs" / "envelope"
 SECTIONS = {"solid": {"model.kinematics": "extensible"},

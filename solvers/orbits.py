@@ -212,7 +212,7 @@ class AlphaMap(PeriodMap):
         """The section state along s at ``samples`` (default SECTION_SAMPLES; at most
         one a step) equally spaced steps of one period from X: [(t, Probes.section()
         dict)] (normalised, t from phase 0), the orbit's fields for its limits block
-        (studies/branch_limits.py).  A plain :meth:`period`: it keeps its steps as
+        (studies/analysis/branch_limits.py).  A plain :meth:`period`: it keeps its steps as
         one would."""
         M = steps or self.steps_per_period(f1_Hz)
         n = min(M, samples or self.SECTION_SAMPLES)

@@ -31,7 +31,7 @@ def middle_vertex(mesh) -> tuple[float, np.ndarray]:
 
 
 class SectionProbe:
-    """The section's state along s for the limits block (studies/structure_limits.py):
+    """The section's state along s for the limits block (studies/analysis/structure_limits.py):
     the one list of its fields, as UFL of a model's fields by role (models/), at the
     Lagrange nodes of the scalar space ``V_s``; the fields are one vector-valued
     expression (one interpolation and one gather per call: simulate calls it at every
@@ -116,7 +116,7 @@ class Probes:
             "twist": (compat.expression(model.twist(by_role, c), V_s),  # (34)
                       dolfinx.fem.Function(V_s)),
         }
-        # the section's state for the limits block (studies/structure_limits.py)
+        # the section's state for the limits block (studies/analysis/structure_limits.py)
         self.section_probe = SectionProbe(model, by_role, c, V_s)
 
     def values(self) -> dict:

@@ -10,7 +10,7 @@ copy per output time while a point settles (measured in
 docs/explanation/structure_limits.md) and changes no number of the sweep.  Between
 two output times the extremes are not seen: at 64 samples a period the maximum of a
 smooth periodic signal is missed by at most about (pi / 64)^2 / 2 = 0.12 % of its
-oscillation.  Normalised units; studies/structure_limits.py turns them into SI.
+oscillation.  Normalised units; studies/analysis/structure_limits.py turns them into SI.
 """
 
 from __future__ import annotations

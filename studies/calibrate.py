@@ -46,7 +46,8 @@ from mpi4py import MPI
 
 from rawehelix import fits
 from rawehelix.errors import SceneError, SolverError
-from rawehelix.studies import pool, quantities, writers
+from rawehelix.studies import pool, quantities
+from rawehelix.studies.store import writers
 from rawehelix.studies.study import EXIT_UNMET, Source, key_type
 
 FD_STEP = 1e-3  # forward-difference step of the Jacobian, relative to the scene's value

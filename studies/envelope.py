@@ -5,7 +5,7 @@ For COUNT values of the dotted scene key KEY (default DEFAULT_VALUES, the "ticks
 
 1. the one-parameter branch over the f1 window (``rawehelix orbits``, by harmonic
    balance unless ``method`` says otherwise), with its folds, bifurcations and each
-   point's limits block (studies/branch_limits.py);
+   point's limits block (studies/analysis/branch_limits.py);
 2. the boundary where the first limit is reached: the f1 where a point's
    ``first_limit`` changes along the branch, located by bisection in f1 between the
    two branch points (FIRST_LIMIT_BISECTIONS orbits at fixed f1 and KEY, each with its
@@ -20,7 +20,7 @@ For COUNT values of the dotted scene key KEY (default DEFAULT_VALUES, the "ticks
    (periodic_orbits/bifurcation_curve.py), forward and back where no curve reached them,
    checked the same way (``check_Hz``).  Between two such curves the response is unstable.
 
-The curves: studies/envelope_curves.py.
+The curves: studies/analysis/envelope_curves.py.
 
 MPI: the ticks are dealt to the ranks (a rank's ticks, one branch each); the curves
 are traced on rank 0 from the gathered ticks.  Resumable (``outdir``): each
@@ -42,8 +42,10 @@ from mpi4py import MPI
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits.bifurcations import critical, stability_changes
-from rawehelix.studies import branch_limits, envelope_curves, forcing, orbit_method, orbits, writers
-from rawehelix.studies.orbits_store import OrbitsStoreError
+from rawehelix.studies import forcing, orbit_method, orbits
+from rawehelix.studies.analysis import branch_limits, envelope_curves
+from rawehelix.studies.store import writers
+from rawehelix.studies.store.orbits_store import OrbitsStoreError
 from rawehelix.studies.sampling import Variable
 
 DEFAULT_VALUES = 5  # ticks when --vary gives no COUNT
@@ -65,7 +67,7 @@ def claim(outdir, header: dict, comm):
     """Lock ``outdir`` and refuse it if it holds another envelope (its header differs),
     before any tick is opened; else write the header (collective).  The lock, held
     by the caller as long as it writes."""
-    from rawehelix.studies import outdir_lock
+    from rawehelix.studies.store import outdir_lock
     lock = outdir_lock.hold(outdir, comm)
     old = writers.claim_directory(Path(outdir) / HEADER, header, comm)
     if old is not None:
@@ -137,7 +139,7 @@ class EnvelopeResult:
                 "fold_curves_wall_s": self.fold_curves_wall_s, "wall_s": self.wall_s}
 
     def write(self, outdir) -> Path:
-        from rawehelix.studies.envelope_figure import envelope_png
+        from rawehelix.studies.present.envelope_figure import envelope_png
         outdir = Path(outdir)
         outdir.mkdir(parents=True, exist_ok=True)
         writers.write_json(outdir / "summary.json", self.summary)
@@ -237,7 +239,7 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         orbit_method.choose(at, method)
     lock = None
     if outdir is not None:
-        from rawehelix.studies.sweep_store import fingerprint
+        from rawehelix.studies.store.sweep_store import fingerprint
         lock = claim(outdir, {"scene": params.name, "fingerprint": fingerprint(params),
                               "key": vary.key, "values": values, "f1_window_Hz": [f1_lo, f1_hi],
                               "method": method, "f1_step_Hz": f1_step_Hz}, comm)

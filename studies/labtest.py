@@ -23,7 +23,7 @@ EI (secant, from the closed-form inverse of solvers/analytic.py), the line
 through the roots, then Gauss-Newton on (a, b) with the law in the rod, at
 small loads (the law's energy couples the axial force to kappa^2, so its
 test softens with the load: docs/explanation/labtest.md); the fit is
-:mod:`rawehelix.studies.labfit`.  Any test with ``fit`` also fits the scene's
+:mod:`rawehelix.studies.analysis.labfit`.  Any test with ``fit`` also fits the scene's
 ``[section]`` members at the section level (``summary["section_fit"]``,
 labfit.section_fit; docs/explanation/section.md).
 
@@ -45,7 +45,9 @@ from rawehelix import fits
 from rawehelix.errors import SolverError
 from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.solvers import analytic
-from rawehelix.studies import labfit, labmembers, labtest_figure, writers
+from rawehelix.studies.analysis import labfit, labmembers
+from rawehelix.studies.present import labtest_figure
+from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError, toml_value
 from rawehelix.studies.study import EXIT_UNMET
 

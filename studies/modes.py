@@ -20,7 +20,7 @@ decay rate, no frequency, no family's mode); with ``count = k`` the k slowest
 (|lambda|) modes.  Either way in ascending frequency |Im lambda| (then
 |lambda|), the overdamped ones last by decay rate: the order of the table
 ``rawehelix modes`` prints.  (Table 3 of the paper lists them the other way
-round; studies/report.py pairs rows by family.)
+round; studies/present/report.py pairs rows by family.)
 """
 
 from __future__ import annotations
@@ -120,7 +120,7 @@ class ModesResult(list):
         """summary.json (atomic), and with mode shapes modes.png, modes.xdmf
         and, where pyvista works, one animated GIF per family's first mode.
         Returns the paths written."""
-        from rawehelix.studies import writers
+        from rawehelix.studies.store import writers
         outdir = pathlib.Path(outdir)
         if self.rank != 0:
             return []
@@ -132,7 +132,7 @@ class ModesResult(list):
         return paths
 
     def _write_shapes(self, outdir: pathlib.Path, firsts: dict) -> list[pathlib.Path]:
-        from rawehelix.studies import writers
+        from rawehelix.studies.store import writers
         x0 = self.x0_m
         L0 = float(np.max(next(iter(firsts.values())).s_m))
         chord = x0[-1] / np.linalg.norm(x0[-1])
@@ -160,7 +160,7 @@ class ModesResult(list):
                                     f"p = {info['degree']} (displacement and twist each "
                                     f"scaled to 1)"),
             writers.centre_line_xdmf(outdir / "modes.xdmf", x0, point_data)]
-        from rawehelix.studies import render
+        from rawehelix.studies.present import render
         if render.available():
             for f, m in firsts.items():
                 path = render.mode_animation(

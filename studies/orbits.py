@@ -18,7 +18,7 @@ stops the others at their next point, and every rank raises.
 Resumable (``outdir``): every point is stored as it is found (its entry,
 multipliers and state, and the continuation's state after it), one
 directory per window, whole or not at all and checked when read
-(:class:`~rawehelix.studies.orbits_store.WindowStore`); a rerun continues after the last stored point.
+(:class:`~rawehelix.studies.store.orbits_store.WindowStore`); a rerun continues after the last stored point.
 
 Both schemes: the FE generalised-alpha map (:mod:`rawehelix.solvers.orbits`)
 and the paper's spline-Galerkin flow (:mod:`rawehelix.references.spline_galerkin.orbits`),
@@ -47,9 +47,11 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import branch_limits, forcing, schemes, writers
-from rawehelix.studies.orbits_report import report  # noqa: F401  (the command's text)
-from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
+from rawehelix.studies import forcing, schemes
+from rawehelix.studies.analysis import branch_limits
+from rawehelix.studies.present.orbits_report import report  # noqa: F401  (the command's text)
+from rawehelix.studies.store import writers
+from rawehelix.studies.store.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
 #: the order of a branch's points, in which its first limits are found
 ALONG = "along the branch from the first f1 of --f1"
@@ -311,7 +313,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     cuts = windows(f1_start_Hz, f1_stop_Hz, comm.size)
     store = None
     if outdir is not None:
-        from rawehelix.studies.sweep_store import fingerprint
+        from rawehelix.studies.store.sweep_store import fingerprint
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
                   "tension_step": tension_step, "superharmonics": list(superharmonics),
                   **({"method": method} if method != "shooting" else {}),

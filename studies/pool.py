@@ -10,11 +10,11 @@ worker), and a slow point holds up no other.  With one rank it is a loop.
 
 Resumable: a task's record is written atomically to ``DIR/points/<id>.json``
 as soon as it is finished; a run started again (after SIGKILL too) skips
-every task whose record exists and passes its checks (studies/checkpoints.py:
+every task whose record exists and passes its checks (studies/store/checkpoints.py:
 checksum, schema, the fingerprint of the study and of the PETSc options; a
 record that fails is set aside into ``DIR/corrupt/`` and computed again),
 and ``DIR/computed.log`` gets one line per task computed.  The directory is
-locked by the run (studies/outdir_lock.py).  A failed task (the stage raised one of
+locked by the run (studies/store/outdir_lock.py).  A failed task (the stage raised one of
 ``quantities.POINT_ERRORS``) is recorded with its reason and counts as
 finished; so does one that ran past ``point_timeout`` (:func:`time_limit`),
 unless a later run allows it more time.  Any other exception on a rank is a
@@ -37,7 +37,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError
-from rawehelix.studies import checkpoints, outdir_lock, writers
+from rawehelix.studies.store import checkpoints, outdir_lock, writers
 
 HEADER = "study.json"
 
@@ -56,9 +56,9 @@ SCHEMA = {"id": str, "kind": str, "overrides": dict, "values": dict, "errors": d
 
 class Store:
     """The finished tasks of one study in ``outdir`` (see the module docstring):
-    the directory locked from :meth:`open` on (studies/outdir_lock.py), each
+    the directory locked from :meth:`open` on (studies/store/outdir_lock.py), each
     record sealed with the header's and the PETSc options' fingerprint and
-    checked when read (studies/checkpoints.py)."""
+    checked when read (studies/store/checkpoints.py)."""
 
     def __init__(self, outdir, header: dict):
         self.outdir, self.header = Path(outdir), header

@@ -283,7 +283,7 @@ def check_branches(params: Parameters, branches: int, f1_lo_Hz: float, f1_hi_Hz:
                    method: str = "hb", key: str = "--vary", max_points: int = MAX_BRANCH_POINTS):
     """Refuse ``branches`` branches (an envelope's COUNT, orbits' ranks) whose points
     kept in memory (X and the record) pass the machine's memory; returns the expected
-    points (for the disk's estimate, studies/outdir.py)."""
+    points (for the disk's estimate, studies/store/outdir.py)."""
     check_count(key, branches)
     points = branches * branch_points(f1_lo_Hz, f1_hi_Hz, max_points)
     n = float(orbit_size(params, method))
@@ -300,7 +300,7 @@ def check_branches(params: Parameters, branches: int, f1_lo_Hz: float, f1_hi_Hz:
 def simulate_output_bytes(params: Parameters, until_s: float | None = None) -> float:
     """The disk of a simulation's series (time_series.csv, ~150 B an output step) and
     frames (centre_line.xdmf/.h5, ~100 B a node a frame) up to ``until_s``
-    (studies/outdir.py's extra_bytes)."""
+    (studies/store/outdir.py's extra_bytes)."""
     tm = params.time
     until_s = tm.until_s if until_s is None else until_s
     return (150.0 * until_s / tm.output_every_s

@@ -34,7 +34,8 @@ from mpi4py import MPI
 
 from rawehelix.families import FAMILY_LABELS
 from rawehelix.parameters import Parameters
-from rawehelix.studies import forcing, limits, schemes, writers
+from rawehelix.studies import forcing, limits, schemes
+from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
 
 #: the curves whose local maxima are peaks (ResponsePoint attributes)

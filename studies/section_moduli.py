@@ -20,9 +20,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import labfit, labtest, writers
+from rawehelix.studies.analysis import labfit
 
 #: the closed forms of members.py, as printed
+from rawehelix.studies import labtest
+from rawehelix.studies.store import writers
 FORMULAS = {"EA_N": "n (k cos^3 beta + P0 cos beta sin^2 beta) + EA_b",
             "EI_Nm2": "n (k cos^3 beta + P0 cos beta sin^2 beta) R^2 / 2",
             "GJ_Nm2": "n cos beta R^2 (k sin^2 beta + P0 cos^2 beta)"}

@@ -37,7 +37,9 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, metrics, schemes, structure_limits, writers
+from rawehelix.studies import limits, schemes
+from rawehelix.studies.analysis import metrics, structure_limits
+from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -70,7 +72,7 @@ class Frame:
     tension_N: np.ndarray
     twist_rad_per_m: np.ndarray
     spin_rpm: np.ndarray
-    # the members along s (studies/structure_limits.py::Tracker.profile)
+    # the members along s (studies/analysis/structure_limits.py::Tracker.profile)
     member_force_min_N: np.ndarray | None = None
     member_force_max_N: np.ndarray | None = None
     moment_ratio: np.ndarray | None = None
@@ -143,7 +145,7 @@ class TimeSeries:
         if len(self.limits_history):
             writers.members_png(outdir / "members.png", self.limits_history, self.frames,
                                 self.summary["limits"]["criteria"]["breaking"], title)
-        from rawehelix.studies import render
+        from rawehelix.studies.present import render
         if not self.frames or not render.available():
             return
         R = self.params.helix.radius_m

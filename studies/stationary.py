@@ -13,7 +13,9 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import schemes, structure_limits, writers
+from rawehelix.studies import schemes
+from rawehelix.studies.analysis import structure_limits
+from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -110,7 +112,7 @@ def sag_m(params: Parameters, result) -> float:
 
 
 def limits_block(params: Parameters, solver) -> dict | None:
-    """The ``limits`` block (studies/structure_limits.py) of the stationary solver's
+    """The ``limits`` block (studies/analysis/structure_limits.py) of the stationary solver's
     state (t = None), on rank 0 (None elsewhere).  Collective."""
     from rawehelix.solvers.probes import SectionProbe
     section = SectionProbe.of_rod(solver.rod).section()

@@ -60,8 +60,9 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import pool, quantities, scene, writers
+from rawehelix.studies import pool, quantities, scene
 # the design and its analysis; parse_vary, design and variance_indices are the study's too
+from rawehelix.studies.store import writers
 from rawehelix.studies.sampling import (SAMPLES, SEED, Variable, design, design_size,  # noqa: F401
                                         parse_vary, sensitivities, variance_indices)
 

@@ -41,8 +41,10 @@ from rawehelix.parameters import Parameters, Sweep
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.periodic import periodic_response
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import branch_limits, forcing, limits, schemes, sweep_advice, writers
-from rawehelix.studies.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
+from rawehelix.studies import forcing, limits, schemes, sweep_advice
+from rawehelix.studies.analysis import branch_limits
+from rawehelix.studies.store import writers
+from rawehelix.studies.store.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
 from rawehelix.studies.scene import SceneError
 
 def make_backend(params: Parameters, comm, track: bool = True):

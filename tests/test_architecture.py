@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 MAX_LINES = 400  # "no product module over about 400 lines holds more than one job"
 #: the longer modules and their one job
 LONG: dict[str, str] = {
-    "studies/render.py": "off-screen pyvista pictures of the helix; one file because, once "
+    "studies/present/render.py": "off-screen pyvista pictures of the helix; one file because, once "
                          "DOLFINx is loaded, each picture is drawn in a fresh interpreter that "
                          "loads this file alone (a VTK/DOLFINx library clash)",
 }

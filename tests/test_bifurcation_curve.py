@@ -161,11 +161,11 @@ def test_the_other_boundary_is_refused():
 
 
 def _envelope_curves(values, with_crossings, twice=False):
-    """studies/envelope_curves.py on the Mathieu tongue: ticks at ``values`` of eps, those
+    """studies/analysis/envelope_curves.py on the Mathieu tongue: ticks at ``values`` of eps, those
     in ``with_crossings`` starting from its two PD boundaries (brentq on the monodromy)
     with a bracket around each, as the envelope's branches would (``twice``: each
     boundary met twice, as by a branch that passes the band twice)."""
-    from rawehelix.studies import envelope_curves
+    from rawehelix.studies.analysis import envelope_curves
 
     freqs, B, _ = SCENES["period_doubling"]
     found = {e: [_boundary("period_doubling", e, side) for side in (-1, 1)]
@@ -178,12 +178,12 @@ def _envelope_curves(values, with_crossings, twice=False):
 
 
 def test_the_envelope_traces_each_crossing_forward_and_back_where_it_is_new():
-    """studies/envelope_curves.py on the Mathieu tongue in (f1, eps), ticks at eps = 0.03
+    """studies/analysis/envelope_curves.py on the Mathieu tongue in (f1, eps), ticks at eps = 0.03
     (below the tip: no PD), 0.10 and 0.15 (two PD each, as a branch would report them):
     the 0.10 crossings go forward and end on 0.15's own within 1e-5 Hz (``check_Hz``);
     one goes back toward 0.03, turns round the tip and comes back to 0.10's other
     crossing (checked), which is then not traced again, nor are 0.15's."""
-    from rawehelix.studies import envelope_curves
+    from rawehelix.studies.analysis import envelope_curves
 
     curves = _envelope_curves([0.03, 0.10, 0.15], with_crossings=(0.10, 0.15))
     forward = [c for c in curves if c["to_value"] == 0.15]

@@ -1,5 +1,5 @@
 """The limits block of a sweep's points and of an orbit branch's points (issue 29,
-studies/branch_limits.py): carried, stored, loaded from before it existed, and the
+studies/analysis/branch_limits.py): carried, stored, loaded from before it existed, and the
 orbit's moment ratio against a brute-force integration of the same orbit."""
 
 import json
@@ -10,9 +10,11 @@ import pytest
 from mpi4py import MPI
 
 from rawehelix.members import CRITERIA
-from rawehelix.studies import branch_limits, checkpoints, scene, sweep, sweep_store
+from rawehelix.studies.analysis import branch_limits
 
 # FE at N = 2: a few seconds a point (tests/test_sweep.py's FE_TINY)
+from rawehelix.studies.store import checkpoints, sweep_store
+from rawehelix.studies import scene, sweep
 TINY = {"lead_in_s": 0.2, "min_periods": 2, "max_periods": 3, "record_periods": 1,
         "periodic_tolerance": 0.1}
 DOCS_SWEEP = Path(__file__).resolve().parents[1] / "docs" / "sweep" / "fe_N8" / "summary.json"

@@ -25,7 +25,9 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from rawehelix.studies import checkpoints, outdir_lock, pool, quantities, writers
+from rawehelix.studies.store import checkpoints, outdir_lock, writers
+
+from rawehelix.studies import pool, quantities
 from tests_util import world_folder
 
 SELF = MPI.COMM_SELF
@@ -43,7 +45,7 @@ def set_aside(folder: Path) -> list[str]:
 # -- the lock ---------------------------------------------------------------------------------
 HOLDER = """
 import sys, time
-from rawehelix.studies import outdir_lock
+from rawehelix.studies.store import outdir_lock
 held = outdir_lock.hold(sys.argv[1])
 print("held", flush=True)
 time.sleep(120)
@@ -354,7 +356,7 @@ def sweep_fake(monkeypatch):
 
 
 def run_sweep(sweep_fake, folder, fingerprint="scene-a"):
-    from rawehelix.studies.sweep_store import DirectoryStore
+    from rawehelix.studies.store.sweep_store import DirectoryStore
     sweep, params = sweep_fake
     store = DirectoryStore(folder, {"scene": "fake", "fingerprint": fingerprint})
     store.open(SELF)
@@ -407,7 +409,7 @@ def test_a_bad_sweep_point_is_named_set_aside_and_computed_again(tmp_path, sweep
 def test_points_of_two_scenes_never_mix_in_sweep_json(tmp_path, sweep_fake):
     """A directory of another sweep is refused (SweepError: exit 2); without
     sweep.json, another scene's points are set aside, never merged."""
-    from rawehelix.studies.sweep_store import SweepError
+    from rawehelix.studies.store.sweep_store import SweepError
     a, _ = run_sweep(sweep_fake, tmp_path)
     with pytest.raises(SweepError, match="holds a sweep of another scene"):
         run_sweep(sweep_fake, tmp_path, "scene-b")

@@ -81,7 +81,7 @@ class _FakeSolver:
     lambda a, b, T: a * T + 3000.0,  # b unseen
     lambda a, b, T: 2290.0 * np.exp(T * (a / 1e4 + b / 1e6))])  # a and b seen alike
 def test_the_lab_laws_gauss_newton_says_when_its_jacobian_cannot_determine_a_b(reading):
-    from rawehelix.studies import labfit
+    from rawehelix.studies.analysis import labfit
     solver = _FakeSolver(reading)
 
     def test(solver, T, loads):

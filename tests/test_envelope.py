@@ -11,7 +11,8 @@ from mpi4py import MPI
 
 import rawehelix as rh
 from rawehelix.errors import SceneError
-from rawehelix.studies import envelope, envelope_curves
+from rawehelix.studies import envelope
+from rawehelix.studies.analysis import envelope_curves
 
 VARY, F1 = "helix.EI_Nm2=4381:4600:2", (11.9, 13.0)  # N = 2: folds near 12.01 and 12.74 Hz
 

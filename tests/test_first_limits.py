@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rawehelix.members import CRITERIA, Members
-from rawehelix.studies import branch_limits, structure_limits
+from rawehelix.studies.analysis import branch_limits, structure_limits
 
 
 def block(firsts: dict, off=("breaking",)) -> dict:

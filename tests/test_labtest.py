@@ -203,7 +203,7 @@ def test_section_fit_reproduces_eq62(table2, section):
     """k fitted to Eq. (62): the fitted ring's strains, read by bisection on members.py,
     regress to EA = 3.64e4 N within 1 %, and k lies near the taut closed form."""
     from dataclasses import replace
-    from rawehelix.studies import labfit
+    from rawehelix.studies.analysis import labfit
     scene = table2.replace(section=section)
     m = scene.model.section.members(scene.helix, width=0.0)
     out = labfit.section_fit("axial", m, scene.helix.EA_N, L0,
@@ -219,7 +219,7 @@ def test_section_fit_reproduces_eq62(table2, section):
 
 @pytest.fixture(scope="module")
 def bending_fit(table2):
-    from rawehelix.studies import labfit
+    from rawehelix.studies.analysis import labfit
     m = table2.model.section.members(table2.helix, width=0.0)
     lab = labtest.section_lab("bending", labtest.PAPER_BENDING_TENSIONS_N,
                               labtest.DEFAULT_LOADS["fit"])

@@ -13,7 +13,7 @@ import pytest
 import rawehelix as rh
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import simulate as simulate_study
-from rawehelix.studies.structure_limits import Tracker
+from rawehelix.studies.analysis.structure_limits import Tracker
 
 KEYS = {"law", "members", "min_member_force_N", "max_member_force_N", "slack_fraction_max",
         "moment_ratio_max", "moment_without_tension", "twist_per_length_max", "first_limit",

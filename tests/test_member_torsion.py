@@ -27,12 +27,12 @@ from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.probes import SectionProbe
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene
-from rawehelix.studies import structure_limits
+from rawehelix.studies.analysis import structure_limits
 
 N, P = 8, 3
 #: self-stressed, unlaid: GJ = n R^2 P0 = 140 N m^2 (the helix's) at P0 = 646 N
 STRESSED = {"law": "tensegrity", "torsion": "members", "self_stress_N": 646.0, "bar_EA_N": 2e4}
-#: laid, the lab fit's GJ at 200 N (studies/labfit.py): its lay is held by a torque
+#: laid, the lab fit's GJ at 200 N (studies/analysis/labfit.py): its lay is held by a torque
 LAID = {"law": "tensegrity", "torsion": "members", "lay_angle_deg": 16.8}
 
 

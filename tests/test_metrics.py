@@ -1,4 +1,4 @@
-"""Time-series metrics (studies.metrics) on synthetic signals with known answers.
+"""Time-series metrics (studies.analysis.metrics) on synthetic signals with known answers.
 
 A piecewise-linear signal is reproduced exactly by the linear interpolation
 that locates the last exit from the band: its settling time is exact at any
@@ -8,7 +8,7 @@ sampling interval, not rounded up to the next sample.
 import numpy as np
 import pytest
 
-from rawehelix.studies import metrics
+from rawehelix.studies.analysis import metrics
 
 
 def ramps(t, target, ends):

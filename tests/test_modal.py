@@ -339,8 +339,8 @@ def test_compute_default_selection_fe(tmp_path, monkeypatch):
     assert np.linalg.norm(lon.displacement, axis=1).max() == pytest.approx(1.0)
     assert result.x0_m.shape == (len(lon.s_m), 3)
     assert "Rigid rotation" in study.format_table(result)
-    # the animation of studies.render, when it is there: one GIF per family's first mode
-    from rawehelix.studies import render
+    # the animation of studies.present.render, when it is there: one GIF per family's first mode
+    from rawehelix.studies.present import render
     calls = []
 
     def animation(path, s_m, x0_m, displacement, alpha_rad, radius_m, title):

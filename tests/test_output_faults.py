@@ -72,7 +72,7 @@ import resource, signal, sys
 import numpy as np
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
 resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
-from rawehelix.studies import outdir_lock, writers
+from rawehelix.studies.store import outdir_lock, writers
 try:
     writers.write_npz(sys.argv[1], {"X": np.ones(100000), "state_ds": np.ones(3)})
 except outdir_lock.OutputFault as err:

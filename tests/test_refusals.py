@@ -16,7 +16,8 @@ from pathlib import Path
 import pytest
 
 from rawehelix.errors import SceneError
-from rawehelix.studies import outdir, resources
+from rawehelix.studies.store import outdir
+from rawehelix.studies import resources
 
 CLI = [sys.executable, "-m", "rawehelix.cli.main"]
 HUGE = ["--elements", "100000000", "--set", 'discretisation.bending="mixed"']

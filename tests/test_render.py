@@ -1,4 +1,4 @@
-"""studies/render.py: the geometry (numpy) and, with pyvista, silent off-screen pictures."""
+"""studies/present/render.py: the geometry (numpy) and, with pyvista, silent off-screen pictures."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from rawehelix.studies import render
+from rawehelix.studies.present import render
 
 
 def _sagging(n=9, L=16.0, sag=0.05):
@@ -59,7 +59,7 @@ def test_pictures_are_written_and_vtk_is_silent(tmp_path):
     with no X server: nothing of VTK may reach stderr."""
     script = textwrap.dedent(f"""
         import numpy as np
-        from rawehelix.studies import render
+        from rawehelix.studies.present import render
         from tests_util_render import helix
         x, T = helix()
         a = np.linspace(0.0, 1.0, len(x))

@@ -1,4 +1,4 @@
-"""studies/report.py and the report half of cli/demo.py, on synthetic data."""
+"""studies/present/report.py and the report half of cli/demo.py, on synthetic data."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from rawehelix.cli import demo
-from rawehelix.studies import paper
-from rawehelix.studies.report import (TABLE3_HEADER, MissingImage, Section, Table, table3_rows,
+from rawehelix.studies.present import paper
+from rawehelix.studies.present.report import (TABLE3_HEADER, MissingImage, Section, Table, table3_rows,
                                       write_report)
 
 PNG = bytes.fromhex("89504e470d0a1a0a")  # the signature is all the page needs

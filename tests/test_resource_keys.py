@@ -7,7 +7,8 @@ registered command has its rows in the estimate tables."""
 import pytest
 
 from rawehelix.cli.commands import COMMANDS
-from rawehelix.studies import outdir, resources, scene
+from rawehelix.studies.store import outdir
+from rawehelix.studies import resources, scene
 from tests.test_refusals import assert_refused
 
 SIM = ["simulate", "nominal_operation", "--elements", "4"]
@@ -117,5 +118,5 @@ def test_an_unregistered_command_is_an_internal_error_not_a_default(lookup):
     """No silent fall-back: a command without its rows is an internal error naming
     the table and the command (it used to be estimated as 'modes' and 50 MB)."""
     with pytest.raises(KeyError, match=r"internal: command 'no_such_command' has no .* in "
-                                       r"studies/(resources|outdir)\.py"):
+                                       r"studies/(resources|store/outdir)\.py"):
         lookup()

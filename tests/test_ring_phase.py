@@ -26,7 +26,8 @@ from rawehelix.members import Members, phase_spread
 from rawehelix.parameters import ParameterError
 from rawehelix.solvers.probes import SectionProbe
 from rawehelix.solvers.stationary import StationarySolver
-from rawehelix.studies import scene, structure_limits
+from rawehelix.studies import scene
+from rawehelix.studies.analysis import structure_limits
 
 RING = Members(n=6, R=0.19, beta=math.radians(10.0), k=6000.0, P0=40.0, EA_b=2e4, width=1e-4)
 

@@ -13,7 +13,7 @@ from rawehelix.references.spline_galerkin import dynamics, spectrum, stationary
 from rawehelix.references.spline_galerkin.basis import SplineBasis
 from rawehelix.references.spline_galerkin.system import SplineGalerkin
 from rawehelix.studies import modes as modes_study
-from rawehelix.studies import paper
+from rawehelix.studies.present import paper
 from rawehelix.studies import scene, schemes
 
 

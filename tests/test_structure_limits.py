@@ -1,4 +1,4 @@
-"""The ``limits`` block's tracker (studies/structure_limits.py) on hand-made states
+"""The ``limits`` block's tracker (studies/analysis/structure_limits.py) on hand-made states
 whose member forces follow from statics alone (a ring of n tethers carrying N and M:
 f = N/n + 2 M cos(phi)/(n R) with phi from the bending plane's outer side)."""
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rawehelix.members import Members
-from rawehelix.studies.structure_limits import Tracker
+from rawehelix.studies.analysis.structure_limits import Tracker
 
 R, N0 = 0.19, 76.0
 

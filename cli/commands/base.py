@@ -83,8 +83,9 @@ def say(comm, text: str):
 
 def check_branch_output(params, command, outdir, branches, lo, hi, method, max_points=None):
     """The disk of the branches' stored points (orbits, envelope): their memory first
-    (studies/resources.py), then the folder's room (studies/outdir.py)."""
-    from rawehelix.studies import outdir as outdir_check, resources
+    (studies/resources.py), then the folder's room (studies/store/outdir.py)."""
+    from rawehelix.studies.store import outdir as outdir_check
+    from rawehelix.studies import resources
     resources.check(params, command)  # the discretisation's own check comes first
     points = resources.check_branches(params, branches, lo, hi, method,
                                       key="--vary" if command == "envelope" else "--f1",

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from rawehelix.cli.commands.base import Command, overrides, petsc_unused, say
-from rawehelix.studies import outdir as outdir_check, outdir_lock
+from rawehelix.studies.store import outdir as outdir_check, outdir_lock
 from rawehelix.studies.scene import SceneError
 
 

@@ -49,7 +49,8 @@ def _simulate_arguments(p):
 
 
 def _simulate(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import outdir as outdir_check, resources, simulate
+    from rawehelix.studies.store import outdir as outdir_check
+    from rawehelix.studies import resources, simulate
     resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
     resources.check_simulate(params, args.until)  # its outputs, frames and steps
     outdir_check.check(outdir, "simulate",
@@ -81,8 +82,9 @@ def _sweep_arguments(p):
 
 
 def _sweep(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import outdir as outdir_check, resources, sweep
-    from rawehelix.studies.sweep_store import SweepError
+    from rawehelix.studies.store import outdir as outdir_check
+    from rawehelix.studies import resources, sweep
+    from rawehelix.studies.store.sweep_store import SweepError
     count = resources.frequency_count(params)
     resources.check_run(params, "sweep")  # before the disk's estimate counts its points
     outdir_check.check(outdir, "sweep", points=count,

@@ -24,7 +24,7 @@ import os
 from pathlib import Path
 
 import rawehelix as rh
-from rawehelix.studies import paper
+from rawehelix.studies.present import paper
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
 OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))
@@ -53,7 +53,7 @@ print(f"{s['steps']} steps, {s['newton_iterations']} Newton iterations, "
 #
 # `spin_rpm` has three columns: the spin at s = 0, near L0/2 and at L0.  The
 # settling time is the last time any of the three leaves the 2 % band around
-# the target (one definition, `studies/metrics.py`, used by the `converge`
+# the target (one definition, `studies/analysis/metrics.py`, used by the `converge`
 # study too).  The paper says the controller brings every node to 120 rpm and
 # that the tension stays "almost constant throughout the helix and equal to
 # around 200 N".

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 import rawehelix as rh
-from rawehelix.studies import paper
+from rawehelix.studies.present import paper
 
 SMALL = os.environ.get("RAWEHELIX_TUTORIAL_SMALL") == "1"
 OUT = Path(os.environ.get("RAWEHELIX_TUTORIAL_OUT", "results/tutorials"))

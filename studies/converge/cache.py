@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rawehelix.parameters import Parameters
-from rawehelix.studies import writers
+from rawehelix.studies.store import writers
 
 
 class RunCache:

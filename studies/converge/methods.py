@@ -21,7 +21,8 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.families import VIBRATIONS
-from rawehelix.studies import metrics, schemes
+from rawehelix.studies.analysis import metrics
+from rawehelix.studies import schemes
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,7 @@ def spin_overshoot(params: Parameters, method: Method, value) -> np.ndarray:
 
 def settling_time(params: Parameters, method: Method, value) -> np.ndarray:
     """When all three spins stay within the settling band of the target [s]
-    (Sec. 5.2, :func:`rawehelix.studies.metrics.settling_time`); nan if they
+    (Sec. 5.2, :func:`rawehelix.studies.analysis.metrics.settling_time`); nan if they
     have not settled by the end of the run."""
     t, spin = _spin_series(params, method, value)
     settled = metrics.settling_time(t, spin, params.controller.target_rpm)

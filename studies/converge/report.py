@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.studies import writers
+from rawehelix.studies.store import writers
 
 
 def _order(order: float) -> str:

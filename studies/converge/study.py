@@ -18,7 +18,8 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import quantities, writers
+from rawehelix.studies import quantities
+from rawehelix.studies.store import writers
 from rawehelix.studies.converge import report
 from rawehelix.studies.converge.cache import RunCache
 from rawehelix.studies.converge.methods import Method

@@ -298,7 +298,7 @@ def run(outdir: Path | None, cases=None, log=print) -> list[Outcome]:
         outcomes.append(outcome)
         log(f"  {name:<20} {outcome.status:<10} {outcome.detail} ({outcome.wall_s:.1f} s)")
     if outdir is not None and MPI.COMM_WORLD.rank == 0:
-        from rawehelix.studies import writers
+        from rawehelix.studies.store import writers
         outdir = Path(outdir)
         outdir.mkdir(parents=True, exist_ok=True)
         writers.write_json(outdir / "summary.json", {"cases": [o.__dict__ for o in outcomes]})

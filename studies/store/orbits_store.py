@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.studies import checkpoints, outdir_lock, writers
-from rawehelix.studies.checkpoints import NUMBER
+from rawehelix.studies.store import checkpoints, outdir_lock, writers
+from rawehelix.studies.store.checkpoints import NUMBER
 
 HEADER = "orbits.json"
 
@@ -44,10 +44,10 @@ class WindowStore:
     """The points of one window in ``DIR/window<k>``: per point ``p<i>.npz`` (X
     and the continuation's state after the point, ``state_*``), then ``p<i>.json``
     (entry, multipliers, events), sealed with the fingerprint of the branch and
-    the PETSc options and the .npz's checksum (studies/checkpoints.py): written
+    the PETSc options and the .npz's checksum (studies/store/checkpoints.py): written
     last, the record is the point's completeness marker, so a point is stored
     whole or not at all; and ``computed.log`` (one line per point computed).
-    :meth:`open` locks ``DIR`` first (studies/outdir_lock.py)."""
+    :meth:`open` locks ``DIR`` first (studies/store/outdir_lock.py)."""
 
     def __init__(self, directory: Path, base: str = ""):
         self.dir = Path(directory)

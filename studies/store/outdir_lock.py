@@ -13,7 +13,7 @@ Python API, only count up.  Under MPI rank 0 holds it and the other ranks
 learn the verdict by a broadcast.
 
 Taking the lock removes the temporary files a killed run left behind
-(:func:`rawehelix.studies.writers.remove_stale_temps`).  Releasing it
+(:func:`rawehelix.studies.store.writers.remove_stale_temps`).  Releasing it
 removes ``.lock``, and the folder too if the lock made it and it stayed
 empty (bad input found after the lock was taken writes nothing).
 
@@ -144,7 +144,7 @@ def _take(folder: Path, command: str | None = None):
         os.ftruncate(fd, 0)
         os.write(fd, f"pid {os.getpid()} on host {socket.gethostname()}, since "
                      f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}\n".encode())
-        from rawehelix.studies import writers
+        from rawehelix.studies.store import writers
         writers.remove_stale_temps(folder)
     except OSError as err:
         os.close(fd)

@@ -11,7 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.studies import branch_limits, writers
+from rawehelix.studies.analysis import branch_limits
+
+from rawehelix.studies.store import writers
 
 COLOURS = {"single": "tab:green", "coexisting": "tab:orange", "limit": "tab:red",
            "unstable": "0.55"}

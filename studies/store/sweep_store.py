@@ -4,8 +4,8 @@ directory that makes it resumable (see :mod:`rawehelix.studies.sweep`).
 A store holds, per f1, the record (the summary entry, the per-period maxima and
 the tension series) and the final state as plain arrays; it reads and writes
 only its own files.  The directory is locked by the run (one writer,
-studies/outdir_lock.py) and every record is sealed and checked when read,
-its state against the checksum in the record (studies/checkpoints.py): a
+studies/store/outdir_lock.py) and every record is sealed and checked when read,
+its state against the checksum in the record (studies/store/checkpoints.py): a
 point that fails is set aside into ``corrupt/``, with a warning, and computed
 again.  ``sweep.json`` is rewritten from the good points alone."""
 
@@ -20,8 +20,8 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.periodic import CRITERION
-from rawehelix.studies import checkpoints, outdir_lock, writers
-from rawehelix.studies.checkpoints import NUMBER, OPTIONAL_NUMBER
+from rawehelix.studies.store import checkpoints, outdir_lock, writers
+from rawehelix.studies.store.checkpoints import NUMBER, OPTIONAL_NUMBER
 
 RESULTS = "sweep.json"
 
@@ -79,8 +79,8 @@ STATE = "state"  # the seal's name of the point's final state (.npz)
 
 class DirectoryStore:
     """Finished points in a checkpoint directory: resumable (see the module
-    docstring), each point sealed and checked when read (studies/checkpoints.py),
-    the directory locked from :meth:`open` on (studies/outdir_lock.py)."""
+    docstring), each point sealed and checked when read (studies/store/checkpoints.py),
+    the directory locked from :meth:`open` on (studies/store/outdir_lock.py)."""
 
     def __init__(self, outdir: Path, header: dict):
         self.outdir, self.header = Path(outdir), header

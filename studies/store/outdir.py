@@ -47,7 +47,7 @@ def estimate_bytes(command: str, points: int = 0, extra_bytes: float = 0.0) -> f
         base = OUTPUT_BYTES[command]
     except KeyError:
         raise KeyError(f"internal: command {command!r} has no output estimate in "
-                       f"studies/outdir.py OUTPUT_BYTES (registered: {sorted(OUTPUT_BYTES)})"
+                       f"studies/store/outdir.py OUTPUT_BYTES (registered: {sorted(OUTPUT_BYTES)})"
                        ) from None
     return base + BYTES_PER_POINT * points + extra_bytes
 
@@ -72,4 +72,4 @@ def check(outdir, command: str, points: int = 0, option: str = "-o", extra_bytes
         raise SceneError(option, str(outdir),
                          f"its filesystem has {free / MB:.3g} MB free, less than the about "
                          f"{need / MB:.3g} MB that '{command}' writes (estimates in "
-                         f"studies/outdir.py): free some space or name another folder")
+                         f"studies/store/outdir.py): free some space or name another folder")

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rawehelix.studies import labfit
+from rawehelix.studies.analysis import labfit
 
 
 def _members(layout: dict, **keys) -> dict:

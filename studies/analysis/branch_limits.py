@@ -1,7 +1,7 @@
 """The ``limits`` block of a sweep's and an orbit branch's points (issue 29), and
 their summary's block over the points.
 
-A point's block is studies/structure_limits.py's :class:`Tracker` block over the
+A point's block is studies/analysis/structure_limits.py's :class:`Tracker` block over the
 section states of its steady window (a sweep: the recorded periods; an orbit: one
 period); its entry also carries the block's headline values flat, for the table of
 points: ``moment_ratio_max``, ``slack_fraction_max`` and ``first_limit`` (the kind).
@@ -25,7 +25,7 @@ past it, and its f1 is only an upper bound.  :func:`first_lines` prints them and
 from __future__ import annotations
 
 from rawehelix.members import CRITERIA
-from rawehelix.studies import structure_limits
+from rawehelix.studies.analysis import structure_limits
 
 #: why a point has no block (its ``status``)
 NOT_RECORDED = "not recorded (a point stored before the limits block existed)"

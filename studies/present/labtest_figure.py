@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.studies import writers
+from rawehelix.studies.store import writers
 
 __all__ = ["labtest_png"]
 

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rawehelix.families import FAMILY_LABELS
-from rawehelix.studies import paper as paper_data
-from rawehelix.studies import writers
+from rawehelix.studies.present import paper as paper_data
+from rawehelix.studies.store import writers
 
 
 @dataclass

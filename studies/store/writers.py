@@ -124,7 +124,7 @@ def claim_directory(path: Path, header: dict, comm) -> dict | None:
     another header, that one is returned on every rank (the caller refuses the
     directory), else None.  A header file that is not JSON (damaged outside a
     run: its writes are atomic) is set aside with a warning and written again.
-    Collective; the caller holds the folder's lock (studies/outdir_lock.py)."""
+    Collective; the caller holds the folder's lock (studies/store/outdir_lock.py)."""
     old = None
     if comm.rank == 0:
         path = Path(path)
@@ -133,7 +133,7 @@ def claim_directory(path: Path, header: dict, comm) -> dict | None:
             try:
                 stored = json.loads(path.read_text())
             except (ValueError, UnicodeDecodeError) as err:
-                from rawehelix.studies.quarantine import set_aside
+                from rawehelix.studies.store.quarantine import set_aside
                 set_aside([path], path.parent, f"not JSON ({err})",
                                       then="written again")
         if stored is None:
@@ -292,7 +292,7 @@ def write_npz(path: Path, arrays: dict) -> Path:
     return _atomic(path, fill)
 
 
-#: the members' fields of a frame (studies/structure_limits.py::Tracker.profile)
+#: the members' fields of a frame (studies/analysis/structure_limits.py::Tracker.profile)
 MEMBER_FIELDS = ("member_force_min_N", "member_force_max_N", "moment_ratio")
 
 
@@ -300,7 +300,7 @@ def frames_xdmf(path: Path, frames) -> Path:
     """The moving centre line with its fields, one XDMF step per frame
     (``simulate.Frame``: t_s, s_m, x_m, tension_N, twist, alpha, spin and, where
     present, :data:`MEMBER_FIELDS`)."""
-    from rawehelix.studies.xdmf_series import PolylineSeries
+    from rawehelix.studies.store.xdmf_series import PolylineSeries
     series = PolylineSeries(path)
     try:
         for f in frames:
@@ -314,7 +314,7 @@ def frames_xdmf(path: Path, frames) -> Path:
 
 
 def members_png(path: Path, history, frames, breaking_N, title: str) -> Path:
-    """The [section] members' forces (the limits block, studies/structure_limits.py):
+    """The [section] members' forces (the limits block, studies/analysis/structure_limits.py):
     (a) the smallest and largest member force against t (``history``: rows t [s],
     min, max [N]) with the slack line (0) and the breaking force (if set); (b) the
     smallest member force over (s, t) from the frames (``simulate.Frame``)."""

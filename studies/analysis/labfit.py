@@ -18,7 +18,7 @@ import numpy as np
 
 from rawehelix import fits
 from rawehelix.solvers import analytic
-from rawehelix.studies.scene import SceneError
+from rawehelix.errors import SceneError
 
 FIT_TOLERANCE = 1e-4  # relative: the per-tension root find of the intrinsic EI
 FIT_TARGET = 0.01  # the law's simulated test reproduces Eq. (64) within 1 %

@@ -1,6 +1,6 @@
 """Damaged files of an output folder set aside, not deleted: into
 ``<outdir>/corrupt/<UTC time>/`` with a warning that names the file and the reason
-(studies/checkpoints.py, docs/explanation/faults.md)."""
+(studies/store/checkpoints.py, docs/explanation/faults.md)."""
 
 from __future__ import annotations
 

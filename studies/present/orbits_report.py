@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rawehelix.studies import branch_limits
+from rawehelix.studies.analysis import branch_limits
 
 
 def report(result) -> str:

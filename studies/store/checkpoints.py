@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rawehelix.studies import writers
-from rawehelix.studies.quarantine import CORRUPT, set_aside  # noqa: F401  (re-exported)
+from rawehelix.studies.store import writers
+from rawehelix.studies.store.quarantine import CORRUPT, set_aside  # noqa: F401  (re-exported)
 
 SEAL = "_seal"
 NUMBER = (int, float)
