@@ -314,6 +314,7 @@ class FakeResponse:
     series_t_s: tuple = (0.0, 1.0)
     series_tension_N: tuple = (1.0, 2.0)
     sections: object = None  # no fields along s: the point's limits block says so
+    unsettled: dict | None = None  # periodic: no reason to give (solvers/periodic.py)
 
     @property
     def tension_max_N(self):
@@ -338,7 +339,7 @@ class FakeBackend:
         return np.asarray(data["y"])
 
 
-def fake_response(backend, q, f1, state, t, sweep_params, lead_in):
+def fake_response(backend, q, f1, state, t, sweep_params, lead_in, progress=None):
     """T max depends on the state continued from: a point continued from a wrong
     or missing state gives another T max."""
     new = state + np.array([f1, 1.0])

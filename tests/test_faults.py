@@ -84,6 +84,25 @@ def test_refused_before_work(tmp_path, argv, status, message):
     assert list(tmp_path.iterdir()) == []  # no -o folder, no ./results
 
 
+# refusals found after the lock of the default folder results/<scene>/<command> was taken
+DEFAULT_FOLDER_FAULTS = [
+    (["orbits", "mobile_end", "--elements", "2", "--f1", "1:1.5", "--max-points", "0"],
+     "--max-points: 0"),
+    (["simulate", "nominal_operation", "--elements", "4", "--until", "1e9"], "--until"),
+    (["labtest", "bending", "--fit", "--tension", "100"], "cannot determine the fit's law"),
+]
+
+
+@pytest.mark.parametrize("argv,message", DEFAULT_FOLDER_FAULTS,
+                         ids=[c[0][0] for c in DEFAULT_FOLDER_FAULTS])
+def test_refused_without_o_leaves_no_results_folder(tmp_path, argv, message):
+    """Without -o, a refusal leaves neither results/<scene>/<command> nor the parents
+    the lock made for it (results/<scene>, results/)."""
+    run = subprocess.run([*RAWEHELIX, *argv], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 2 and message in run.stderr, run.stderr
+    assert list(tmp_path.iterdir()) == []  # no empty results/<scene>/
+
 @pytest.mark.slow
 def test_ctrl_c_keeps_points_and_resumes(tmp_path):
     """SIGINT after the first of two points: exit 130, one line saying that 1 point

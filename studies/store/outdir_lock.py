@@ -14,10 +14,10 @@ learn the verdict by a broadcast.
 
 Taking the lock removes the temporary files a killed run left behind
 (:func:`rawehelix.studies.store.writers.remove_stale_temps`).  Releasing it
-removes ``.lock``, and the folder too if the lock made it and it stayed
+removes ``.lock``, and the folders the lock made (the -o folder, results/<scene>) if they stayed
 empty (bad input found after the lock was taken writes nothing).
 
-One command per output folder (issue 41): the command line names its command when
+One command per output folder: the command line names its command when
 it takes the lock (:func:`hold`'s ``command``), and a folder whose marker
 ``OUTDIR/.rawehelix-command`` names another command (or, written before the
 marker existed, holds another command's header file: :data:`HEADERS`) is refused
@@ -50,7 +50,7 @@ OWNER = ".rawehelix-command"  # the command whose output the folder holds
 HEADERS = {"sweep.json": "sweep", "orbits.json": "orbits", "envelope.json": "envelope"}
 #: the errors of a disk, not of the program: turned into OutputFault by :func:`hold`
 DISK_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG)
-_held: dict[Path, list] = {}  # folder -> [fd, count, made the folder, command]
+_held: dict[Path, list] = {}  # folder -> [fd, count, the folders made (deepest first), command]
 
 
 class FolderBusy(SceneError):
@@ -104,7 +104,7 @@ def _take(folder: Path, command: str | None = None):
         if command is not None:
             _held[folder][3] = command
         return
-    made = not folder.exists()
+    made = _missing(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
@@ -171,11 +171,20 @@ def _let_go(folder: Path):
     except OSError:
         pass
     os.close(fd)
-    if made:
+    for made_dir in made:  # -o's folder, then the parents it needed (results/<scene>)
         try:
-            folder.rmdir()  # only if empty: nothing was written
+            made_dir.rmdir()  # only if empty: nothing was written
         except OSError:
-            pass
+            break
+
+
+def _missing(folder: Path) -> list[Path]:
+    """The folders that making ``folder`` creates, deepest first."""
+    missing = []
+    while not folder.exists() and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
 
 
 class Holding:
