@@ -172,6 +172,18 @@ class PeriodicOrbitProblem(abc.ABC):
     #: entries"); their multipliers are reported apart
     carried = np.zeros(0, dtype=int)
 
+    # What the studies read off every problem (set by each method's constructor):
+
+    #: the stationary state as an unknown X: a branch's first orbit starts from it
+    #: (studies/orbits.py), and the spline scheme linearises about it
+    X_stationary: np.ndarray
+    #: the scene's normalised parameters without forcing (parameters/normalised.py, its
+    #: steady torque); ``q_base.at_frequency(f1_Hz, 0.0)`` is the forced scene at f1
+    q_base: object
+    #: the normalised scene at the last f1 evaluated (``q_base`` before any): its
+    #: scales turn samples into units (``q.tension_N``, the branch's T max)
+    q: object
+
     @abc.abstractmethod
     def continuable(self) -> None:
         """Raise SolverError if the problem's orbits cannot be continued in f1

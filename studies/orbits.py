@@ -47,7 +47,7 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import branch_limits, forcing, schemes, writers
+from rawehelix.studies import branch_limits, forcing, orbit_method, schemes, writers
 from rawehelix.studies.orbits_report import report  # noqa: F401  (the command's text)
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
@@ -74,7 +74,7 @@ class OrbitsResult:
     tension_step: float = 0.0
     scheme: str = "fe"  # "fe" (generalised-alpha, dt_s) or "spline" (Radau, adaptive)
     superharmonics: tuple = ()  # the orders k of the sites the step closed in on
-    method: str = "shooting"  # the periodic-orbit problem: "shooting" or "hb"
+    method: str = "shooting"  # the method that ran (studies/orbit_method.py's names)
     method_reason: str = ""  # why (studies/orbit_method.py::choose)
     orbits: list = field(default_factory=list, repr=False)  # the Orbits, in branch order
 
@@ -83,17 +83,14 @@ class OrbitsResult:
         scheme = schemes.get(self.scheme)
         if not scheme.has_degree:  # the spline reference: N and its adaptive integrator
             return f"{scheme.name} N = {self.elements}, {scheme.integrator}"
-        if self.method == "hb":
-            Hs = [p["accuracy"]["H"] for p in self.branch if "accuracy" in p] or [0]
-            return (f"N = {self.elements}, p = {self.degree}, harmonic balance H = "
-                    f"{min(Hs)}-{max(Hs)}")
-        return f"N = {self.elements}, p = {self.degree}, dt = {self.dt_s * 1e3:g} ms"
+        return orbit_method.get(self.method).discretisation(self.elements, self.degree,
+                                                            self.dt_s, self.branch)
 
     @property
     def summary(self) -> dict:
         return {"scene": self.scene, "scheme": self.scheme, "elements": self.elements,
                 "degree": self.degree,
-                "dt_s": self.dt_s if self.method == "shooting" else None,
+                "dt_s": self.dt_s if orbit_method.get(self.method).steps_in_time else None,
                 "method": self.method, "method_reason": self.method_reason,
                 "torque": "the ramp (69) at its final value",
                 "tension_step": self.tension_step,
@@ -175,14 +172,13 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
     return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
 
 
-def period_map(params: Parameters, method: str = "shooting"):
-    """The scene's periodic-orbit problem on this rank: shooting on its scheme's
-    period map (the FE generalised-alpha map, or the paper's spline-Galerkin flow,
-    ``discretisation.scheme``) or harmonic balance (``method`` "hb",
-    studies/orbit_method.py)."""
-    from rawehelix.studies import orbit_method
+def problem(params: Parameters, method: str = "shooting"):
+    """The scene's periodic-orbit problem of ``method`` on this rank, from the methods'
+    registry (studies/orbit_method.py: shooting on its scheme's period map, the FE
+    generalised-alpha map or the paper's spline-Galerkin flow, or harmonic balance);
+    a turning ring refused."""
     refuse_turning_ring(params)
-    return orbit_method.problem(params, method)
+    return orbit_method.get(method).problem(params)
 
 
 def refuse_turning_ring(params: Parameters) -> None:
@@ -236,7 +232,7 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
     start_f1, stop_f1 = window
     lo, hi = sorted(window)
-    m = period_map(params, method)
+    m = problem(params, method)
     sites, about = (), {"sites": []}
     if superharmonics:
         try:
@@ -285,7 +281,6 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     (default SUPERHARMONIC_ORDERS; () for none); ``method``: "shooting", "hb" or
     "auto" (studies/orbit_method.py); ``f1_step_Hz``: the most a step moves f1 (None: as
     the step control takes it)."""
-    from rawehelix.studies import orbit_method
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
@@ -314,7 +309,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
         from rawehelix.studies.sweep_store import fingerprint
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
                   "tension_step": tension_step, "superharmonics": list(superharmonics),
-                  **({"method": method} if method != "shooting" else {}),
+                  **orbit_method.get(method).store_header(),
                   **({"f1_step_Hz": f1_step_Hz} if f1_step_Hz else {})}
         store = WindowStore.open(Path(outdir), header, comm)
 
