@@ -242,10 +242,21 @@ class PeriodicOrbitProblem(abc.ABC):
         """X with its carried entries set to what a period makes of them (G at X)."""
 
     @abc.abstractmethod
-    def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
-              steps: int | None = None, linear: bool = False) -> Orbit:
+    def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12,
+              steps: int | None = None) -> Orbit:
         """The orbit near X0 at fixed f1 by the problem's own Newton (``steps``: the
-        resolution; ``linear``: a cheap first Jacobian, where the problem has one)."""
+        resolution).  A method's own knobs are its own keywords (shooting's lead-in
+        and linear chord, floquet.py::PeriodMap.orbit), used by its own
+        :meth:`first_orbit` and :meth:`predicted_orbit`."""
+
+    def first_orbit(self, f1_Hz: float) -> Orbit:
+        """A branch's first orbit at f1, from the stationary state (``X_stationary``)."""
+        return self.orbit(self.X_stationary, f1_Hz)
+
+    def predicted_orbit(self, X, f1_Hz: float, tol: float, max_it: int) -> Orbit:
+        """The orbit from a continuation's predicted point (its natural step), at the
+        resolution the problem holds at f1."""
+        return self.orbit(X, f1_Hz, tol=tol, max_it=max_it, steps=self.resolution(f1_Hz))
 
     @abc.abstractmethod
     def finish(self, X, f1_Hz: float, iterations: int, residual: float, start: float,

@@ -47,13 +47,13 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
+from rawehelix.periodic_orbits.floquet import LEAD_IN_PERIODS  # noqa: F401  (benchmarks')
 from rawehelix.studies import branch_limits, forcing, orbit_method, schemes, writers
 from rawehelix.studies.orbits_report import report  # noqa: F401  (the command's text)
 from rawehelix.studies.orbits_store import OrbitsStoreError, WindowStore  # noqa: F401
 
 #: the order of a branch's points, in which its first limits are found
 ALONG = "along the branch from the first f1 of --f1"
-LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
 ABORT_TAG = 713  # a rank's failure, sent to the others
 
 
@@ -249,7 +249,7 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
     if stored:
         traced.resume(*stored)
     else:
-        first = m.orbit(m.X_stationary, start_f1, lead_in=LEAD_IN_PERIODS)
+        first = m.first_orbit(start_f1)
         traced.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
         if store:
             store.save(first, [], traced.state)
