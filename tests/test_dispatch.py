@@ -110,3 +110,26 @@ def test_the_orbit_methods_registry_owns_the_command_lines_choices():
     with pytest.raises(SceneError) as err:
         orbit_method.get("fourier")
     assert all(name in str(err.value) for name in orbit_method.METHODS)
+
+
+def test_the_orbit_problems_interface_carries_no_methods_knob():
+    """``PeriodicOrbitProblem.orbit`` takes what every method takes; shooting's lead-in
+    and linear chord are the period map's own keywords, reached through the
+    interface's ``first_orbit`` and ``predicted_orbit`` (harmonic balance has neither)."""
+    import inspect
+
+    from rawehelix.periodic_orbits.floquet import PeriodMap
+    from rawehelix.periodic_orbits.problem import PeriodicOrbitProblem
+    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+
+    def knobs(cls):
+        return set(inspect.signature(cls.orbit).parameters)
+
+    shared = knobs(PeriodicOrbitProblem)
+    assert not shared & {"lead_in", "linear"}
+    assert knobs(HarmonicBalance) == shared
+    assert knobs(PeriodMap) >= shared | {"lead_in", "linear"}
+    for name in ("first_orbit", "predicted_orbit"):
+        assert getattr(PeriodMap, name) is not getattr(PeriodicOrbitProblem, name)
+    for name in ("X_stationary", "q_base", "q"):  # declared, with their words
+        assert name in PeriodicOrbitProblem.__annotations__
