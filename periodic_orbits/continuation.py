@@ -221,8 +221,7 @@ class Branch:
         if not f1 > 0:
             return None
         try:
-            return self.problem.orbit(Y[:-1], f1, tol=self.tol, max_it=2 * self.max_it,
-                                      steps=self.problem.resolution(f1), linear=True)
+            return self.problem.predicted_orbit(Y[:-1], f1, tol=self.tol, max_it=2 * self.max_it)
         except SolverError as err:
             log.debug("natural step to %.6f Hz failed: %s", f1, err)
             return None

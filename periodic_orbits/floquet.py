@@ -57,6 +57,9 @@ SLOW_RATE = 0.1
 #: the same for the linear monodromy (PeriodMap.linear_monodromy), which costs about one
 #: period of the map to build, a tenth of a fresh monodromy (N = 8, 4.34 Hz; 1/50 at 0.6 Hz)
 LINEAR_RATE = 0.5
+#: the periods stepped from the stationary state before a branch's first shooting: the
+#: scheme's start-up transient decays (:meth:`PeriodMap.first_orbit`)
+LEAD_IN_PERIODS = 5
 
 
 #: what to try where shooting finds no orbit (its refusals' way out, on the command line)
@@ -223,6 +226,15 @@ class PeriodMap(PeriodicOrbitProblem):
         ``tangent``) the monodromy."""
         PX, tension, Phi = self.period(X, f1_Hz, tangent=tangent, steps=steps)
         return PX - X - delta * self.e_alpha, tension, Phi
+
+    def first_orbit(self, f1_Hz: float) -> Orbit:
+        """From the stationary state after LEAD_IN_PERIODS periods of lead-in."""
+        return self.orbit(self.X_stationary, f1_Hz, lead_in=LEAD_IN_PERIODS)
+
+    def predicted_orbit(self, X, f1_Hz: float, tol: float, max_it: int) -> Orbit:
+        """The shooting's Newton with the linear monodromy as its first chord."""
+        return self.orbit(X, f1_Hz, tol=tol, max_it=max_it, steps=self.resolution(f1_Hz),
+                          linear=True)
 
     def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
               steps: int | None = None, linear: bool = False) -> Orbit:

@@ -172,6 +172,18 @@ class PeriodicOrbitProblem(abc.ABC):
     #: entries"); their multipliers are reported apart
     carried = np.zeros(0, dtype=int)
 
+    # What the studies read off every problem (set by each method's constructor):
+
+    #: the stationary state as an unknown X: a branch's first orbit starts from it
+    #: (studies/orbits.py), and the spline scheme linearises about it
+    X_stationary: np.ndarray
+    #: the scene's normalised parameters without forcing (parameters/normalised.py, its
+    #: steady torque); ``q_base.at_frequency(f1_Hz, 0.0)`` is the forced scene at f1
+    q_base: object
+    #: the normalised scene at the last f1 evaluated (``q_base`` before any): its
+    #: scales turn samples into units (``q.tension_N``, the branch's T max)
+    q: object
+
     @abc.abstractmethod
     def continuable(self) -> None:
         """Raise SolverError if the problem's orbits cannot be continued in f1
@@ -230,10 +242,21 @@ class PeriodicOrbitProblem(abc.ABC):
         """X with its carried entries set to what a period makes of them (G at X)."""
 
     @abc.abstractmethod
-    def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12, lead_in: int = 0,
-              steps: int | None = None, linear: bool = False) -> Orbit:
+    def orbit(self, X0, f1_Hz: float, tol: float = 1e-7, max_it: int = 12,
+              steps: int | None = None) -> Orbit:
         """The orbit near X0 at fixed f1 by the problem's own Newton (``steps``: the
-        resolution; ``linear``: a cheap first Jacobian, where the problem has one)."""
+        resolution).  A method's own knobs are its own keywords (shooting's lead-in
+        and linear chord, floquet.py::PeriodMap.orbit), used by its own
+        :meth:`first_orbit` and :meth:`predicted_orbit`."""
+
+    def first_orbit(self, f1_Hz: float) -> Orbit:
+        """A branch's first orbit at f1, from the stationary state (``X_stationary``)."""
+        return self.orbit(self.X_stationary, f1_Hz)
+
+    def predicted_orbit(self, X, f1_Hz: float, tol: float, max_it: int) -> Orbit:
+        """The orbit from a continuation's predicted point (its natural step), at the
+        resolution the problem holds at f1."""
+        return self.orbit(X, f1_Hz, tol=tol, max_it=max_it, steps=self.resolution(f1_Hz))
 
     @abc.abstractmethod
     def finish(self, X, f1_Hz: float, iterations: int, residual: float, start: float,

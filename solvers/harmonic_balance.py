@@ -264,11 +264,11 @@ class HarmonicBalance(PeriodicOrbitProblem):
     def samples(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:
         return self.tension(self.coefficients(X, self._H(X, resolution)), f1_Hz)
 
-    def orbit(self, X0, f1_Hz: float, tol: float = 1e-9, max_it: int = 20, lead_in: int = 0,
-              steps: int | None = None, linear: bool = False) -> Orbit:
+    def orbit(self, X0, f1_Hz: float, tol: float = 1e-9, max_it: int = 20,
+              steps: int | None = None) -> Orbit:
         """Newton at fixed f1 (PETSc LU, backtracking on |G|); without ``steps`` (H),
         H is raised from the problem's until the tail is below ``tail_tol`` (then
-        the problem's H).  ``lead_in`` and ``linear``: the shooting's, unused."""
+        the problem's H)."""
         start = time.perf_counter()
         H = steps or self.H
         X = self.embed(X0, H)

@@ -155,7 +155,7 @@ def _tick(params, key, value, f1_window, method, outdir, progress, f1_step_Hz):
                             outdir=None if outdir is None else Path(outdir),
                             progress=progress, f1_step_Hz=f1_step_Hz)
     points = branch.orbits
-    m = orbits.period_map(p, branch.method)
+    m = orbits.problem(p, branch.method)
     limits = branch_limits.OrbitLimits(m, p)
     crossings = [_crossing(m, limits, a, b, ea["first_limit"], eb["first_limit"], value)
                  for a, b, ea, eb in zip(points, points[1:], branch.branch, branch.branch[1:])
@@ -269,7 +269,7 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         bifurcations_at = [pieces[k][2][1] for k in range(len(values))]
         used, reason = pieces[0][3], pieces[0][4]
         problem_at = envelope_curves.Problems(
-            lambda v: orbits.period_map(params_at(params, vary.key, v), used))
+            lambda v: orbits.problem(params_at(params, vary.key, v), used))
         clock = time.perf_counter()
         curves = envelope_curves.fold_curves(problem_at, vary.key, values, ticks, folds_at,
                                              substeps)

@@ -1,15 +1,22 @@
-"""Which periodic-orbit problem traces a scene's orbits (``--method``): shooting on
-the scheme's period map or harmonic balance (solvers/harmonic_balance.py), and
-the rule of ``auto``, stated once here and reported with every result
-(docs/explanation/harmonic_balance.md, "Where HB is the wrong tool")."""
+"""The periodic-orbit methods (``--method``), chosen by name: the one registry that
+the command line, the studies and the resources ask instead of testing the name.
+
+* ``shooting``: Newton on the scheme's period map (studies/schemes.py);
+* ``hb``: harmonic balance (solvers/harmonic_balance.py), H chosen by accuracy,
+  Hill's method for the multipliers;
+* ``auto``: the rule of :meth:`Auto.choose`, stated once here and reported with every
+  result (docs/explanation/harmonic_balance.md, "Where HB is the wrong tool").
+
+An :class:`OrbitMethod` owns every decision made by its name: its refusal of a scene
+(with the command-line way out), its periodic-orbit problem (:meth:`~OrbitMethod.problem`: studies/orbits.py's
+:func:`~rawehelix.studies.orbits.problem` asks it),
+the size of its unknown, the result's description and each command's default
+(:func:`default_for`).  :func:`get` refuses an unknown name once, with the list."""
 
 from __future__ import annotations
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.periodic_orbits.problem import FREE_ROTATION
-
-METHODS = ("shooting", "hb", "auto")
 
 
 def cannot(params: Parameters) -> str | None:
@@ -35,37 +42,146 @@ def wrong_tool(params: Parameters) -> str | None:
     return cannot(params)
 
 
-def choose(params: Parameters, method: str) -> tuple[str, str]:
-    """(the method that runs, why): ``auto`` takes harmonic balance wherever it can run
-    (:func:`cannot`), with :func:`wrong_tool`'s warning for a non-smooth law: on the
-    tensegrity section (mobile_end, N = 4, 10 to 9 Hz) HB traced 5 points in 23 s where
-    shooting failed at the first in 100 s (at 16 Hz both fail: HB in 52 s, shooting in
-    8 s).  ``hb`` where it cannot run is refused (bad input); a scene without the
-    controller's integral action by every method, with the way out."""
-    if method not in METHODS:
-        raise SceneError("--method", method, f"must be one of {METHODS}")
-    if params.normalised().steady_torque().k1 == 0.0:  # neither method: the way out
-        raise SceneError("--method", method, FREE_ROTATION)
-    why = wrong_tool(params)
-    if method == "hb" and cannot(params):
-        raise SceneError("--method", method, f"harmonic balance is the wrong tool here: "
-                         f"{cannot(params)}")
-    if method == "auto":
+class OrbitMethod:
+    """What the commands and studies need of a periodic-orbit method (one instance per
+    name)."""
+
+    name: str = ""
+    #: the ``--method`` help's words for it
+    help: str = ""
+    #: True: the problem steps in time with the scene's dt (shooting's period map), so
+    #: the result reports dt; False: the result reports its own resolution
+    steps_in_time: bool = True
+    #: True: the orbits report prints the method line (its reason, H and accuracy)
+    reported: bool = False
+
+    def choose(self, params: Parameters) -> tuple[str, str]:
+        """(the method that runs, why) for ``params``, or SceneError (bad input) with
+        the command-line way out where this method cannot run the scene."""
+        return self.name, "as asked"
+
+    def problem(self, params: Parameters):
+        """The periodic-orbit problem of this method on this rank (a
+        :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`)."""
+        raise NotImplementedError
+
+    def state_size(self, params: Parameters) -> int:
+        """The entries of an orbit's unknown X (studies/resources.py)."""
+        from rawehelix.studies import schemes
+        return schemes.of(params).period_state_size(params)
+
+    def store_header(self) -> dict:
+        """The method's entry in a stored branch's header (orbits_store.py, which
+        refuses a folder holding another branch): its name."""
+        return {"method": self.name}
+
+    def discretisation(self, elements: int, degree: int, dt_s: float, branch: list) -> str:
+        """The result's description of its FE discretisation (N, p and the period's)."""
+        return f"N = {elements}, p = {degree}, dt = {dt_s * 1e3:g} ms"
+
+
+class Shooting(OrbitMethod):
+    name = "shooting"
+    help = "shooting on the period map"
+
+    def store_header(self) -> dict:  # the stores written before the methods had none
+        return {}
+
+    def problem(self, params: Parameters):
+        from rawehelix.studies import schemes
+        return schemes.of(params).period_map(params)
+
+
+class HarmonicBalanceMethod(OrbitMethod):
+    name = "hb"
+    help = "harmonic balance ('hb': H chosen by accuracy, Hill's method for the multipliers)"
+    steps_in_time = False
+    reported = True
+
+    def choose(self, params: Parameters) -> tuple[str, str]:
         if cannot(params):
-            return "shooting", f"auto: shooting, as {cannot(params)}"
-        if why:
-            return "hb", f"auto: harmonic balance, which runs here; warning: {why}"
-        return "hb", "auto: harmonic balance, as every law of the scene is smooth"
-    if method == "hb" and why:
-        return method, f"as asked; warning: {why}"
-    return method, "as asked"
+            raise SceneError("--method", self.name, f"harmonic balance is the wrong tool "
+                             f"here: {cannot(params)}")
+        why = wrong_tool(params)
+        return self.name, f"as asked; warning: {why}" if why else "as asked"
 
-
-def problem(params: Parameters, method: str):
-    """The periodic-orbit problem of ``method`` (one of :func:`choose`'s answers)
-    on this rank."""
-    if method == "hb":
+    def problem(self, params: Parameters):
         from rawehelix.solvers.harmonic_balance import HarmonicBalance
         return HarmonicBalance(params)
-    from rawehelix.studies import schemes
-    return schemes.of(params).period_map(params)
+
+    def state_size(self, params: Parameters) -> int:
+        from rawehelix.studies import schemes
+        scheme = schemes.of(params)
+        if scheme.harmonic_balance_refusal:  # its period map's state
+            return scheme.period_state_size(params)
+        from rawehelix.solvers.harmonic_balance import H_START
+        return (2 * H_START + 1) * scheme.unknowns(params)
+
+    def discretisation(self, elements: int, degree: int, dt_s: float, branch: list) -> str:
+        Hs = [p["accuracy"]["H"] for p in branch if "accuracy" in p] or [0]
+        return f"N = {elements}, p = {degree}, harmonic balance H = {min(Hs)}-{max(Hs)}"
+
+
+class Auto(OrbitMethod):
+    """Harmonic balance wherever it can run (:func:`cannot`), with :func:`wrong_tool`'s
+    warning for a non-smooth law: on the tensegrity section (mobile_end, N = 4, 10 to
+    9 Hz) HB traced 5 points in 23 s where shooting failed at the first in 100 s (at
+    16 Hz both fail: HB in 52 s, shooting in 8 s).  Its results carry the method that
+    ran, never ``auto``."""
+
+    name = "auto"
+    help = "'auto' (hb where every law is smooth; the choice and its reason are in summary.json)"
+
+    def choose(self, params: Parameters) -> tuple[str, str]:
+        if cannot(params):
+            return SHOOTING.name, f"auto: shooting, as {cannot(params)}"
+        why = wrong_tool(params)
+        if why:
+            return HB.name, f"auto: harmonic balance, which runs here; warning: {why}"
+        return HB.name, "auto: harmonic balance, as every law of the scene is smooth"
+
+    def problem(self, params: Parameters):
+        return get(self.choose(params)[0]).problem(params)
+
+    def state_size(self, params: Parameters) -> int:  # sized for harmonic balance's
+        return HB.state_size(params)
+
+
+SHOOTING, HB, AUTO = Shooting(), HarmonicBalanceMethod(), Auto()
+#: every method by its name, in the order ``--method`` lists them
+ORBIT_METHODS: dict[str, OrbitMethod] = {m.name: m for m in (SHOOTING, HB, AUTO)}
+METHODS = tuple(ORBIT_METHODS)
+#: each command's default method: orbits shoots (its reference results), envelope's
+#: many branches take harmonic balance
+DEFAULTS = {"orbits": SHOOTING.name, "envelope": HB.name}
+
+
+def get(name: str) -> OrbitMethod:
+    """The method of ``name``; SceneError (bad input) naming the allowed names."""
+    try:
+        return ORBIT_METHODS[name]
+    except (KeyError, TypeError):
+        raise SceneError("--method", name, f"must be one of {METHODS}") from None
+
+
+def default_for(command: str) -> str:
+    """The ``--method`` default of ``command`` (``orbits``, ``envelope``)."""
+    return DEFAULTS[command]
+
+
+def described() -> str:
+    """The methods in words, for ``--method``'s help: "a, b or c"."""
+    words = [m.help for m in ORBIT_METHODS.values()]
+    return ", ".join(words[:-1]) + " or " + words[-1]
+
+
+def choose(params: Parameters, method: str) -> tuple[str, str]:
+    """(the method that runs, why): the method's own rule (:meth:`OrbitMethod.choose`,
+    ``auto``'s :meth:`Auto.choose`); an unknown name is refused (:func:`get`), and a
+    scene without the controller's integral action by every method, with the way out."""
+    from rawehelix.periodic_orbits.problem import FREE_ROTATION
+    chosen = get(method)
+    if params.normalised().steady_torque().k1 == 0.0:  # neither method: the way out
+        raise SceneError("--method", method, FREE_ROTATION)
+    return chosen.choose(params)
+

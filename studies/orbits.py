@@ -47,7 +47,8 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import forcing, schemes
+from rawehelix.periodic_orbits.floquet import LEAD_IN_PERIODS  # noqa: F401  (benchmarks')
+from rawehelix.studies import forcing, orbit_method, schemes
 from rawehelix.studies.analysis import branch_limits
 from rawehelix.studies.present.orbits_report import report  # noqa: F401  (the command's text)
 from rawehelix.studies.store import writers
@@ -55,7 +56,6 @@ from rawehelix.studies.store.orbits_store import OrbitsStoreError, WindowStore  
 
 #: the order of a branch's points, in which its first limits are found
 ALONG = "along the branch from the first f1 of --f1"
-LEAD_IN_PERIODS = 5  # before the first shooting: the scheme's start-up transient decays
 ABORT_TAG = 713  # a rank's failure, sent to the others
 
 
@@ -76,26 +76,28 @@ class OrbitsResult:
     tension_step: float = 0.0
     scheme: str = "fe"  # "fe" (generalised-alpha, dt_s) or "spline" (Radau, adaptive)
     superharmonics: tuple = ()  # the orders k of the sites the step closed in on
-    method: str = "shooting"  # the periodic-orbit problem: "shooting" or "hb"
+    method: str = "shooting"  # the method that ran (studies/orbit_method.py's names)
     method_reason: str = ""  # why (studies/orbit_method.py::choose)
     orbits: list = field(default_factory=list, repr=False)  # the Orbits, in branch order
+
+    @property
+    def method_reported(self) -> bool:
+        """Whether the report names the method (studies/orbit_method.py: its ``reported``)."""
+        return orbit_method.get(self.method).reported
 
     @property
     def discretisation(self) -> str:
         scheme = schemes.get(self.scheme)
         if not scheme.has_degree:  # the spline reference: N and its adaptive integrator
             return f"{scheme.name} N = {self.elements}, {scheme.integrator}"
-        if self.method == "hb":
-            Hs = [p["accuracy"]["H"] for p in self.branch if "accuracy" in p] or [0]
-            return (f"N = {self.elements}, p = {self.degree}, harmonic balance H = "
-                    f"{min(Hs)}-{max(Hs)}")
-        return f"N = {self.elements}, p = {self.degree}, dt = {self.dt_s * 1e3:g} ms"
+        return orbit_method.get(self.method).discretisation(self.elements, self.degree,
+                                                            self.dt_s, self.branch)
 
     @property
     def summary(self) -> dict:
         return {"scene": self.scene, "scheme": self.scheme, "elements": self.elements,
                 "degree": self.degree,
-                "dt_s": self.dt_s if self.method == "shooting" else None,
+                "dt_s": self.dt_s if orbit_method.get(self.method).steps_in_time else None,
                 "method": self.method, "method_reason": self.method_reason,
                 "torque": "the ramp (69) at its final value",
                 "tension_step": self.tension_step,
@@ -177,14 +179,13 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
     return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
 
 
-def period_map(params: Parameters, method: str = "shooting"):
-    """The scene's periodic-orbit problem on this rank: shooting on its scheme's
-    period map (the FE generalised-alpha map, or the paper's spline-Galerkin flow,
-    ``discretisation.scheme``) or harmonic balance (``method`` "hb",
-    studies/orbit_method.py)."""
-    from rawehelix.studies import orbit_method
+def problem(params: Parameters, method: str = "shooting"):
+    """The scene's periodic-orbit problem of ``method`` on this rank, from the methods'
+    registry (studies/orbit_method.py: shooting on its scheme's period map, the FE
+    generalised-alpha map or the paper's spline-Galerkin flow, or harmonic balance);
+    a turning ring refused."""
     refuse_turning_ring(params)
-    return orbit_method.problem(params, method)
+    return orbit_method.get(method).problem(params)
 
 
 def refuse_turning_ring(params: Parameters) -> None:
@@ -238,7 +239,7 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
     start_f1, stop_f1 = window
     lo, hi = sorted(window)
-    m = period_map(params, method)
+    m = problem(params, method)
     sites, about = (), {"sites": []}
     if superharmonics:
         try:
@@ -255,7 +256,7 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
     if stored:
         traced.resume(*stored)
     else:
-        first = m.orbit(m.X_stationary, start_f1, lead_in=LEAD_IN_PERIODS)
+        first = m.first_orbit(start_f1)
         traced.start(first, direction=1.0 if stop_f1 > start_f1 else -1.0)
         if store:
             store.save(first, [], traced.state)
@@ -287,7 +288,6 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     (default SUPERHARMONIC_ORDERS; () for none); ``method``: "shooting", "hb" or
     "auto" (studies/orbit_method.py); ``f1_step_Hz``: the most a step moves f1 (None: as
     the step control takes it)."""
-    from rawehelix.studies import orbit_method
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
@@ -316,7 +316,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
         from rawehelix.studies.store.sweep_store import fingerprint
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
                   "tension_step": tension_step, "superharmonics": list(superharmonics),
-                  **({"method": method} if method != "shooting" else {}),
+                  **orbit_method.get(method).store_header(),
                   **({"f1_step_Hz": f1_step_Hz} if f1_step_Hz else {})}
         store = WindowStore.open(Path(outdir), header, comm)
 

@@ -260,14 +260,11 @@ def branch_points(f1_lo_Hz: float, f1_hi_Hz: float, max_points: int = MAX_BRANCH
 
 
 def orbit_size(params: Parameters, method: str = "hb") -> int:
-    """The entries of an orbit's unknown X: harmonic balance's (2 H + 1) unknowns at its
-    first H (H_START: it grows where the orbit needs it), shooting's state (3n), the
-    spline scheme's 8 N."""
-    scheme = schemes.of(params)
-    if method == "shooting" or scheme.harmonic_balance_refusal:  # its period map's state
-        return scheme.period_state_size(params)
-    from rawehelix.solvers.harmonic_balance import H_START
-    return (2 * H_START + 1) * unknowns(params)
+    """The entries of an orbit's unknown X, the method's (studies/orbit_method.py):
+    harmonic balance's (2 H + 1) unknowns at its first H (H_START: it grows where the
+    orbit needs it), shooting's state (3n), the spline scheme's 8 N."""
+    from rawehelix.studies import orbit_method
+    return orbit_method.get(method).state_size(params)
 
 
 def store_bytes_per_point(params: Parameters, method: str = "hb") -> float:

@@ -68,9 +68,9 @@ def test_refuses_without_controller():
 
 @pytest.mark.parametrize("scheme, kind", [("spline", "SplineMap"), ("fe", "AlphaMap")])
 def test_the_orbits_command_takes_the_scenes_scheme(scheme, kind):
-    from rawehelix.studies.orbits import period_map
+    from rawehelix.studies.orbits import problem
     params = rh.load_scene("mobile_end", scheme=scheme, elements=2, overrides=SCENE)
-    assert type(period_map(params)).__name__ == kind
+    assert type(problem(params)).__name__ == kind
 
 
 

@@ -51,6 +51,16 @@ def scene_arguments(p, schemes):
     petsc_unused(p)
 
 
+def method_argument(p, command: str, help: str):
+    """``--method``: its choices and ``command``'s default from the orbit methods'
+    registry (studies/orbit_method.py); ``help`` may name {methods} (the methods in
+    words) and {default}."""
+    from rawehelix.studies import orbit_method
+    default = orbit_method.default_for(command)
+    p.add_argument("--method", default=default, choices=orbit_method.METHODS,
+                   help=help.format(methods=orbit_method.described(), default=default))
+
+
 def overrides(args, f1_grid: bool = False) -> dict:
     """--set KEY=VALUE (values in TOML syntax: 9000, 1e-3, true, "graded") and,
     for a command with ``f1_grid``, --f1 START:STOP:STEP, as dotted scene keys:

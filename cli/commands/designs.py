@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import logging
 
-from rawehelix.cli.commands.base import Command, check_branch_output, overrides, say
+from rawehelix.cli.commands.base import (Command, check_branch_output, method_argument,
+                                          overrides, say)
 from rawehelix.studies import quantities
 from rawehelix.studies.scene import SceneError
 
@@ -103,9 +104,8 @@ def _envelope_arguments(p):
                         "default 5), e.g. helix.EI_Nm2=2000:8000:5 or ends.elongation; "
                         "one only (a map has one axis of keys)")
     p.add_argument("--f1", required=True, metavar="LO:HI", help="the f1 window in Hz")
-    p.add_argument("--method", default="hb", choices=("hb", "shooting", "auto"),
-                   help="the periodic-orbit problem of the branches and the curves "
-                        "(default hb)")
+    method_argument(p, "envelope", "the periodic-orbit problem of the branches and the "
+                                   "curves (default {default})")
 
 
 def _envelope(rh, params, args, outdir, comm) -> int:

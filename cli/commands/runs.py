@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from rawehelix.cli.commands.base import Command, check_branch_output, say
+from rawehelix.cli.commands.base import Command, check_branch_output, method_argument, say
 from rawehelix.studies.scene import SceneError
 
 
@@ -119,11 +119,7 @@ def _orbits_arguments(p):
                    help="orders k of the k:1 resonances f_n / k of the lateral natural "
                         "frequencies where the step closes in on a multiplier's "
                         "crossing of +1 ('none': the T max step only)")
-    p.add_argument("--method", default="shooting", choices=("shooting", "hb", "auto"),
-                   help="the periodic-orbit problem: shooting on the period map, harmonic "
-                        "balance ('hb': H chosen by accuracy, Hill's method for the "
-                        "multipliers) or 'auto' (hb where every law is smooth; the choice "
-                        "and its reason are in summary.json)")
+    method_argument(p, "orbits", "the periodic-orbit problem: {methods}")
 
 
 def _orbits(rh, params, args, outdir, comm) -> int:

@@ -63,7 +63,13 @@ VARIATIONAL_TOL = 1e-5  # its estimated error, relative to max |Phi| (a chord Ja
 
 
 class SplineMap(PeriodMap):
-    """The period map of the spline-Galerkin scheme at N elements, with its tangent."""
+    """The period map of the spline-Galerkin scheme at N elements, with its tangent.
+
+    Beyond the problem's declared attributes (``X_stationary``, ``q``, ``q_base``), the
+    spline scheme's studies (studies/schemes.py, its driven frequencies) read
+    ``system``: the :class:`SplineGalerkin` of the scene at the last f1 evaluated."""
+
+    system: SplineGalerkin
 
     def __init__(self, params: Parameters, elements: int | None = None):
         self.params = params

@@ -10,7 +10,7 @@ def report(result) -> str:
     lines = [f"{result.title}: {len(s['branch'])} periodic orbits, {result.discretisation}, "
              f"in {result.wall_s:.1f} s "
              f"(torque: {s['torque']})"]
-    if s.get("method", "shooting") != "shooting" or "auto" in s.get("method_reason", ""):
+    if result.method_reported or "auto" in s.get("method_reason", ""):
         acc = [p["accuracy"] for p in s["branch"] if "accuracy" in p]
         lines.append(f"  method: {s['method']} ({s['method_reason']})" + (
             f"; H {min(a['H'] for a in acc)}-{max(a['H'] for a in acc)}, the highest "
