@@ -23,7 +23,7 @@ demo: install
 	$(PY) -m rawehelix.cli.demo results
 
 test: install
-	$(PY) -m pytest -q -m "$(MARKS)" $(PYTEST_ARGS)
+	$(PY) -m pytest -q -m "$(MARKS)" --durations=15 $(PYTEST_ARGS)
 	$(MPIRUN) $(PY) -m pytest -q -m "mpi and ($(MARKS))" -p no:cacheprovider $(PYTEST_ARGS)
 
 test-long: install

@@ -98,7 +98,8 @@ def test_a_crossing_is_the_monodromys(kind):
         assert (abs(c.multiplier.imag) < 1e-9 and c.multiplier.real < 0) == (kind == "period_doubling")
 
 
-@pytest.mark.parametrize("kind", sorted(SCENES))
+@pytest.mark.parametrize("kind", [pytest.param(k, marks=pytest.mark.long) if k == "neimark_sacker"
+                                  else k for k in sorted(SCENES)])  # NS: 7 s, make test-long
 def test_the_curve_in_two_parameters_is_the_monodromys(kind):
     """Traced from eps = 0.12 to 0.20 in natural steps of 0.02 at most, both boundaries
     (the first step halved: 0.02 moves the boundary by about JUMP_HZ): every point

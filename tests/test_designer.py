@@ -165,6 +165,7 @@ def test_an_integer_grid_of_integers_is_kept_as_integers():
 
 # -- section.rings: the number of rings instead of their spacing -------------------------
 
+@pytest.mark.long  # make test's budget (make test-long runs it)
 def test_rings_and_their_spacing_give_identical_limits():
     """section.rings = 9 on the 16.12 m helix is ring_spacing_m = 16.12 / 8: the same
     members, and the same limits block of a solved stationary state."""

@@ -29,6 +29,8 @@ def small(tmp_path_factory):
     return result, out
 
 
+@pytest.mark.long  # the envelope of the small fixture, 25 s: make test-long (test_output_faults and
+# test_first_limits run envelopes in make test)
 def test_fold_curves_end_on_the_next_values_own_folds(small):
     """Each fold of EI = 4381 continued to 4600 by the minimally augmented system lands
     on the fold that the one-parameter branch at 4600 finds within 1e-3 Hz, and starts on
@@ -46,6 +48,8 @@ def test_fold_curves_end_on_the_next_values_own_folds(small):
     assert s["fold_check_max_Hz"] <= envelope_curves.CHECK_HZ
 
 
+@pytest.mark.long  # the envelope of the small fixture, 25 s: make test-long (test_output_faults and
+# test_first_limits run envelopes in make test)
 def test_the_summary_is_documented_and_the_map_drawn(small):
     from tests.test_docs import undocumented
     result, out = small
@@ -55,6 +59,8 @@ def test_the_summary_is_documented_and_the_map_drawn(small):
 
 
 @pytest.mark.long  # ~15 s: make test-long (the orbits' own resume is in make test)
+@pytest.mark.long  # the envelope of the small fixture, 25 s: make test-long (test_output_faults and
+# test_first_limits run envelopes in make test)
 def test_a_killed_run_resumes(small, tmp_path):
     """The last three stored points of the second value's branch removed (a run killed
     there): a rerun computes just those again and ends with the same envelope."""

@@ -28,7 +28,7 @@ EXPECTED = {
 
 # the cases that take more than about a minute (pytest --durations: 101 s and 59 s)
 SLOW = ("f1_40Hz", "string_limit")
-LONG = ("f1_40Hz",)  # 165 s on a fresh clone: make test-long
+LONG = ("f1_40Hz", "string_limit")  # 165 s and 6 s on a fresh clone: make test-long
 
 
 def test_every_case_is_pinned():

@@ -104,6 +104,7 @@ def test_refused_without_o_leaves_no_results_folder(tmp_path, argv, message):
     assert list(tmp_path.iterdir()) == []  # no empty results/<scene>/
 
 @pytest.mark.slow
+@pytest.mark.long  # 18 s; make test's budget (make test-long runs it)
 def test_ctrl_c_keeps_points_and_resumes(tmp_path):
     """SIGINT after the first of two points: exit 130, one line saying that 1 point
     was kept and how to resume; the rerun computes only the other point."""

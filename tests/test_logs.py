@@ -57,6 +57,7 @@ def test_vv_shows_the_compiler(tmp_path):
         assert any("gcc" in line for line in err)
 
 
+@pytest.mark.long  # make test's budget (make test-long runs it)
 def test_stationary_on_a_cold_cache_prints_nothing_on_stderr(tmp_path):
     """The whole `stationary` command (every form of the rod) on a cold cache:
     the summary on stdout, nothing on stderr."""

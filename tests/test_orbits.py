@@ -155,6 +155,7 @@ def test_the_orbit_is_the_full_newton_orbit(alpha_map, full_newton):
     assert new.max_multiplier == pytest.approx(old.max_multiplier, rel=1e-8)
 
 
+@pytest.mark.long  # 12 s; make test's budget (test_branch_limits compares a point with the brute force)
 def test_orbit_is_the_brute_force_periodic_response(alpha_map):
     """Issue 13 test 1 at N = 4, 10 Hz: T max and T min of the shooting orbit
     equal those of the brute-force integration to the sweep's periodicity

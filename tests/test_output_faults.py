@@ -109,6 +109,7 @@ def test_another_command_into_an_envelopes_folder_is_refused(envelope_dir):
         assert snapshot(out) == before
 
 
+@pytest.mark.long  # 10 s; make test's budget (test_faults keeps a case of the same refusal)
 def test_each_command_keeps_its_own_folder(tmp_path):
     """stationary's folder: stationary again runs (its own), modes is refused; a folder
     of an older rawehelix (no marker) is known by its store's header file (sweep.json);

@@ -41,7 +41,8 @@ def test_a_scene_it_models_is_compared(EI):
 
 
 @pytest.mark.parametrize("changes", [{"ends": {"elevation_deg": 90.0}},
-                                     {"environment": {"wind_speed_m_s": 40.0}}])
+                                     pytest.param({"environment": {"wind_speed_m_s": 40.0}},
+                                                  marks=pytest.mark.long)])  # 10 s: make test-long
 def test_a_reference_that_fails_is_reported_in_one_line(changes):
     """Values inside the documented ranges where the shooting's root finder fails
     (a vertical chord; a strong wind): reported, one line, no traceback, no advice

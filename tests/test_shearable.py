@@ -206,6 +206,7 @@ def lateral_in_plane(params, count=3):
                               if m.family == "lateral_in_plane"])[:count]
 
 
+@pytest.mark.long  # 15 s; make test's budget (make test-long runs it)
 def test_forced_orbit_at_10_hz_tends_to_the_extensible_rod():
     """The periodic orbit of the mobile end at 10 Hz (Sec. 5.3, N = 4, p = 3, rotary inertia
     off): T max tends to the extensible rod's (250.08 N) like 1/GA, measured 30.26, 2.905 N

@@ -72,6 +72,7 @@ def test_kill_and_resume_equals_uninterrupted(tmp_path, fast_scene):
     assert len(log.read_text().splitlines()) == len(computed)
 
 
+@pytest.mark.long  # make test's budget (make test-long runs it)
 def test_other_discretisation_is_refused(tmp_path, fast_scene, capsys):
     out = tmp_path / "out"
     assert cli.main(["sweep", str(fast_scene), "--f1", "9:9:1", "-o", str(out)]) == 0
