@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from rawehelix.errors import SolverError
-from rawehelix.periodic_orbits.problem import Observable, Orbit
+from rawehelix.periodic_orbits.problem import UNIT_CIRCLE_TOL, Observable, Orbit
 
 BISECTION_HZ = 1e-4  # PD / NS located to this width in f1 [Hz]
 BISECTION_MAX = 12  # probes per bisection
@@ -50,7 +50,7 @@ def _kinds(mu) -> dict:
 
 def _unstable(mu) -> dict:
     """Multipliers outside the unit circle, by kind (real > 1, real < -1, complex)."""
-    out = np.abs(mu) > 1.0 + 1e-9
+    out = np.abs(mu) > 1.0 + UNIT_CIRCLE_TOL
     return {kind: int(np.sum(out & sel)) for kind, sel in _kinds(mu).items()}
 
 

@@ -52,6 +52,10 @@ import numpy as np
 import scipy.linalg
 
 
+#: |mu| within this of 1 is on the unit circle (rounding of an undamped orbit's
+#: multipliers), neither growing nor decaying: the stability criterion of every orbit
+UNIT_CIRCLE_TOL = 1e-9
+
 #: what a scene without the controller's integral action (k1 = 0, Eq. 40) gets from
 #: ``orbits`` and ``envelope``, with the command-line way out (one line): its twist's
 #: rotation is free, a family of orbits, so no isolated orbit exists to continue in f1
@@ -104,7 +108,10 @@ class Orbit:
 
     @property
     def stable(self) -> bool:
-        return self.max_multiplier < 1.0
+        """No multiplier outside the unit circle by more than :data:`UNIT_CIRCLE_TOL`: an
+        undamped orbit's multipliers sit on the circle to rounding (|mu| = 1 + 4e-16),
+        neutrally stable, not unstable."""
+        return self.max_multiplier <= 1.0 + UNIT_CIRCLE_TOL
 
     def entry(self) -> dict:
         out = {"f1_Hz": self.f1_Hz, "tension_max_N": self.tension_max_N,
