@@ -131,8 +131,11 @@ def report(result: SectionResult) -> str:
         lines.append(f"    {key[:2]} = {FORMULAS[key]:52s} = {taut[key]:.6g} {unit}")
     lines.append(f"  under the tension T = {at['tension_N']:.6g} N ({at['tension_from']}):"
                  f" EA = {at['EA_N']:.6g} N, EI = {at['EI_Nm2']:.6g} N m^2, GJ = "
-                 f"{at['GJ_Nm2']:.6g} N m^2 (without a lay the tethers' tension T_t adds "
-                 f"T_t R^2 = {at['tethers_tension_N'] * m['radius_m'] ** 2:.4g} to GJ)")
+                 f"{at['GJ_Nm2']:.6g} N m^2 (their tension T_t = {at['tethers_tension_N']:.4g} N adds "
+                 f"{at['GJ_Nm2'] - taut['GJ_Nm2']:.4g} to GJ; T_t R^2 = "
+                 f"{at['tethers_tension_N'] * m['radius_m'] ** 2:.4g} without a lay"
+                 + (")" if m["lay_angle_deg"] == 0 else
+                    f", less at the lay of {m['lay_angle_deg']:g} deg)"))
     lines.append(f"  the scene's helix: EA_N = {h['EA_N']:.6g}, EI_Nm2 = {h['EI_Nm2']:.6g}, "
                  f"GJ_Nm2 = {h['GJ_Nm2']:.6g} ({h['from']})")
     a, b = lab["EI_law"]["a_Nm2_per_N"], lab["EI_law"]["b_Nm2"]

@@ -273,6 +273,12 @@ def test_from_section_puts_the_members_closed_forms_in_the_rod(tmp_path, n, k, l
     T_t = T * (want["EA_N"] - bars) / want["EA_N"]
     if lay == 0:
         assert s["at_tension"]["GJ_Nm2"] - want["GJ_Nm2"] == pytest.approx(T_t * 0.25, rel=0.01)
+    else:  # a lay takes the tension's share down (the tester's D6: the remark said T_t R^2)
+        assert 0 < s["at_tension"]["GJ_Nm2"] - want["GJ_Nm2"] < T_t * 0.25
+    # the printed remark is the section's: the share it adds, and the lay named only if laid
+    share = s["at_tension"]["GJ_Nm2"] - want["GJ_Nm2"]
+    assert f"adds {share:.4g} to GJ; T_t R^2 = {T_t * 0.25:.4g} without a lay" in run.stdout
+    assert ("less at the lay of" in run.stdout) is (lay != 0)
 
 
 def test_section_prints_the_lab_tests_values_for_a_given_scene(tmp_path):
