@@ -236,8 +236,12 @@ def check_sweep(params: Parameters, count: int, f1_max_Hz: float, key: str, copi
     sections = samples * _nodes(params) * BYTES_PER_SECTION_NODE
     need, have = estimate_bytes(params, "sweep") + count * record + sections, machine_bytes()
     if need > have:
-        big = "sweep.samples_per_period" if sections + count * 16 * samples >= \
-            count * 16 * sw.max_periods else "sweep.max_periods"
+        big = "sweep.max_periods"
+        if sections + count * 16 * samples >= count * 16 * sw.max_periods:
+            # the series and section samples: name the factor furthest above its default
+            default = type(sw)()
+            big = max(("sweep.samples_per_period", "sweep.record_periods"),
+                      key=lambda k: getattr(sw, k[6:]) / getattr(default, k[6:]))
         _refuse(big, f"{getattr(sw, big.split('.')[1]):g}", f"{count:g} points at "
                 f"sweep.samples_per_period = {sw.samples_per_period:g}, sweep.record_periods = "
                 f"{sw.record_periods:g}, sweep.max_periods = {sw.max_periods:g}", need, have,
