@@ -186,10 +186,14 @@ def _long_integer(text: str) -> str:
 
 
 def resolve(path) -> Path:
-    """A scene path, or the name of a scene shipped in ``studies/scenes``."""
+    """A scene path, or the name of a scene shipped in ``studies/scenes``, or the stem of
+    a ``.toml`` file (``my_helix`` for ``my_helix.toml``: the name a run's advice prints,
+    ``params.name``, runs as printed beside the file)."""
     p = Path(path)
-    if not p.exists() and not p.suffix and (SCENE_DIR / f"{p.name}.toml").exists():
-        p = SCENE_DIR / f"{p.name}.toml"
+    if not p.exists() and not p.suffix:
+        for candidate in (SCENE_DIR / f"{p.name}.toml", p.with_suffix(".toml")):
+            if candidate.is_file():
+                return candidate
     return p
 
 

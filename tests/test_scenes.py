@@ -7,6 +7,7 @@ import dataclasses
 import math
 import re
 import tomllib
+from pathlib import Path
 
 import pytest
 
@@ -153,3 +154,20 @@ def test_unknown_section_and_missing_section(tmp_path, capsys):
     path = write_scene(tmp_path / "t.toml", {}, base=data)
     assert cli.main(["stationary", str(path), "-o", str(tmp_path / "o")]) == 2
     assert "[ends]" in capsys.readouterr().err
+
+
+def test_a_runs_advice_names_a_scene_file_that_loads_as_printed(tmp_path, monkeypatch):
+    """The advice of a run (sweep's 'rawehelix orbits NAME ...', stationary's 'rawehelix
+    simulate NAME ...') names the scene by ``params.name``, the file's stem: beside the
+    file that name loads the file (the tester's D1: it failed 'no such scene file');
+    a shipped scene's name still loads the shipped scene."""
+    shipped = scene.resolve("stationary_table2")
+    (tmp_path / "my_helix.toml").write_text(shipped.read_text())
+    monkeypatch.chdir(tmp_path)
+    params = scene.load("my_helix.toml")
+    assert params.name == "my_helix"
+    assert scene.resolve(params.name) == Path("my_helix.toml")
+    assert scene.load(params.name) == params
+    assert scene.resolve("stationary_table2") == shipped
+    with pytest.raises(scene.SceneError, match="no such scene file"):
+        scene.load("not_my_helix")
