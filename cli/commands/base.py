@@ -37,7 +37,7 @@ def petsc_unused(p):
 
 def scene_arguments(p, schemes):
     """The options of every command that runs one scene."""
-    p.add_argument("scene", help="scene TOML file, or the name of a shipped scene")
+    p.add_argument("scene", help="scene TOML file (or its stem), or the name of a shipped scene")
     p.add_argument("-o", "--output", type=Path, default=None,
                    help="output directory (default results/<scene>/<command>)")
     p.add_argument("--elements", type=int, default=None, help="number of elements N")
