@@ -177,11 +177,17 @@ def _tick(params, key, value, f1_window, method, outdir, progress, f1_step_Hz):
             bifurcation_starts.append({"bracket_Hz": (a.f1_Hz, b.f1_Hz), "X": a.X,
                                        "resolution": a.steps, "kind": kind,
                                        "f1_Hz": inside[0]["f1_Hz"] if inside else a.f1_Hz})
-    rising = branch.branch[::-1] if branch.branch and branch.branch[0]["f1_Hz"] > \
-        branch.branch[-1]["f1_Hz"] else branch.branch  # traced from HI: read from LO
+    # the continuation's last point may land past the window's end (the step that leaves
+    # it): the tick reports what lies in [LO, HI] only (the tester's D7)
+    inside = lambda e: lo <= e["f1_Hz"] <= hi  # noqa: E731
+    entries = [e for e in branch.branch if inside(e)]
+    crossings = [c for c in crossings if inside(c)]
+    rising = entries[::-1] if entries and entries[0]["f1_Hz"] > \
+        entries[-1]["f1_Hz"] else entries  # traced from HI: read from LO
     tick = {"value": value, "branch": [
         {k: e.get(k) for k in ("f1_Hz", "tension_max_N", "stable", "first_limit")}
-        for e in branch.branch], "folds": branch.folds, "bifurcations": branch.bifurcations,
+        for e in entries], "folds": [f for f in branch.folds if inside(f)],
+        "bifurcations": [b for b in branch.bifurcations if inside(b)],
         "limits": branch_limits.over_points(rising, order=RISING),
         "limits_first_by_kind": branch_limits.first_by_kind(rising),
         "f1_gap_max_Hz": max((abs(b.f1_Hz - a.f1_Hz) for a, b in zip(points, points[1:])),

@@ -168,3 +168,16 @@ def test_the_tensegritys_unstable_band_is_the_shootings():
 def params_at(elongation, sets):
     return rh.load_scene("mobile_end", elements=4, degree=3,
                          overrides={**sets, "ends.elongation": elongation})
+
+
+def test_a_tick_reports_only_its_window():
+    """The continuation's last step leaves the window (here to 12.158 and 12.906 Hz for
+    --f1 12.2:12.9): the envelope's ticks, their folds and limits hold points in [LO, HI]
+    only (the tester's D7), and the branch still reaches both ends.  9 s."""
+    lo, hi = 12.2, 12.9
+    result = rh.envelope(_scene(), VARY, lo, hi, comm=MPI.COMM_SELF)
+    for tick in result.summary["ticks"]:
+        f1 = [e["f1_Hz"] for e in tick["branch"]]
+        assert lo <= min(f1) <= lo + 0.05 and max(f1) == pytest.approx(hi), tick["value"]
+        assert all(lo <= e["f1_Hz"] <= hi for e in tick["folds"] + tick["bifurcations"])
+    assert all(lo <= c["f1_Hz"] <= hi for c in result.summary["limit_curve"])
