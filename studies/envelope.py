@@ -72,8 +72,7 @@ def claim(outdir, header: dict, comm):
     old = writers.claim_directory(Path(outdir) / HEADER, header, comm)
     if old is not None:
         lock.release()
-        now = writers._jsonable(header)
-        changed = [OPTION_OF.get(k, k) for k in header if old.get(k) != now.get(k)]
+        changed = writers.changed(old, header, OPTION_OF)
         raise EnvelopeStoreError(
             f"{Path(outdir) / HEADER}: holds another envelope (scene {old.get('scene')!r}, "
             f"--vary {old.get('key')} = {old.get('values')}, --f1 {old.get('f1_window_Hz')}, "
@@ -245,8 +244,9 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         orbit_method.choose(at, method)
     lock = None
     if outdir is not None:
-        from rawehelix.studies.store.sweep_store import fingerprint
+        from rawehelix.studies.store.sweep_store import fingerprint, scene_keys
         lock = claim(outdir, {"scene": params.name, "fingerprint": fingerprint(params),
+                              writers.SCENE_KEYS: scene_keys(params),
                               "key": vary.key, "values": values, "f1_window_Hz": [f1_lo, f1_hi],
                               "method": method, "f1_step_Hz": f1_step_Hz}, comm)
     start = time.perf_counter()

@@ -313,8 +313,10 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     cuts = windows(f1_start_Hz, f1_stop_Hz, comm.size)
     store = None
     if outdir is not None:
-        from rawehelix.studies.store.sweep_store import fingerprint
+        from rawehelix.studies.store.sweep_store import fingerprint, scene_keys
+        from rawehelix.studies.store.writers import SCENE_KEYS
         header = {"scene": params.name, "fingerprint": fingerprint(params), "windows": cuts,
+                  SCENE_KEYS: scene_keys(params),
                   "tension_step": tension_step, "superharmonics": list(superharmonics),
                   **orbit_method.get(method).store_header(),
                   **({"f1_step_Hz": f1_step_Hz} if f1_step_Hz else {})}

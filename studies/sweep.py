@@ -44,7 +44,8 @@ from rawehelix.solvers.snes import SolverError
 from rawehelix.studies import forcing, limits, schemes, sweep_advice
 from rawehelix.studies.analysis import branch_limits
 from rawehelix.studies.store import writers
-from rawehelix.studies.store.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint
+from rawehelix.studies.store.sweep_store import DirectoryStore, MemoryStore, _key, fingerprint, scene_keys
+from rawehelix.studies.store.writers import SCENE_KEYS
 from rawehelix.studies.scene import SceneError
 
 def make_backend(params: Parameters, comm, track: bool = True):
@@ -250,7 +251,7 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     header = {"scene": params.name, "fingerprint": fingerprint(params), "scheme": disc.scheme,
               "elements": disc.elements, "degree": disc.degree if schemes.of(params).has_degree else None}
     if checkpoint is not None:
-        store = DirectoryStore(Path(checkpoint), header)
+        store = DirectoryStore(Path(checkpoint), {**header, SCENE_KEYS: scene_keys(params)})
         store.open(comm)
     else:
         store = MemoryStore()

@@ -522,6 +522,16 @@ def test_two_sweeps_started_together_on_one_folder(tmp_path):
     peak = json.loads((out / "summary.json").read_text())["peak_tension_N"]
     assert f"{peak:.1f} N" in winner[1]
     assert not (out / outdir_lock.LOCK).exists() and temps(out) == []
+    # the loser run again on the finished folder is refused saying what changed, the
+    # key with its two values (the tester's D5: it named the scene only)
+    winner_ei = (4381, 6000)[[r[0] for r in results].index(0)]
+    loser_ei = 10381 - winner_ei
+    again = subprocess.run([sys.executable, "-m", "rawehelix.cli.main", "sweep", "mobile_end",
+                            "--scheme", "fe", *TINY, "--set", f"helix.EI_Nm2={loser_ei}",
+                            "-o", str(out)], capture_output=True, text=True, timeout=300)
+    assert again.returncode == 2 and len(again.stderr.strip().splitlines()) == 1, again.stderr
+    assert "changed: the scene's keys (--set" in again.stderr
+    assert f"helix.EI_Nm2 {winner_ei}.0 -> {loser_ei}.0" in again.stderr
 
 
 def test_the_command_line_ends_a_full_disk_with_one_line_and_status_1(tmp_path, monkeypatch,

@@ -56,6 +56,8 @@ def test_an_envelope_rerun_with_an_argument_changed_is_refused(envelope_dir, cha
     before = snapshot(out)
     done = run([*ENVELOPE, *change, "-o", "out"], cwd)
     assert_one_line(done, "-o", "holds another envelope", option, "use another -o")
+    if option == "--set":  # the key and its two values are named
+        assert "ends.elongation 0.002 -> 0.004" in done.stderr
     assert snapshot(out) == before
 
 

@@ -141,7 +141,10 @@ def open_directory(outdir: Path, header: dict, comm):
     """Refuse a directory that holds another branch, then write its header (collective)."""
     old = writers.claim_directory(Path(outdir) / HEADER, header, comm)
     if old is not None:
+        from rawehelix.studies.store.sweep_store import OPTION_OF
+        what = writers.changed(old, header, OPTION_OF)
         raise OrbitsStoreError(f"{Path(outdir) / HEADER}: holds another branch (scene "
                                f"{old.get('scene')!r}, f1 windows {old.get('windows')}, "
-                               f"tension_step {old.get('tension_step')}); use another -o "
-                               f"directory or delete it")
+                               f"tension_step {old.get('tension_step')}"
+                               + (f"; changed: {', '.join(what)}" if what else "")
+                               + "); use another -o directory or delete it")

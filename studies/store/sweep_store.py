@@ -35,13 +35,30 @@ def fingerprint(params: Parameters) -> str:
     list, the end time nor the output sampling (the time step and the
     periodicity test do count).  The directory's identity: each point's own
     fingerprint folds in the run's PETSc options too (:class:`DirectoryStore`)."""
+    return writers.digest(_fingerprinted(params))
+
+
+def scene_keys(params: Parameters) -> dict:
+    """The keys :func:`fingerprint` hashes, dotted, for a header to record
+    (``writers.SCENE_KEYS``): a refusal then says which of them changed."""
+    return writers.scene_keys(_fingerprinted(params))
+
+
+def _fingerprinted(params: Parameters) -> dict:
     data = params.as_dict()
     data["ends"].pop("circle_frequency_Hz")
     data["time"] = {"dt_s": data["time"]["dt_s"]}
     for key in ("f1_start_Hz", "f1_stop_Hz", "f1_step_Hz"):
         data["sweep"].pop(key)
     data["sweep"]["criterion"] = CRITERION  # the periodicity test judges the points too
-    return writers.digest(data)
+    return data
+
+
+#: the command-line way to each key of a sweep's or a branch's header
+OPTION_OF = {"scene": "SCENE", "fingerprint": "the scene's keys (--set, --elements, --degree, "
+             "--scheme)", "scheme": "--scheme", "elements": "--elements", "degree": "--degree",
+             "windows": "--f1 (or the ranks)", "tension_step": "--tension-step",
+             "superharmonics": "--superharmonics", "f1_step_Hz": "--f1-step"}
 
 
 def _key(f1: float) -> str:
@@ -189,7 +206,9 @@ def check_directory(outdir: Path, header: dict):
                               then="written again from the points")
         return
     if old.get("fingerprint") != header["fingerprint"]:
+        what = writers.changed(old, header, OPTION_OF)
         raise SweepError(
             f"{path}: holds a sweep of another scene or discretisation or periodicity test (scene "
             f"{old.get('scene')!r}, scheme {old.get('scheme')!r}, N = {old.get('elements')}, "
-            f"p = {old.get('degree')}); use another -o directory or delete it")
+            f"p = {old.get('degree')}" + (f"; changed: {', '.join(what)}" if what else "")
+            + "); use another -o directory or delete it")

@@ -119,6 +119,45 @@ def write_json(path: Path, data: dict) -> Path:
     return write_text(path, json.dumps(_jsonable(data), indent=2) + "\n")
 
 
+#: a header's record of the scene's keys (:func:`scene_keys`): written for the refusal to
+#: say what changed, not compared (a folder written before it had none)
+SCENE_KEYS = "scene_keys"
+
+
+def scene_keys(data: dict, prefix: str = "") -> dict:
+    """The scene's dict (``Parameters.as_dict``, or a fingerprint's part of it) as dotted
+    keys: {"helix.EI_Nm2": 4381.0, ...}."""
+    out = {}
+    for key, value in data.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(scene_keys(value, name + "."))
+        else:
+            out[name] = _jsonable(value)
+    return out
+
+
+def changed(old: dict, new: dict, option_of: dict | None = None, most: int = 4) -> list[str]:
+    """What differs between a folder's header ``old`` and a run's ``new``: each header
+    key by its option (``option_of``), and the scene's keys with their old and new values
+    where both headers record them (:data:`SCENE_KEYS`), the first ``most`` of them."""
+    option_of = option_of or {}
+    new = _jsonable(new)
+    out = [option_of.get(k, k) for k in new if k != SCENE_KEYS and old.get(k) != new.get(k)]
+    a, b = old.get(SCENE_KEYS), new.get(SCENE_KEYS)
+    if a is not None and b is not None:
+        keys = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+        out += [f"{k} {a.get(k, 'absent')} -> {b.get(k, 'absent')}" for k in keys[:most]]
+        if len(keys) > most:
+            out.append(f"{len(keys) - most} more scene keys")
+    return out
+
+
+def _compared(header):
+    return {k: v for k, v in header.items() if k != SCENE_KEYS} if isinstance(header, dict) \
+        else header
+
+
 def claim_directory(path: Path, header: dict, comm) -> dict | None:
     """A run's header file ``path``: written on rank 0 if absent; if it holds
     another header, that one is returned on every rank (the caller refuses the
@@ -138,7 +177,7 @@ def claim_directory(path: Path, header: dict, comm) -> dict | None:
                                       then="written again")
         if stored is None:
             write_json(path, header)
-        elif stored != _jsonable(header):
+        elif _compared(stored) != _compared(_jsonable(header)):
             old = stored if isinstance(stored, dict) else {"header": stored}
     return comm.bcast(old, root=0)
 
