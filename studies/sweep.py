@@ -390,5 +390,6 @@ def report(result: SweepResult) -> str:
         lines += [f"    try: {a}" for a in first["not_periodic"].get("advice", [])]
         lines.append("    (each point's reason and advice: points[].not_periodic in summary.json)")
     if "limits_first_by_kind" in s:
-        lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"])
+        lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"],
+                                            scene=s["scene"])
     return "\n".join(lines)

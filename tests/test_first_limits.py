@@ -54,6 +54,11 @@ def test_a_collapse_met_at_every_point_does_not_hide_the_first_slack():
     assert "moment saturation: not reached in f1 = 1..1.6 Hz" in text
     assert "breaking force: not checked (section.breaking_force_N not set)" in text
     assert "already at the first point, f1 = 1 Hz: the run starts past it" in text
+    # a limit met at rest is no matter of the f1 window (the tester's D4): the line says
+    # how to tell (the stationary state of the same scene) and what moves it then
+    text = "\n".join(branch_limits.first_lines(firsts, over, scene="my_helix"))
+    assert ("unless the helix meets it at rest: if 'rawehelix stationary my_helix' reports it "
+            "too, more rings, less torque or more tension move it") in text
 
 
 def test_first_is_in_the_runs_own_order_not_the_lowest_f1():

@@ -164,7 +164,7 @@ def _met(x: dict) -> str:
         f"f1 = {x['f1_Hz']:g} Hz"
 
 
-def first_lines(firsts: dict, block: dict, indent: str = "  ") -> list[str]:
+def first_lines(firsts: dict, block: dict, indent: str = "  ", scene: str = "SCENE") -> list[str]:
     """The report's lines of each kind's first (:func:`first_by_kind`) over the points
     of the summary's ``block`` (:func:`over_points`): its f1 and place, or why none."""
     if not block or not block.get("points_recorded"):
@@ -181,7 +181,9 @@ def first_lines(firsts: dict, block: dict, indent: str = "  ") -> list[str]:
                                              f"{_met(x)}, {place(x)}"))
     if any(x and x["already_at_first_point"] for x in firsts.values()):
         lines.append(f"{indent}  (met already at the first point, f1 = {lo:g} Hz: the run starts "
-                     f"past it; extend the run before that f1 to find where it begins)")
+                     f"past it; extend the run before that f1 to find where it begins, unless "
+                     f"the helix meets it at rest: if 'rawehelix stationary {scene}' reports "
+                     f"it too, more rings, less torque or more tension move it, not the f1 window)")
     return lines
 
 

@@ -24,7 +24,8 @@ def report(result) -> str:
     if ratio:
         lines.append(f"  largest |M| / (N R): {ratio['value']:.3f} at f1 = {ratio['f1_Hz']:.4f} Hz")
     if "limits_first_by_kind" in s:
-        lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"])
+        lines += branch_limits.first_lines(s["limits_first_by_kind"], s["limits"],
+                                            scene=s["scene"])
     for w in s["windows"]:
         if "sites_error" in w:
             lines.append(f"  warning, f1 {w['f1_Hz'][0]:g}:{w['f1_Hz'][1]:g} Hz: {w['sites_error']}")
