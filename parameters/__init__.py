@@ -18,7 +18,7 @@ cross-checks), :mod:`.fingerprint` (compatibility of stored fingerprints),
 Every name stays importable from ``rawehelix.parameters``.
 """
 
-from rawehelix.operation.generator import NAMES as GENERATOR_LAWS
+from rawehelix.operation.generator import LAWS as GENERATOR_LAWS
 from rawehelix.operation.rotor import AXES as ROTOR_AXES
 from rawehelix.operation.wind import PROFILES as WIND_PROFILES
 from rawehelix.parameters.checks import ParameterError

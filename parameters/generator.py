@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from rawehelix.operation.generator import NAMES as LAWS
+from rawehelix.operation.generator import LAWS
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 from rawehelix.parameters.tables import numbers, read_beside, read_csv
 

@@ -86,7 +86,7 @@ def test_mppt_at_the_optimal_gain_runs_at_the_best_tip_speed_ratio(v):
     cp_max, tsr_opt = 0.4, 5.5  # the CSV's header: Cp = 0.4 x^2 (3 - 2x), x = tsr / 5.5
     assert law.cp_max == pytest.approx(cp_max, abs=1e-6) and law.tsr_opt == tsr_opt
     k = 0.5 * RHO * math.pi * R**5 * law.cp_max / law.tsr_opt**3
-    points = rigid_shaft.operating_points(law, gen_law.Mppt(k),
+    points = rigid_shaft.operating_points(law, gen_law.GeneratorLaw("mppt", mppt_gain_Nms2=k),
                                           v, RHO)
     assert len(points) == 1 and points[0].stable
     p = points[0]
@@ -108,7 +108,7 @@ def test_mppt_at_any_gain_is_the_root_scipy_finds(factor):
     roots = [brentq(f, x0, x1, xtol=1e-15) for x0, x1 in zip(grid[:-1], grid[1:])
              if f(x0) * f(x1) < 0]
     v = 8.0
-    points = rigid_shaft.operating_points(law, gen_law.Mppt(k),
+    points = rigid_shaft.operating_points(law, gen_law.GeneratorLaw("mppt", mppt_gain_Nms2=k),
                                           v, RHO)
     assert [p.tsr for p in points] == pytest.approx(roots, rel=1e-9)
     for p in points:  # stable: the net torque falls through the root
@@ -124,7 +124,7 @@ def test_rated_power_caps_the_generator():
     law = rotor()
     k = 0.5 * RHO * math.pi * R**5 * law.cp_max / law.tsr_opt**3
     rated, v = 800.0, 10.0  # 1/2 rho pi R^2 V^3 Cp_max = 3079 W: capped
-    g = gen_law.Mppt(k, rated_power_W=rated)
+    g = gen_law.GeneratorLaw("mppt", mppt_gain_Nms2=k, rated_power_W=rated)
     assert g.torque(1.0) == pytest.approx(k)  # below: k Omega^2
     assert g.torque(40.0) == pytest.approx(rated / 40.0)  # k 40^3 = 9476 W above it
     assert g.dtorque_domega(40.0) == pytest.approx(-rated / 1600.0)
@@ -146,11 +146,12 @@ def test_rated_power_caps_the_generator():
 
 
 def test_a_torque_table_and_a_constant_torque():
-    g = gen_law.TorqueTable(table_rpm=[0.0, 60.0, 120.0], table_torque_Nm=[0.0, 10.0, 25.0])
+    g = gen_law.GeneratorLaw("torque", table_rpm=[0.0, 60.0, 120.0],
+                             table_torque_Nm=[0.0, 10.0, 25.0])
     assert g.torque(90 * RPM) == pytest.approx(17.5, rel=1e-14)
     assert g.torque(200 * RPM) == 25.0  # its last row beyond the table
     assert g.dtorque_domega(90 * RPM) == pytest.approx(15.0 / (60 * RPM))
-    assert gen_law.TorqueTable(torque_Nm=12.0).torque(3.0) == 12.0
+    assert gen_law.GeneratorLaw("torque", torque_Nm=12.0).torque(3.0) == 12.0
 
 
 def test_the_paper_law_holds_its_target_spin():
@@ -160,7 +161,7 @@ def test_the_paper_law_holds_its_target_spin():
     v = 6.0
     target = 5.0 * v / R
     for K2, stable in ((0.5, True), (1e-3, True)):
-        g = gen_law.PaperLaw(target, integral_Nm=2.0, damping_Nms=K2)
+        g = gen_law.GeneratorLaw("paper", target_rad_s=target, integral_Nm=2.0, damping_Nms=K2)
         (p,) = rigid_shaft.operating_points(law, g, v, RHO)
         assert p.omega_rad_s == target and p.generator_torque_Nm == p.rotor_torque_Nm
         h = 1e-6 * target
@@ -171,7 +172,7 @@ def test_the_paper_law_holds_its_target_spin():
     dQ = law.dtorque_domega(stall, v, RHO)
     assert dQ > 0
     for K2 in (0.5 * dQ, dQ - 1e-3):  # net slope dQ - K2 > 0, however small: unstable
-        g = gen_law.PaperLaw(stall, integral_Nm=2.0, damping_Nms=K2)
+        g = gen_law.GeneratorLaw("paper", target_rad_s=stall, integral_Nm=2.0, damping_Nms=K2)
         (p,) = rigid_shaft.operating_points(law, g, v, RHO)
         assert p.slope_Nms == pytest.approx(dQ - K2, rel=1e-9) and not p.stable
     with pytest.raises(ValueError, match="holds the rotor at its target spin"):
@@ -184,7 +185,7 @@ def test_a_speed_outside_the_table_names_the_wind_and_rotor_speed():
         law.torque(50.0, 4.0, RHO)  # tsr 25
     text = str(err.value)
     assert "wind 4 m/s" in text and f"{50.0 / RPM:.4g} rpm" in text and "[1, 8]" in text
-    g = gen_law.PaperLaw(120 * RPM, integral_Nm=1.0)
+    g = gen_law.GeneratorLaw("paper", target_rad_s=120 * RPM, integral_Nm=1.0)
     with pytest.raises(OutOfTable, match="wind 1 m/s and rotor speed 120 rpm"):
         rigid_shaft.operating_points(law, g, 1.0, RHO)
 
