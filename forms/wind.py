@@ -48,6 +48,9 @@ class ProfileWind:
 
     def speed(self, r, c):
         """The wind's speed (normalised) at the centre line r: v_w0 f(-r . k_E)."""
+        if r is None:  # a caller of forms/rod.py's drag that gave no centre line
+            raise ValueError("a wind profile's drag needs the centre line r (its height): "
+                             "pass r to forms/rod.py's aerodynamic_force and body_force")
         return c.v_w0 * self.factor(-r[2], self)
 
 

@@ -67,6 +67,8 @@ def test_the_uniform_wind_is_todays_drag_expression():
     windy = scene.load("stationary_table2", overrides={**UNIFORM, "wind.profile": "power"})
     c = Coefficients.from_normalised(windy.normalised(), windy.model)
     assert signature(rod.aerodynamic_force(r_t, c, r)) != signature(today)  # it can differ
+    with pytest.raises(ValueError, match="needs the centre line r"):
+        rod.aerodynamic_force(r_t, c)  # a profile without the height: said, not a TypeError
 
 
 def test_wind_section_uniform_reproduces_the_environment_wind_bit_for_bit():
