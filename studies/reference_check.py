@@ -67,9 +67,11 @@ def references() -> dict[str, Reference]:
     (models/kinematics.py::Kinematics.reference)."""
     from rawehelix.references import shooting, shooting_shear
     return {"shooting": Reference(shooting.solve, too_many_segments),
-            "extensible_elastica": Reference(shooting.solve_extensible),
+            "extensible_elastica": Reference(shooting.solve_extensible,
+                                             shooting.uniform_load_only),
             "shearable_elastica": Reference(shooting_shear.solve_shearable,
-                                            shooting_shear.not_applicable)}
+                                            lambda p: shooting.uniform_load_only(p)
+                                            or shooting_shear.not_applicable(p))}
 
 
 def reference_of(params: Parameters) -> Reference:
