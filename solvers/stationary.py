@@ -56,6 +56,10 @@ class StationarySolver:
         self.rod = PlanarRod(params, comm) if planar else RodDiscretisation(params, comm)
         self.F = self.rod.stationary_residual()
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
+        self._observables(planar)
+
+    def _observables(self, planar: bool):
+        """The tension field's space and expression (Eq. 29)."""
         p = self.rod.degree
         self.V_T = compat.scalar_space(self.rod.mesh, "DG", p - 1)
         self.tension_expr = (tension(self.rod.centre_line(), self.rod.c.sigma) if planar  # (29)

@@ -1,0 +1,187 @@
+"""The stationary state with a lifted top end (issue 43, ``[lifter] top = "lifted"``).
+
+The ground end is held as in Eq. (35); the top end's position is an unknown, and
+its condition is the natural force term of forms/lifter.py: the top is a point
+mass (rotor plus hub) under its weight, the rotor's thrust and the lifter's force,
+balanced by the helix's end force.  Twist and bending at the ends as in the fixed
+case (alpha(0) = 0, the top's torque by Eq. 39, r'' = 0 by Eq. 37).
+
+Newton starts from the straight chord to the first estimate of :func:`first_top`.
+A lifter that cannot hold the helix and the top up is refused before any work
+(:func:`check_holds`); a Newton that fails, or a state that sags below the ground
+anchor, raises :class:`SagError`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import dolfinx
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from rawehelix.errors import SceneError
+from rawehelix.forms import lifter
+from rawehelix.forms.kinematics import K_E  # noqa: F401  (z points down: the weight is +z)
+from rawehelix.parameters import Parameters
+from rawehelix.solvers.discrete import RodDiscretisation
+from rawehelix.solvers.snes import NewtonSolver, SolverError
+from rawehelix.solvers.stationary import StationaryResult, StationarySolver
+
+DOWN = np.array([0.0, 0.0, 1.0])  # k_E: z points down (Sec. 2.1)
+
+
+def lifter_direction(elevation_deg: float, azimuth_deg: float) -> np.ndarray:
+    """The unit vector of the lifter's pull: ``elevation_deg`` above the horizontal,
+    ``azimuth_deg`` about the vertical from -i_E (the paper's top end, Eq. 66, lies
+    along azimuth 0: x < 0, downwind of the ground station) towards +j_E."""
+    e, a = math.radians(elevation_deg), math.radians(azimuth_deg)
+    return np.array([-math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), -math.sin(e)])
+
+
+@dataclass(frozen=True)
+class TopLoad:
+    """The forces on the lifted top end, SI: the lifter's pull [N] (3,), the rotor's
+    thrust [N] (3,) and the top's mass [kg] (rotor plus hub) under gravity g [m/s^2]."""
+
+    lifter_N: tuple
+    thrust_N: tuple = (0.0, 0.0, 0.0)
+    mass_kg: float = 0.0
+    g_m_s2: float = 9.81
+
+    def __post_init__(self):
+        for name in ("lifter_N", "thrust_N"):
+            value = np.asarray(getattr(self, name), dtype=float)
+            if value.shape != (3,) or not np.all(np.isfinite(value)):
+                raise ValueError(f"TopLoad.{name} must be 3 finite numbers [N], not {value}")
+            object.__setattr__(self, name, tuple(float(x) for x in value))
+        if not (math.isfinite(self.mass_kg) and self.mass_kg >= 0):
+            raise ValueError(f"TopLoad.mass_kg must be finite and >= 0, not {self.mass_kg}")
+
+    def total_N(self) -> np.ndarray:
+        """F = lifter + thrust + m g k_E [N]: the end force of forms/lifter.py."""
+        return np.add(self.lifter_N, self.thrust_N) + self.mass_kg * self.g_m_s2 * DOWN
+
+
+def ground_force(params: Parameters, load: TopLoad) -> np.ndarray:
+    """n(0) = F + W k_E [N]: the force the helix pulls its ground anchor with (the
+    end force plus the helix's weight W = M g, if gravity is on): the stationary
+    balance of the whole helix and its top."""
+    weight = params.helix.mass_kg * params.environment.g_m_s2 * float(params.model.gravity)
+    return load.total_N() + weight * DOWN
+
+
+def check_holds(params: Parameters, load: TopLoad, key: str = "lifter.force_N"):
+    """Refuse (SceneError, exit 2) a lifter that cannot hold the helix and the top up:
+    the upward part of lifter + thrust not above the weight of the helix and the top,
+    so that the helix would leave its ground anchor downwards (into the ground)."""
+    up = -ground_force(params, load)[2]
+    if not up > 0:
+        lift = -float(np.add(load.lifter_N, load.thrust_N)[2])
+        weight = lift - up
+        raise SceneError(
+            params.name, key,
+            f"the lifter cannot hold the helix up: the upward force of lifter and thrust, "
+            f"{lift:.4g} N, is not above the weight of the helix and the top, {weight:.4g} N; "
+            f"raise lifter.force_N or lifter.elevation_deg, or lower rotor.mass_kg")
+
+
+def first_top(params: Parameters, load: TopLoad) -> np.ndarray:
+    """The first estimate of r(1) (normalised): the straight rod along the mean internal
+    force n = F + W/2 k_E, stretched by |n| / EA (Eq. 29)."""
+    q = params.normalised()
+    n = (load.total_N() + 0.5 * params.helix.mass_kg * params.environment.g_m_s2
+         * float(params.model.gravity) * DOWN) / q.force_scale
+    size = float(np.linalg.norm(n))
+    return (1.0 + size / q.sigma) * n / size
+
+
+class SagError(SolverError):
+    """The lifted helix found no stationary state above its ground anchor."""
+
+
+@dataclass
+class LiftedResult:
+    """A converged lifted stationary state: the rod's result and the top (SI)."""
+
+    result: StationaryResult
+    top_m: np.ndarray  # r(L0) [m] (z down)
+    load: TopLoad
+
+    @property
+    def chord_elevation_deg(self) -> float:
+        """The elevation of the chord 0 -> r(L0) above the horizontal [deg]."""
+        x, y, z = self.top_m
+        return math.degrees(math.atan2(-z, math.hypot(x, y)))
+
+
+class LiftedStationarySolver(StationarySolver):
+    """Newton for the stationary residual of Eqs. (30)-(31) with the lifted top: the
+    fixed solver's rod without the top's position, plus the end term -F . v(1)."""
+
+    def __init__(self, params: Parameters, load: TopLoad, comm=MPI.COMM_WORLD,
+                 scene: str = "scene"):
+        self.params, self.scene, self.load = params, scene, load
+        self.rod = RodDiscretisation(params, comm, free_top=True)
+        mesh = self.rod.mesh
+        self.F_top = dolfinx.fem.Constant(mesh, PETSc.ScalarType((0.0, 0.0, 0.0)))
+        self.set_load(load)
+        _, _, ds = self.rod.measures
+        v = self.rod.model.split(self.rod.test)["centre_line"]
+        self.F = (self.rod.stationary_residual()
+                  + lifter.end_residual(self.F_top, self.rod.centre_line(), v, ds))
+        self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
+        self._observables(planar=False)
+
+    def set_load(self, load: TopLoad):
+        """The top's forces (SI), normalised by M g (Eq. 29); a new load needs no
+        recompilation."""
+        self.load = load
+        self.F_top.value[:] = load.total_N() / self.rod.q.force_scale
+
+    def solve_lifted(self, first_guess=None) -> LiftedResult:
+        """Solve from the chord to :func:`first_top` (or ``first_guess``: s -> (n, 3))."""
+        check_holds(self.params, self.load)
+        start = time.perf_counter()
+        if first_guess is None:
+            top = first_top(self.params, self.load)
+            first_guess = lambda s: np.outer(s, top)  # noqa: E731
+        self.rod.set_centre_line(first_guess)
+        try:
+            its = self.newton.solve(f"lifted stationary state of {self.scene}")
+        except SolverError as err:
+            raise SagError(f"{err} The lifted top found no stationary state: the lifter may "
+                           f"be too weak to hold the helix up (raise lifter.force_N or "
+                           f"lifter.elevation_deg)") from None
+        result = self.gather()
+        self._check_above_ground(result)
+        self._check_taut(result)
+        result.newton_iterations = its
+        result.wall_s = time.perf_counter() - start
+        result.state = self.rod.get_state()
+        top = None if result.centre_line is None else self.rod.q.length_m(result.centre_line[-1])
+        top = self.rod.comm.bcast(top, root=0)
+        return LiftedResult(result, top, self.load)
+
+    def _check_above_ground(self, result):
+        """z <= 0 everywhere (z points down, the anchor at z = 0): else the helix sags
+        into the ground, where no stationary state of a free rod exists."""
+        low = None if result.centre_line is None else float(result.centre_line[:, 2].max())
+        low = self.rod.comm.bcast(low, root=0)
+        if low > 1e-9:
+            raise SagError(
+                f"{self.scene}: the lifted helix sags {self.rod.q.length_m(low):.4g} m below "
+                f"its ground anchor: the lifter does not hold it up; raise lifter.force_N or "
+                f"lifter.elevation_deg")
+
+
+def solve(params: Parameters, load: TopLoad, comm=MPI.COMM_WORLD,
+          top_torque: float = 0.0) -> tuple[LiftedStationarySolver, LiftedResult]:
+    """The lifted stationary state of ``params`` under ``load``; ``top_torque``
+    (normalised by GJ / L0, Eq. 39) at the top, held by the ground (alpha(0) = 0)."""
+    solver = LiftedStationarySolver(params, load, comm, scene=params.name)
+    solver.set_end_torques(ground=top_torque, top=top_torque)
+    return solver, solver.solve_lifted()
