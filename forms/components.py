@@ -57,9 +57,23 @@ class Hysteresis(Protocol):
         """z's equation."""
 
 
+@runtime_checkable
+class SpinDragLaw(Protocol):
+    """The spinning tethers' torque loss (forms/spin_drag.py): SpinDrag, or the null
+    NoSpinDrag."""
+
+    fields: tuple
+
+    def dissipation(self, alpha_t, dx):
+        """The dissipation potential D(alpha_t)."""
+
+    def residual(self, alpha_t, psi, c, dx):
+        """Its torque in the twist equation, delta dD/d alpha_t [psi]."""
+
+
 #: the section law's protocol is written beside the laws it describes
 #: (forms/section_law.py::SectionComponent, the registry's UFL half)
 SectionLaw = SectionComponent
 
 
-__all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw"]
+__all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw", "SpinDragLaw"]

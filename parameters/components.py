@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import dataclasses
 
-from rawehelix.parameters import damping, eilaw, hysteresis, section, shear
+from rawehelix.parameters import damping, eilaw, hysteresis, section, shear, spin_drag
 
 #: the sections, in the order of their checks
-SECTIONS = (eilaw, damping, hysteresis, section, shear)
+SECTIONS = (eilaw, damping, hysteresis, section, shear, spin_drag)
 
 
 def group_keys() -> dict:

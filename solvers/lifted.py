@@ -131,8 +131,9 @@ class LiftedStationarySolver(StationarySolver):
         self.set_load(load)
         _, _, ds = self.rod.measures
         v = self.rod.model.split(self.rod.test)["centre_line"]
-        self.F = (self.rod.stationary_residual()
-                  + lifter.end_residual(self.F_top, self.rod.centre_line(), v, ds))
+        self.F = self._with_spin_drag(
+            self.rod.stationary_residual()
+            + lifter.end_residual(self.F_top, self.rod.centre_line(), v, ds), planar=False)
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
         self._observables(planar=False)
 

@@ -13,6 +13,7 @@ import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from rawehelix import compat
 from rawehelix.parameters import Parameters
@@ -54,9 +55,27 @@ class StationarySolver:
         self.params, self.scene = params, scene
         # planar: the reduced (x, z) model (solvers.planar), for planar torque-free scenes
         self.rod = PlanarRod(params, comm) if planar else RodDiscretisation(params, comm)
-        self.F = self.rod.stationary_residual()
+        self.F = self._with_spin_drag(self.rod.stationary_residual(), planar)
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
         self._observables(planar)
+
+    def _with_spin_drag(self, F, planar: bool):
+        """F plus the spin drag's torque (forms/spin_drag.py) of a relative equilibrium
+        spinning at alpha_t = Omega (:meth:`set_spin`; 0 until set): the operating point's
+        state.  F itself when the scene has no spin drag."""
+        self.spin = None
+        if planar or self.rod.q.spin_drag == 0:
+            return F
+        self.spin = dolfinx.fem.Constant(self.rod.mesh, PETSc.ScalarType(0.0))
+        psi = self.rod.model.split(self.rod.test)["twist"]
+        return F + self.rod.c.spin_drag.residual(self.spin, psi, self.rod.c, self.rod.measures[0])
+
+    def set_spin(self, omega: float):
+        """The spin Omega (normalised: rad per t_scale) of the relative equilibrium whose
+        spin drag (forms/spin_drag.py) loads the twist equation; the stationary state
+        (Sec. 5.1) has Omega = 0.  Without a spin drag there is nothing to set."""
+        if self.spin is not None:
+            self.spin.value = omega
 
     def _observables(self, planar: bool):
         """The tension field's space and expression (Eq. 29)."""

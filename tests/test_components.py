@@ -58,13 +58,15 @@ def test_group_of_an_active_section_reaches_normalised():
 
 def _implementations():
     """Every class of each component of forms/coefficients.py, null objects included."""
-    from rawehelix.forms import coefficients, damping, eilaw, hysteresis, section_law
-    from rawehelix.forms.components import BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw
+    from rawehelix.forms import coefficients, damping, eilaw, hysteresis, section_law, spin_drag
+    from rawehelix.forms.components import (BendingLaw, Damping, Hysteresis, Kinematics,
+                                            SectionLaw, SpinDragLaw)
     return [(Kinematics, cls) for cls in coefficients.KINEMATICS.values()] + [
         (Damping, damping.KelvinVoigt), (Damping, damping.NoneDamping),
         (BendingLaw, eilaw.TensionDependentBending), (BendingLaw, eilaw.ConstantBending),
         (Hysteresis, hysteresis.BoucWen), (Hysteresis, hysteresis.NoneHysteresis),
-        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.NonlinearSection)]
+        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.NonlinearSection),
+        (SpinDragLaw, spin_drag.SpinDrag), (SpinDragLaw, spin_drag.NoSpinDrag)]
 
 
 @pytest.mark.parametrize("protocol, cls", _implementations(),

@@ -1,0 +1,98 @@
+"""The scene's ``[spin_drag]`` section: the spinning helix's own aerodynamic torque loss
+(issue 43; forms/spin_drag.py).
+
+Each of the section's n tethers (``section.tethers``) sits at the radius R
+(``section.radius_m``, or ``helix.radius_m``) and moves through still air at Omega R
+as the helix spins.  On a tether laid at the angle beta to the axis
+(``section.lay_angle_deg``) the velocity normal to it is Omega R cos beta, and a
+unit of axial length holds 1 / cos beta of tether; the drag per tether length is
+1/2 rho C_d d |v_n| v_n (a cylinder in cross-flow, the law of KiteTurbineDynamics.jl's
+tether drag), at the lever arm R.  So the distributed torque per axial length is
+
+    q(Omega) = -c Omega |Omega|,   c = n (1/2) rho C_d d R^3 cos beta   [N m s^2 / m],
+
+with rho = ``environment.air_density_kg_m3``.  The wind's own component across the
+tethers is left out (it adds on one side of the ring what it takes on the other).
+``tether_diameter_m = 0`` (the default) is off.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from rawehelix.parameters.checks import ParameterError, _non_negative
+
+
+@dataclass(frozen=True)
+class SpinDrag:
+    """The spinning tethers' aerodynamic torque loss, a distributed torque
+    -c Omega |Omega| per length (module docstring).  A scene's ``[spin_drag]``
+    section; ``tether_diameter_m = 0`` (the default) is off."""
+
+    tether_diameter_m: float = 0.0  # d, one tether's diameter; 0: off [m]
+    drag_coefficient: float = 1.0  # C_d, a tether's drag coefficient in cross-flow [-]
+
+    def __post_init__(self):
+        _non_negative("spin_drag", self, "tether_diameter_m", "drag_coefficient")
+        for name in ("tether_diameter_m", "drag_coefficient"):
+            if not math.isfinite(getattr(self, name)):
+                raise ParameterError(f"spin_drag.{name}", getattr(self, name), "must be finite")
+
+    @property
+    def active(self) -> bool:
+        return self.tether_diameter_m > 0 and self.drag_coefficient > 0
+
+    def describe(self) -> str:
+        return (f"spin drag: tethers of d = {self.tether_diameter_m:g} m, "
+                f"C_d = {self.drag_coefficient:g}: torque -c Omega|Omega| per length")
+
+
+def coefficient(p) -> float:
+    """c = n (1/2) rho C_d d R^3 cos beta [N m s^2 per m of helix] of a scene (0: off)."""
+    drag, section = p.model.spin_drag, p.model.section
+    if not drag.active:
+        return 0.0
+    R = section.radius_m or p.helix.radius_m
+    return (section.tethers * 0.5 * p.environment.air_density_kg_m3 * drag.drag_coefficient
+            * drag.tether_diameter_m * R**3 * math.cos(math.radians(section.lay_angle_deg)))
+
+
+def loss_torque(omega, params):
+    """The spin drag's total torque on a helix spinning uniformly at ``omega`` [rad/s]
+    (scalar or array): int_0^L0 c Omega |Omega| ds = c L0 Omega |Omega| [N m], the
+    loss between the rotor's torque and the ground's at an operating point (0: off)."""
+    import numpy as np
+    omega = np.asarray(omega, dtype=float)
+    return coefficient(params) * params.helix.length_m * omega * np.abs(omega)
+
+
+#: its normalised group (parameters/scene.py::GROUP_KEYS): q~ = q L0^2 / GJ and
+#: Omega~ = Omega t_scale, so c~ = c L0^2 / (GJ t_scale^2) = c g L0 / GJ
+GROUP_KEYS = {
+    "spin_drag": ("c g L0/GJ", "Eq. 31",
+                  ("spin_drag.tether_diameter_m", "spin_drag.drag_coefficient",
+                   "environment.air_density_kg_m3"),
+                  ("helix.GJ_Nm2", "helix.length_m", "environment.g_m_s2", "helix.radius_m")),
+}
+
+#: where the section lives in a scene: Parameters.model.spin_drag (the file's [spin_drag])
+HOLDER, KEY, SECTION = "model", "spin_drag", SpinDrag
+
+#: its field of Normalised, off: c~ of :data:`GROUP_KEYS` (forms/spin_drag.py)
+NORMALISED = {"spin_drag": 0.0}
+
+
+def normalise(p, scales: dict) -> dict:
+    """c~ = c g L0 / GJ (the twist equation (31) in the units of forms/twist.py)."""
+    return {"spin_drag": coefficient(p) * scales["g"] * scales["L0"] / p.helix.GJ_Nm2}
+
+
+def check(params) -> None:
+    """What the spin drag cannot run with: the spline scheme and model.twist = false
+    (it is a torque in the twist equation, forms/spin_drag.py)."""
+    section = params.model.spin_drag
+    if section.active and (params.discretisation.scheme != "fe" or not params.model.twist):
+        raise ParameterError("spin_drag.tether_diameter_m", section.tether_diameter_m,
+                             "the spin drag is a torque in the twist equation (31): it needs "
+                             "discretisation.scheme = 'fe' and model.twist = true")

@@ -1,0 +1,68 @@
+"""The spinning helix's own aerodynamic torque loss (issue 43, ``[spin_drag]``,
+forms/spin_drag.py): a distributed torque -c Omega |Omega| per length in Eq. (31),
+c = n (1/2) rho C_d d R^3 cos(lay).  Off by default; its numpy total for the
+operating point; the twist of a steady spinning helix against the closed form of
+a torque falling linearly along s."""
+
+import math
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from rawehelix.errors import SceneError
+from rawehelix.parameters import spin_drag
+from rawehelix.solvers import fields
+from rawehelix.solvers.stationary import StationarySolver
+from rawehelix.studies import scene
+
+RPM = 2 * math.pi / 60
+
+
+def _spinning(d=0.004, N=4, **changes):
+    """Table 2's helix, straight (gravity and drag off), with the spin drag on."""
+    p = scene.load("stationary_table2", elements=N)
+    return p.replace(model={"gravity": False, "drag": False}, spin_drag={"tether_diameter_m": d},
+                     **changes)
+
+
+def test_off_by_default_and_its_coefficient():
+    p = scene.load("stationary_table2")
+    assert not p.model.spin_drag.active and p.normalised().spin_drag == 0.0
+    assert spin_drag.loss_torque(10.0, p) == 0.0
+    q = _spinning(d=0.002, section={"lay_angle_deg": 20.0})
+    # n (1/2) rho C_d d R^3 cos(lay), by hand: 6 tethers, 1.225 kg/m^3, 2 mm, R 0.19 m
+    c = 6 * 0.5 * 1.225 * 1.0 * 0.002 * 0.19**3 * math.cos(math.radians(20.0))
+    assert spin_drag.coefficient(q) == pytest.approx(c, rel=1e-14)
+    omega = np.array([-12.0, 0.0, 12.566])
+    assert spin_drag.loss_torque(omega, q) == pytest.approx(c * 16.12 * omega * np.abs(omega))
+
+
+@pytest.mark.parametrize("rpm", [120.0, -300.0])
+def test_twist_of_a_spinning_helix_is_the_linear_torque_closed_form(rpm):
+    """Rotor torque Q at the top, the ground's twist held: M(s) = Q - c W|W| (L0 - s),
+    so alpha(s) = [Q s - c W|W| (L0 s - s^2/2)] / GJ (solid section, straight helix)."""
+    p = _spinning(d=0.02)  # a thick tether, so the loss is 12 % of Q at 300 rpm
+    q = p.normalised()
+    Q, L0, GJ = 25.0 * np.sign(rpm), p.helix.length_m, p.helix.GJ_Nm2
+    omega = rpm * RPM
+    solver = StationarySolver(p, MPI.COMM_SELF, scene=p.name)
+    solver.set_end_torques(ground=Q / q.torque_scale, top=Q / q.torque_scale)
+    solver.set_spin(omega * q.t_scale)
+    solver.solve()
+    rod = solver.rod
+    s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
+    s = q.length_m(s)
+    c = spin_drag.coefficient(p)
+    closed = (Q * s - c * omega * abs(omega) * (L0 * s - s**2 / 2)) / GJ
+    assert np.max(np.abs(alpha[:, 0] - closed)) < 1e-9 * np.max(np.abs(closed))
+    loss = spin_drag.loss_torque(omega, p)
+    assert abs(loss) > 0.05 * abs(Q)  # the loss is seen, not lost in the tolerance
+    # end to end: (Q - loss / 2) L0 / GJ, the mean moment
+    assert alpha[-1, 0] - alpha[0, 0] == pytest.approx((Q - loss / 2) * L0 / GJ, rel=1e-9)
+
+
+def test_refused_without_the_twist_equation():
+    with pytest.raises(SceneError, match="spin_drag.tether_diameter_m"):
+        scene.load("stationary_table2", overrides={"spin_drag.tether_diameter_m": 0.004,
+                                                  "model.twist": False})
