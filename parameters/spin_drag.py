@@ -11,7 +11,8 @@ tether drag), at the lever arm R.  So the distributed torque per axial length is
 
     q(Omega) = -c Omega |Omega|,   c = n (1/2) rho C_d d R^3 cos beta   [N m s^2 / m],
 
-with rho = ``environment.air_density_kg_m3``.  The wind's own component across the
+with rho the air's density (``wind.air_density_kg_m3``, or
+``environment.air_density_kg_m3``).  The wind's own component across the
 tethers is left out (it adds on one side of the ring what it takes on the other).
 ``tether_diameter_m = 0`` (the default) is off.
 """
@@ -54,7 +55,9 @@ def coefficient(p) -> float:
     if not drag.active:
         return 0.0
     R = section.radius_m or p.helix.radius_m
-    return (section.tethers * 0.5 * p.environment.air_density_kg_m3 * drag.drag_coefficient
+    rho = p.wind.air_density_kg_m3  # [wind]'s density where given (parameters/wind.py)
+    rho = p.environment.air_density_kg_m3 if rho is None else rho
+    return (section.tethers * 0.5 * rho * drag.drag_coefficient
             * drag.tether_diameter_m * R**3 * math.cos(math.radians(section.lay_angle_deg)))
 
 

@@ -143,14 +143,17 @@ class LiftedStationarySolver(StationarySolver):
         self.load = load
         self.F_top.value[:] = load.total_N() / self.rod.q.force_scale
 
-    def solve_lifted(self, first_guess=None) -> LiftedResult:
-        """Solve from the chord to :func:`first_top` (or ``first_guess``: s -> (n, 3))."""
+    def solve_lifted(self, first_guess=None, warm: bool = False) -> LiftedResult:
+        """Solve from the chord to :func:`first_top` (or ``first_guess``: s -> (n, 3));
+        ``warm``: from the state the solver holds (the last solution: a new load or
+        torque of a continuation)."""
         check_holds(self.params, self.load)
         start = time.perf_counter()
         if first_guess is None:
             top = first_top(self.params, self.load)
             first_guess = lambda s: np.outer(s, top)  # noqa: E731
-        self.rod.set_centre_line(first_guess)
+        if not warm:
+            self.rod.set_centre_line(first_guess)
         try:
             its = self.newton.solve(f"lifted stationary state of {self.scene}")
         except SolverError as err:
@@ -186,3 +189,38 @@ def solve(params: Parameters, load: TopLoad, comm=MPI.COMM_WORLD,
     solver = LiftedStationarySolver(params, load, comm, scene=params.name)
     solver.set_end_torques(ground=top_torque, top=top_torque)
     return solver, solver.solve_lifted()
+
+
+def top_load(params: Parameters, thrust_N=(0.0, 0.0, 0.0)) -> TopLoad:
+    """The top's forces of a scene with ``[lifter] top = "lifted"``: the lifter's
+    ``force_N`` along :func:`lifter_direction`, the rotor's (and hub's) ``rotor.mass_kg``
+    under gravity, and the rotor's thrust [N] (3,) (0: the rotor at rest)."""
+    lift = params.lifter
+    return TopLoad(lifter_N=lift.force_N * lifter_direction(lift.elevation_deg, lift.azimuth_deg),
+                   thrust_N=thrust_N, mass_kg=params.rotor.mass_kg,
+                   g_m_s2=params.environment.g_m_s2 * float(params.model.gravity))
+
+
+def stationary(params: Parameters, thrust_N=(0.0, 0.0, 0.0), comm=MPI.COMM_WORLD,
+               top_torque_Nm: float = 0.0, omega_rad_s: float = 0.0,
+               solver: LiftedStationarySolver | None = None):
+    """The lifted stationary state (or relative equilibrium) of a scene under the rotor's
+    thrust: ``(solver, LiftedResult)``; SI in, the operating point's entry.
+
+    ``thrust_N`` (3,) [N] the rotor's thrust vector; ``top_torque_Nm`` the rotor's torque
+    [N m] at the top, held by the ground's twist (alpha(0) = 0, Eq. 39); ``omega_rad_s``
+    the spin [rad/s] of the relative equilibrium, read by the spin drag only
+    (``[spin_drag]``, forms/spin_drag.py).  ``solver``: a solver of the same scene from
+    an earlier call, which restarts from its last state (a continuation in the wind
+    speed: no recompilation, a warm start).  Refuses a lifter that cannot hold the
+    helix up (SceneError, before any work); raises SagError if Newton finds no state."""
+    q = params.normalised()
+    load = top_load(params, thrust_N)
+    warm = solver is not None
+    if solver is None:
+        solver = LiftedStationarySolver(params, load, comm, scene=params.name)
+    solver.set_load(load)
+    m = top_torque_Nm / q.torque_scale  # (39)
+    solver.set_end_torques(ground=m, top=m)
+    solver.set_spin(omega_rad_s * q.t_scale)
+    return solver, solver.solve_lifted(warm=warm)

@@ -114,3 +114,57 @@ def test_a_lifter_too_weak_is_refused_before_any_work():
     lifted.check_holds(p, lifted.TopLoad(lifter_N=strong))  # holds: no error
     with pytest.raises(SceneError, match="cannot hold"):  # the top's mass counts too
         lifted.check_holds(p, lifted.TopLoad(lifter_N=strong, mass_kg=0.5))
+
+
+def test_stationary_of_a_lifted_scene_reports_the_catenary_top():
+    """rh.stationary on a scene with [lifter] top = "lifted" (the cable of the tests
+    above, and a rotor's mass at the top): summary.json's lifter block holds the top
+    where Irvine's closed form puts it, under the lifter and the rotor's weight."""
+    import rawehelix as rh
+    p = _cable(4).replace(lifter={"top": "lifted", "force_N": PULL_N, "elevation_deg": 45.0})
+    s = rh.stationary(p, MPI.COMM_SELF).summary
+    F = PULL_N * lifted.lifter_direction(45.0, 0.0)
+    x, h = catenary.top(-F[0], -F[2], p.helix.mass_kg * 9.81 / p.helix.length_m,
+                        p.helix.EA_N, p.helix.length_m)
+    block = s["lifter"]
+    assert block["top_position_m"] == pytest.approx([-x, 0.0, -h], abs=1e-8)
+    assert block["chord_elevation_deg"] == pytest.approx(math.degrees(math.atan2(h, x)),
+                                                         abs=1e-8)
+    assert block["top_force_N"] == pytest.approx(list(F), abs=1e-12)
+    assert s["shooting"].startswith("not applicable: lifter.top = 'lifted'")
+
+
+def test_a_failed_lifted_solve_exits_1_with_advice(tmp_path):
+    """Newton stopped early (-rawehelix_snes_max_it 2): exit 1, one line naming the
+    lifted top and what to raise, nothing written."""
+    import subprocess
+    import sys
+    run = subprocess.run(
+        [sys.executable, "-m", "rawehelix.cli.main", "stationary", "stationary_table2",
+         "--elements", "2", "--set", 'lifter.top="lifted"', "--set", "lifter.force_N=200",
+         "-rawehelix_snes_max_it", "2", "-o", str(tmp_path / "OUT")],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 1, run.stderr
+    lines = run.stderr.splitlines()
+    assert len(lines) == 1 and "The lifted top found no stationary state" in lines[0]
+    assert "raise lifter.force_N" in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_operating_point_entry_takes_the_thrust_and_restarts_warm():
+    """lifted.stationary(params, thrust_N, solver=...): the entry of the operating
+    points.  A thrust along the chord and the rotor's weight, from the state of the last
+    call (a warm start), put the top where the catenary under
+    lifter + thrust + weight puts it."""
+    p = _cable(4, twist=True).replace(  # a rotor's torque needs the twist (none here)
+        lifter={"top": "lifted", "force_N": PULL_N, "elevation_deg": 45.0},
+        rotor={"radius_m": 2.0, "mass_kg": 1.5, "tsr": (1.0, 5.0, 9.0),
+                                 "cp": (0.1, 0.4, 0.1), "ct": (0.3, 0.8, 0.9)})
+    solver, cold = lifted.stationary(p, comm=MPI.COMM_SELF)
+    thrust = 60.0 * lifted.lifter_direction(40.0, 0.0)
+    solver, warm = lifted.stationary(p, thrust_N=thrust, comm=MPI.COMM_SELF, solver=solver)
+    F = PULL_N * lifted.lifter_direction(45.0, 0.0) + thrust + [0.0, 0.0, 1.5 * 9.81]
+    x, h = catenary.top(-F[0], -F[2], p.helix.mass_kg * 9.81 / p.helix.length_m,
+                        p.helix.EA_N, p.helix.length_m)
+    assert warm.top_m == pytest.approx([-x, 0.0, -h], abs=1e-8)
+    assert warm.result.newton_iterations <= cold.result.newton_iterations  # 4 and 4 at N = 4
