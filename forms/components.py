@@ -64,8 +64,11 @@ class SpinDragLaw(Protocol):
 
     fields: tuple
 
-    def dissipation(self, alpha_t, dx):
+    def dissipation(self, alpha_t, c, dx):
         """The dissipation potential D(alpha_t)."""
+
+    def power(self, alpha_t, c, dx):
+        """The power it takes, alpha_t dD/d alpha_t."""
 
     def residual(self, alpha_t, psi, c, dx):
         """Its torque in the twist equation, delta dD/d alpha_t [psi]."""

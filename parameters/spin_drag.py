@@ -92,9 +92,13 @@ def normalise(p, scales: dict) -> dict:
 
 
 def check(params) -> None:
-    """What the spin drag cannot run with: the spline scheme and model.twist = false
-    (it is a torque in the twist equation, forms/spin_drag.py)."""
+    """What the spin drag cannot run with: the spline scheme, model.twist = false (it is
+    a torque in the twist equation, forms/spin_drag.py) and the shearable rod."""
     section = params.model.spin_drag
+    if section.active and params.model.kinematics == "shearable":
+        raise ParameterError("spin_drag.tether_diameter_m", section.tether_diameter_m,
+                             "the spin drag is written on the unshearable rod's twist "
+                             "equation: not with model.kinematics = 'shearable'")
     if section.active and (params.discretisation.scheme != "fe" or not params.model.twist):
         raise ParameterError("spin_drag.tether_diameter_m", section.tether_diameter_m,
                              "the spin drag is a torque in the twist equation (31): it needs "
