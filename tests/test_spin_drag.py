@@ -75,35 +75,9 @@ def test_spin_up_with_spin_drag_closes_its_energy_balance():
     the non-variational work, minus the dissipated energy int alpha_t dD/d alpha_t,
     to 1e-4 of the dissipated energy.  Measured (1.5 s): dissipated 0.561 (normalised,
     M g L0) of an external work 0.711, balance within 4.0e-7 (7e-7 of it)."""
-    import dolfinx.fem
-    import ufl
-    from rawehelix.forms import rod as rod_forms
-    from rawehelix.solvers.dynamics import DynamicsSolver
+    from tests_util import spin_up_energy_balance
     p = scene.load("nominal_operation", elements=4, degree=3).replace(
         spin_drag={"tether_diameter_m": 0.5}, time={"dt_s": 2e-3})
-    solver = DynamicsSolver.from_stationary(p, options={"ts_alpha_radius": 1.0,
-                                                        "ts_adapt_type": "none"})
-    form, c = solver.form, solver.rod.c
-    f = form.fields
-    dx, _, ds = solver.rod.measures
-    x = ufl.SpatialCoordinate(solver.rod.mesh)
-    external = dolfinx.fem.form(  # drag (Eq. 28) and the end torques (38)-(40), x beta/delta
-        ufl.inner(rod_forms.body_force(f.r_t, c) - c.gravity * ufl.as_vector((0.0, 0.0, 1.0)),
-                  f.r_t) * dx
-        + c.beta * (c.mN * x[0] - form.m0 * (1 - x[0])) * f.alpha_t * ds)
-    dt = 2e-3 / solver.q.t_scale
-    rows = []
-
-    def out(sv):
-        e = sv.energy()
-        rows.append((e["kinetic"] + e["potential"], e["power_nv"], e["dissipation"],
-                     dolfinx.fem.assemble_scalar(external)))
-    solver.advance(1.0 / solver.q.t_scale, on_output=out, output_every=dt)
-    E, p_nv, p_d, p_ext = np.array(rows).T
-
-    def work(p_):
-        return np.concatenate([[0.0], np.cumsum(dt * (p_[1:] + p_[:-1]) / 2)])
-    dissipated = work(p_d)
-    balance = E - E[0] - work(p_ext) - work(p_nv) + dissipated
-    assert dissipated[-1] > 0.3 * work(p_ext)[-1]  # the spin drag takes a large share
+    _, W_ext, _, dissipated, balance = spin_up_energy_balance(p, 1.0)
+    assert dissipated[-1] > 0.3 * W_ext[-1]  # the spin drag takes a large share
     assert np.abs(balance).max() < 1e-4 * dissipated[-1]
