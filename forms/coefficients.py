@@ -5,8 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from rawehelix.forms import wind as wind_profile
 from rawehelix.forms.components import (BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw,
-                                        SpinDragLaw)
+                                        SpinDragLaw, WindProfile)
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
 from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
 from rawehelix.forms.extensible import ExtensibleKinematics
@@ -33,7 +34,8 @@ COMPONENTS = {"damping": KelvinVoigt.from_normalised,
               "bending_law": TensionDependentBending.from_normalised,
               "hysteresis": BoucWen.from_normalised,
               "section": section_law.from_normalised,
-              "spin_drag": SpinDrag.from_normalised}
+              "spin_drag": SpinDrag.from_normalised,
+              "wind": wind_profile.from_normalised}
 
 
 @dataclass
@@ -76,6 +78,9 @@ class Coefficients:
     # the spinning tethers' torque loss, a component (forms/spin_drag.py): SpinDrag, or
     # the null object NoSpinDrag
     spin_drag: SpinDragLaw = field(default_factory=NoSpinDrag)
+    # the wind's profile in the drag, a component (forms/wind.py): ProfileWind, or the
+    # null object UniformWind (the paper's v_w0 at every height)
+    wind: WindProfile = field(default_factory=wind_profile.UniformWind)
     # the ENERGY_COMPONENTS of the scene
     extra: tuple = ()
 
