@@ -25,21 +25,22 @@ from petsc4py import PETSc
 
 from rawehelix.errors import SceneError
 from rawehelix.forms import lifter
-from rawehelix.forms.kinematics import K_E  # noqa: F401  (z points down: the weight is +z)
 from rawehelix.parameters import Parameters
+from rawehelix.parameters.lifter import Lifter
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.snes import NewtonSolver, SolverError
 from rawehelix.solvers.stationary import StationaryResult, StationarySolver
 
-DOWN = np.array([0.0, 0.0, 1.0])  # k_E: z points down (Sec. 2.1)
+DOWN = np.array([0.0, 0.0, 1.0])  # k_E of forms/kinematics.py as numpy: z points down (Sec. 2.1)
 
 
 def lifter_direction(elevation_deg: float, azimuth_deg: float) -> np.ndarray:
-    """The unit vector of the lifter's pull: ``elevation_deg`` above the horizontal,
-    ``azimuth_deg`` about the vertical from -i_E (the paper's top end, Eq. 66, lies
-    along azimuth 0: x < 0, downwind of the ground station) towards +j_E."""
-    e, a = math.radians(elevation_deg), math.radians(azimuth_deg)
-    return np.array([-math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), -math.sin(e)])
+    """The unit vector of a lifter's pull: ``elevation_deg`` above the horizontal,
+    ``azimuth_deg`` about the vertical from -i_E (the paper's top end, Eq. 66, lies along
+    azimuth 0: x < 0, downwind of the ground station) towards +j_E; z points down.  The
+    one definition is parameters/lifter.py's ``Lifter.direction``."""
+    return np.array(Lifter(top="lifted", force_N=1.0, elevation_deg=elevation_deg,
+                           azimuth_deg=azimuth_deg).direction())
 
 
 @dataclass(frozen=True)
@@ -196,7 +197,7 @@ def top_load(params: Parameters, thrust_N=(0.0, 0.0, 0.0)) -> TopLoad:
     ``force_N`` along :func:`lifter_direction`, the rotor's (and hub's) ``rotor.mass_kg``
     under gravity, and the rotor's thrust [N] (3,) (0: the rotor at rest)."""
     lift = params.lifter
-    return TopLoad(lifter_N=lift.force_N * lifter_direction(lift.elevation_deg, lift.azimuth_deg),
+    return TopLoad(lifter_N=lift.force_N * np.array(lift.direction()),
                    thrust_N=thrust_N, mass_kg=params.rotor.mass_kg,
                    g_m_s2=params.environment.g_m_s2 * float(params.model.gravity))
 
