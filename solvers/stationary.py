@@ -16,6 +16,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from rawehelix import compat
+from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import fields
 from rawehelix.forms.kinematics import tension
@@ -52,6 +53,12 @@ class StationarySolver:
 
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
                  planar: bool = False):
+        if params.lifter.active:  # the top held by a force: solvers/lifted.py's solver
+            raise SceneError(
+                params.name, "lifter.top",
+                "'lifted' holds the top end by the lifter's force, which `rawehelix "
+                "stationary` solves; this command (or ends.tension_N) holds the top at "
+                "[ends]' position: set lifter.top = 'fixed', or give ends.elongation")
         self.params, self.scene = params, scene
         # planar: the reduced (x, z) model (solvers.planar), for planar torque-free scenes
         self.rod = PlanarRod(params, comm) if planar else RodDiscretisation(params, comm)
