@@ -168,3 +168,16 @@ def test_operating_point_entry_takes_the_thrust_and_restarts_warm():
                         p.helix.EA_N, p.helix.length_m)
     assert warm.top_m == pytest.approx([-x, 0.0, -h], abs=1e-8)
     assert warm.result.newton_iterations <= cold.result.newton_iterations  # 4 and 4 at N = 4
+
+
+def test_a_lifted_straight_helix_under_torque_twists_by_Q_L0_over_GJ():
+    """Gravity and drag off, the rotor's torque at the lifted top, held by the ground:
+    the rod stays straight along the pull and twists by Q L0 / GJ end to end."""
+    import rawehelix as rh
+    p = scene.load("stationary_table2", elements=4).replace(
+        model={"gravity": False, "drag": False}, torque={"top_Nm": 25.0},
+        lifter={"top": "lifted", "force_N": PULL_N, "elevation_deg": 60.0})
+    s = rh.stationary(p, MPI.COMM_SELF).summary
+    L0, GJ = p.helix.length_m, p.helix.GJ_Nm2
+    assert s["torque"]["twist_end_to_end_rad"] == pytest.approx(25.0 * L0 / GJ, rel=1e-9)
+    assert s["lifter"]["chord_elevation_deg"] == pytest.approx(60.0, abs=1e-9)
