@@ -61,13 +61,36 @@ def coefficient(p) -> float:
             * drag.tether_diameter_m * R**3 * math.cos(math.radians(section.lay_angle_deg)))
 
 
+@dataclass(frozen=True)
+class Loss:
+    """The spin drag's total torque on a helix spinning uniformly, the ``loss`` that
+    operation/rigid_shaft.py's ``operating_points`` reads: c L0 Omega |Omega| [N m]."""
+
+    c_total: float  # c L0 [N m s^2]
+
+    def torque(self, omega):
+        """int_0^L0 c Omega |Omega| ds = c L0 Omega |Omega| [N m] (``omega`` [rad/s])."""
+        import numpy as np
+        omega = np.asarray(omega, dtype=float)
+        return self.c_total * omega * np.abs(omega)
+
+    def dtorque_domega(self, omega):
+        """2 c L0 |Omega| [N m s]."""
+        import numpy as np
+        return 2.0 * self.c_total * np.abs(np.asarray(omega, dtype=float))
+
+
+def loss_of(params) -> Loss | None:
+    """The spin drag's :class:`Loss` of a scene, or None when it has none."""
+    c = coefficient(params)
+    return Loss(c * params.helix.length_m) if c > 0 else None
+
+
 def loss_torque(omega, params):
-    """The spin drag's total torque on a helix spinning uniformly at ``omega`` [rad/s]
-    (scalar or array): int_0^L0 c Omega |Omega| ds = c L0 Omega |Omega| [N m], the
-    loss between the rotor's torque and the ground's at an operating point (0: off)."""
-    import numpy as np
-    omega = np.asarray(omega, dtype=float)
-    return coefficient(params) * params.helix.length_m * omega * np.abs(omega)
+    """The spin drag's total torque at a uniform spin ``omega`` [rad/s] (scalar or array):
+    c L0 Omega |Omega| [N m], the loss between the rotor's torque and the ground's at an
+    operating point (0: off)."""
+    return Loss(coefficient(params) * params.helix.length_m).torque(omega)
 
 
 #: its normalised group (parameters/scene.py::GROUP_KEYS): q~ = q L0^2 / GJ and

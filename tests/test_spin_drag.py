@@ -81,3 +81,29 @@ def test_spin_up_with_spin_drag_closes_its_energy_balance():
     _, W_ext, _, dissipated, balance = spin_up_energy_balance(p, 1.0)
     assert dissipated[-1] > 0.3 * W_ext[-1]  # the spin drag takes a large share
     assert np.abs(balance).max() < 1e-4 * dissipated[-1]
+
+
+def test_operating_point_with_the_loss_is_mppt_with_the_summed_gain():
+    """With MPPT (tau = k Omega^2) the loss c L0 Omega^2 adds to the gain: the rigid
+    shaft's root of Q = tau + loss (operation/rigid_shaft.py with loss_of) is the root of
+    Q(Omega) = (k + c L0) Omega^2, found independently by scipy's brentq on the table."""
+    from scipy.optimize import brentq
+    from rawehelix.operation import generator as generator_law, rigid_shaft, rotor as rotor_law
+    p = scene.load("rotor_example", overrides={"spin_drag.tether_diameter_m": 0.02})
+    rotor, gen = rotor_law.from_params(p), generator_law.from_params(p)
+    loss = spin_drag.loss_of(p)
+    assert spin_drag.loss_of(scene.load("rotor_example")) is None
+    k = p.generator.mppt_gain_Nms2
+    cL = spin_drag.coefficient(p) * p.helix.length_m
+    v_n, rho = 4.6761, p.environment.air_density_kg_m3
+    points = [pt for pt in rigid_shaft.operating_points(rotor, gen, v_n, rho, loss=loss)
+              if pt.stable]
+    assert len(points) == 1
+    lo, hi = (t * v_n / rotor.radius_m for t in (3.0, 8.0))
+    omega = brentq(lambda w: float(rotor.torque(w, v_n, rho)) - (k + cL) * w * w, lo, hi,
+                   xtol=1e-14)
+    assert points[0].omega_rad_s == pytest.approx(omega, rel=1e-9)
+    assert cL * omega**2 > 0.03 * points[0].rotor_torque_Nm  # the loss moves the point
+    # the ground's torque is the rotor's less the loss
+    assert points[0].generator_torque_Nm == pytest.approx(
+        points[0].rotor_torque_Nm - float(loss.torque(omega)), rel=1e-9)
