@@ -23,10 +23,13 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from rawehelix import compat
 from rawehelix.errors import SceneError
 from rawehelix.forms import lifter
+from rawehelix.forms.kinematics import d
 from rawehelix.parameters import Parameters
 from rawehelix.parameters.lifter import Lifter
+from rawehelix.solvers import fields
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.snes import NewtonSolver, SolverError
 from rawehelix.solvers.stationary import StationaryResult, StationarySolver
@@ -46,12 +49,15 @@ def lifter_direction(elevation_deg: float, azimuth_deg: float) -> np.ndarray:
 @dataclass(frozen=True)
 class TopLoad:
     """The forces on the lifted top end, SI: the lifter's pull [N] (3,), the rotor's
-    thrust [N] (3,) and the top's mass [kg] (rotor plus hub) under gravity g [m/s^2]."""
+    thrust [N] (3,) as a fixed vector (axis "wind") and/or its size [N] along the
+    helix's end tangent (axis "tangent": a follower force, forms/lifter.py), and the
+    top's mass [kg] (rotor plus hub) under gravity g [m/s^2]."""
 
     lifter_N: tuple
     thrust_N: tuple = (0.0, 0.0, 0.0)
     mass_kg: float = 0.0
     g_m_s2: float = 9.81
+    tangent_thrust_N: float = 0.0
 
     def __post_init__(self):
         for name in ("lifter_N", "thrust_N"):
@@ -59,30 +65,28 @@ class TopLoad:
             if value.shape != (3,) or not np.all(np.isfinite(value)):
                 raise ValueError(f"TopLoad.{name} must be 3 finite numbers [N], not {value}")
             object.__setattr__(self, name, tuple(float(x) for x in value))
-        if not (math.isfinite(self.mass_kg) and self.mass_kg >= 0):
-            raise ValueError(f"TopLoad.mass_kg must be finite and >= 0, not {self.mass_kg}")
+        for name in ("mass_kg", "tangent_thrust_N"):
+            if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+                raise ValueError(f"TopLoad.{name} must be finite and >= 0, "
+                                 f"not {getattr(self, name)}")
 
     def total_N(self) -> np.ndarray:
-        """F = lifter + thrust + m g k_E [N]: the end force of forms/lifter.py."""
+        """F = lifter + thrust + m g k_E [N]: the dead end force of forms/lifter.py (the
+        tangent thrust, which turns with the end, comes on top)."""
         return np.add(self.lifter_N, self.thrust_N) + self.mass_kg * self.g_m_s2 * DOWN
-
-
-def ground_force(params: Parameters, load: TopLoad) -> np.ndarray:
-    """n(0) = F + W k_E [N]: the force the helix pulls its ground anchor with (the
-    end force plus the helix's weight W = M g, if gravity is on): the stationary
-    balance of the whole helix and its top."""
-    weight = params.helix.mass_kg * params.environment.g_m_s2 * float(params.model.gravity)
-    return load.total_N() + weight * DOWN
 
 
 def check_holds(params: Parameters, load: TopLoad, key: str = "lifter.force_N"):
     """Refuse (SceneError, exit 2) a lifter that cannot hold the helix and the top up:
-    the upward part of lifter + thrust not above the weight of the helix and the top,
-    so that the helix would leave its ground anchor downwards (into the ground)."""
-    up = -ground_force(params, load)[2]
-    if not up > 0:
-        lift = -float(np.add(load.lifter_N, load.thrust_N)[2])
-        weight = lift - up
+    the upward part of lifter + thrust not above the weight of the helix and the top, so
+    that the helix would leave its ground anchor downwards (into the ground).  In the
+    stationary state drag is horizontal (the wind is), so the vertical balance of the
+    helix and its top decides.  A thrust along the end tangent counts for nothing here
+    (its direction is the solution's): the lifter must hold the machine at rest."""
+    lift = -float(np.add(load.lifter_N, load.thrust_N)[2])
+    weight = (load.mass_kg * load.g_m_s2
+              + params.helix.mass_kg * params.environment.g_m_s2 * float(params.model.gravity))
+    if not lift > weight:
         raise SceneError(
             params.name, key,
             f"the lifter cannot hold the helix up: the upward force of lifter and thrust, "
@@ -92,10 +96,13 @@ def check_holds(params: Parameters, load: TopLoad, key: str = "lifter.force_N"):
 
 def first_top(params: Parameters, load: TopLoad) -> np.ndarray:
     """The first estimate of r(1) (normalised): the straight rod along the mean internal
-    force n = F + W/2 k_E, stretched by |n| / EA (Eq. 29)."""
+    force n = F + W/2 k_E (plus the tangent thrust along it), stretched by |n| / EA
+    (Eq. 29)."""
     q = params.normalised()
     n = (load.total_N() + 0.5 * params.helix.mass_kg * params.environment.g_m_s2
          * float(params.model.gravity) * DOWN) / q.force_scale
+    size = float(np.linalg.norm(n))
+    n = n / size * (size + load.tangent_thrust_N / q.force_scale)  # the thrust along it
     size = float(np.linalg.norm(n))
     return (1.0 + size / q.sigma) * n / size
 
@@ -111,6 +118,7 @@ class LiftedResult:
     result: StationaryResult
     top_m: np.ndarray  # r(L0) [m] (z down)
     load: TopLoad
+    end_tangent: np.ndarray  # t(L0) = r'/|r'| at the top (the rotor's axis "tangent")
 
     @property
     def chord_elevation_deg(self) -> float:
@@ -129,12 +137,15 @@ class LiftedStationarySolver(StationarySolver):
         self.rod = RodDiscretisation(params, comm, free_top=True)
         mesh = self.rod.mesh
         self.F_top = dolfinx.fem.Constant(mesh, PETSc.ScalarType((0.0, 0.0, 0.0)))
+        self.F_tangent = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
         self.set_load(load)
         _, _, ds = self.rod.measures
         v = self.rod.model.split(self.rod.test)["centre_line"]
+        r = self.rod.centre_line()
         self.F = self._with_spin_drag(
-            self.rod.stationary_residual()
-            + lifter.end_residual(self.F_top, self.rod.centre_line(), v, ds), planar=False)
+            self.rod.stationary_residual() + lifter.end_residual(self.F_top, r, v, ds)
+            + lifter.follower_residual(self.F_tangent, r, v, ds), planar=False)
+        self._tangent = None  # r' at the nodes, compiled on first use (end_tangent)
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
         self._observables(planar=False)
 
@@ -143,6 +154,7 @@ class LiftedStationarySolver(StationarySolver):
         recompilation."""
         self.load = load
         self.F_top.value[:] = load.total_N() / self.rod.q.force_scale
+        self.F_tangent.value = load.tangent_thrust_N / self.rod.q.force_scale
 
     def solve_lifted(self, first_guess=None, warm: bool = False) -> LiftedResult:
         """Solve from the chord to :func:`first_top` (or ``first_guess``: s -> (n, 3));
@@ -169,7 +181,18 @@ class LiftedStationarySolver(StationarySolver):
         result.state = self.rod.get_state()
         top = None if result.centre_line is None else self.rod.q.length_m(result.centre_line[-1])
         top = self.rod.comm.bcast(top, root=0)
-        return LiftedResult(result, top, self.load)
+        return LiftedResult(result, top, self.load, self.end_tangent())
+
+    def end_tangent(self) -> np.ndarray:
+        """t(L0) = r'/|r'| at the top of the current state (every rank; collective): the
+        rotor's axis "tangent"."""
+        if self._tangent is None:
+            rod = self.rod
+            self._V_d = compat.vector_space(rod.mesh, "DG", rod.degree - 1, 3)
+            self._tangent = d(rod.centre_line())
+        _, values = fields.gather(fields.interpolate_expression(self._tangent, self._V_d))
+        t = None if values is None else values[-1] / np.linalg.norm(values[-1])
+        return self.rod.comm.bcast(t, root=0)
 
     def _check_above_ground(self, result):
         """z <= 0 everywhere (z points down, the anchor at z = 0): else the helix sags
@@ -192,23 +215,28 @@ def solve(params: Parameters, load: TopLoad, comm=MPI.COMM_WORLD,
     return solver, solver.solve_lifted()
 
 
-def top_load(params: Parameters, thrust_N=(0.0, 0.0, 0.0)) -> TopLoad:
+def top_load(params: Parameters, thrust_N=(0.0, 0.0, 0.0),
+             tangent_thrust_N: float = 0.0) -> TopLoad:
     """The top's forces of a scene with ``[lifter] top = "lifted"``: the lifter's
-    ``force_N`` along :func:`lifter_direction`, the rotor's (and hub's) ``rotor.mass_kg``
-    under gravity, and the rotor's thrust [N] (3,) (0: the rotor at rest)."""
+    ``force_N`` along ``Lifter.direction``, the rotor's (and hub's) ``rotor.mass_kg``
+    under gravity, and the rotor's thrust: a vector [N] (3,) and/or a size [N] along the
+    end tangent (0: the rotor at rest)."""
     lift = params.lifter
     return TopLoad(lifter_N=lift.force_N * np.array(lift.direction()),
                    thrust_N=thrust_N, mass_kg=params.rotor.mass_kg,
-                   g_m_s2=params.environment.g_m_s2 * float(params.model.gravity))
+                   g_m_s2=params.environment.g_m_s2 * float(params.model.gravity),
+                   tangent_thrust_N=tangent_thrust_N)
 
 
 def stationary(params: Parameters, thrust_N=(0.0, 0.0, 0.0), comm=MPI.COMM_WORLD,
                top_torque_Nm: float = 0.0, omega_rad_s: float = 0.0,
-               solver: LiftedStationarySolver | None = None):
+               solver: LiftedStationarySolver | None = None, tangent_thrust_N: float = 0.0):
     """The lifted stationary state (or relative equilibrium) of a scene under the rotor's
     thrust: ``(solver, LiftedResult)``; SI in, the operating point's entry.
 
-    ``thrust_N`` (3,) [N] the rotor's thrust vector; ``top_torque_Nm`` the rotor's torque
+    ``thrust_N`` (3,) [N] the rotor's thrust as a fixed vector (axis "wind"), or
+    ``tangent_thrust_N`` [N] its size along the end tangent, which Newton turns with the
+    top (axis "tangent": ``result.end_tangent`` is that axis); ``top_torque_Nm`` the rotor's torque
     [N m] at the top, held by the ground's twist (alpha(0) = 0, Eq. 39); ``omega_rad_s``
     the spin [rad/s] of the relative equilibrium, read by the spin drag only
     (``[spin_drag]``, forms/spin_drag.py).  ``solver``: a solver of the same scene from
@@ -216,7 +244,7 @@ def stationary(params: Parameters, thrust_N=(0.0, 0.0, 0.0), comm=MPI.COMM_WORLD
     speed: no recompilation, a warm start).  Refuses a lifter that cannot hold the
     helix up (SceneError, before any work); raises SagError if Newton finds no state."""
     q = params.normalised()
-    load = top_load(params, thrust_N)
+    load = top_load(params, thrust_N, tangent_thrust_N)
     warm = solver is not None
     if solver is None:
         solver = LiftedStationarySolver(params, load, comm, scene=params.name)

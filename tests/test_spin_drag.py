@@ -68,6 +68,11 @@ def test_refused_without_the_twist_equation():
                                                   "model.twist": False})
 
 
+# 21 s on a cold JIT cache (the dynamics' forms with the spin drag): make test-long.  In
+# make test the spin drag's term is checked by
+# test_twist_of_a_spinning_helix_is_the_linear_torque_closed_form and the energy harness
+# by tests/test_damping.py::test_spin_up_with_damping_closes_its_energy_balance
+@pytest.mark.long
 def test_spin_up_with_spin_drag_closes_its_energy_balance():
     """nominal_operation (N = 4) spun up for 1 s with a spin drag (d = 0.5 m, so that it
     takes most of the work), alpha2 with spectral radius 1 at a fixed 2 ms step: the
