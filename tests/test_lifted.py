@@ -197,3 +197,19 @@ def test_thrust_along_the_end_tangent_is_a_follower_force():
                         p.helix.EA_N, p.helix.length_m)
     assert out.top_m == pytest.approx([-x, 0.0, -h], abs=1e-8)
     assert out.end_tangent == pytest.approx(lifted.lifter_direction(45.0, 0.0), abs=1e-6)
+
+
+@pytest.mark.mpi
+def test_lifted_state_is_the_same_on_one_and_two_ranks():
+    """Table 2's helix with wind, lifted by 200 N at 50 deg and twisted by 25 N m (a
+    3D state): the top, its end tangent and the centre line on MPI.COMM_WORLD equal the
+    serial ones (COMM_SELF on each rank) to 1e-10."""
+    p = scene.load("stationary_table2", elements=4).replace(
+        lifter={"top": "lifted", "force_N": PULL_N, "elevation_deg": 50.0},
+        torque={"top_Nm": 25.0})
+    _, serial = lifted.stationary(p, comm=MPI.COMM_SELF, top_torque_Nm=25.0)
+    _, world = lifted.stationary(p, comm=MPI.COMM_WORLD, top_torque_Nm=25.0)
+    assert np.max(np.abs(serial.top_m - world.top_m)) < 1e-10
+    assert np.max(np.abs(serial.end_tangent - world.end_tangent)) < 1e-10
+    if MPI.COMM_WORLD.rank == 0:
+        assert np.max(np.abs(serial.result.centre_line - world.result.centre_line)) < 1e-10
