@@ -131,6 +131,9 @@ class LiftedStationarySolver(StationarySolver):
     """Newton for the stationary residual of Eqs. (30)-(31) with the lifted top: the
     fixed solver's rod without the top's position, plus the end term -F . v(1)."""
 
+    #: the lifted top's tension is the lifter's (its elongation is not read)
+    SLACK_ADVICE = "raise lifter.force_N"
+
     def __init__(self, params: Parameters, load: TopLoad, comm=MPI.COMM_WORLD,
                  scene: str = "scene"):
         self.params, self.scene, self.load = params, scene, load

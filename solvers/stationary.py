@@ -51,6 +51,9 @@ class StationaryResult:
 class StationarySolver:
     """Newton for the stationary residual of Eqs. (30)-(31) on one discretisation."""
 
+    #: what a slack state's message advises: the fixed top's tension is its elongation's
+    SLACK_ADVICE = "increase ends.elongation"
+
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
                  planar: bool = False):
         if params.lifter.active:  # the top held by a force: solvers/lifted.py's solver
@@ -137,7 +140,7 @@ class StationarySolver:
             raise SlackError(
                 f"{self.scene}: the stationary tension falls to {where[1]:.4g} N at "
                 f"s = {self.rod.q.length_m(where[0]):.4g} m: the helix is slack, and the "
-                f"tension law (22) does not hold for compression; increase ends.elongation")
+                f"tension law (22) does not hold for compression; {self.SLACK_ADVICE}")
 
     def gather(self) -> StationaryResult:
         s, x = self.rod.gather_centre_line()
