@@ -119,6 +119,7 @@ def lifter_block(params: Parameters, top) -> dict:
     return {"top": "lifted", "top_position_m": [float(x) for x in top.top_m],
             "chord_elevation_deg": float(top.chord_elevation_deg),
             "chord_length_m": float(np.linalg.norm(top.top_m)),
+            "end_tangent": [float(x) for x in top.end_tangent],
             "force_N": params.lifter.force_N,
             "top_force_N": [float(x) for x in top.load.total_N()]}
 
