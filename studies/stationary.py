@@ -55,11 +55,17 @@ class Stationary:
 def solve(params: Parameters, comm=MPI.COMM_WORLD, top_torque: float = 0.0):
     """Newton alone (no shooting reference): ``(solver, result, planar)`` on the
     FE rod of :func:`compute` (the planar (x, z) rod where ``model.reduction``
-    allows it and the state is torque-free); ``top_torque`` (normalised, Eq. 39) the
+    allows it and the state is torque-free; the lifted top's solver with
+    ``[lifter] top = "lifted"``, the rotor at rest); ``top_torque`` (normalised, Eq. 39) the
     torque of both ends, balanced (:func:`static_torque`): the twisted state.  The
     parameter studies' stationary quantities take the torque-free one."""
     from rawehelix.solvers.stationary import StationarySolver, reduced
 
+    if params.lifter.active:  # the top held by the lifter's force (solvers/lifted.py)
+        from rawehelix.solvers import lifted
+        q = params.normalised()
+        solver, top = lifted.stationary(params, comm=comm, top_torque_Nm=q.torque_Nm(top_torque))
+        return solver, top.result, False
     planar = reduced(params) and top_torque == 0.0
     solver = StationarySolver(params, comm, scene=params.name, planar=planar)
     if top_torque:
@@ -104,13 +110,13 @@ def static_torque(params: Parameters) -> float:
     return params.normalised().mN0
 
 
-def sag_m(params: Parameters, result, lifted_top: bool = False) -> float:
+def sag_m(params: Parameters, result) -> float:
     """The sag [m] of a stationary result: the centre line's largest distance from the
     chord (to the top of Eq. 66, or to where the lifted top found itself)."""
     from rawehelix.solvers.stationary import sag
     q = params.normalised()
     return q.L0 * sag(result.centre_line,
-                      result.centre_line[-1] if lifted_top else q.top_position())
+                      result.centre_line[-1] if params.lifter.active else q.top_position())
 
 
 def lifter_block(params: Parameters, top) -> dict:
@@ -194,7 +200,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
             "tension_N": {"s0": float(T[0]), "s1": float(T[-1]),
                           "min": float(T.min()), "max": float(T.max()),
                           "mean": float(q.tension_N(mean_tension))},
-            "sag_m": sag_m(params, result, lifted_top=top is not None),
+            "sag_m": sag_m(params, result),
             "ends": ends_block(params, q.tension_N(mean_tension)),
             "torque": None if twist is None else {
                 "top_Nm": params.torque.top_Nm, "ground_Nm": params.torque.top_Nm,

@@ -213,3 +213,17 @@ def test_lifted_state_is_the_same_on_one_and_two_ranks():
     assert np.max(np.abs(serial.end_tangent - world.end_tangent)) < 1e-10
     if MPI.COMM_WORLD.rank == 0:
         assert np.max(np.abs(serial.result.centre_line - world.result.centre_line)) < 1e-10
+
+
+def test_a_study_point_of_a_lifted_scene_is_the_catenary():
+    """The studies' stationary stage (study, calibrate) solves the lifted top: T(0) of
+    the lifted cable is the catenary's, |(H, V - W)| (the helix's weight W below the
+    pull), and the sag is measured from the chord to where the top found itself."""
+    from rawehelix.studies import quantities
+    p = _cable(4).replace(lifter={"top": "lifted", "force_N": PULL_N, "elevation_deg": 45.0})
+    values = quantities.evaluate(p, ["tension_s0_N", "sag_m"])
+    F = PULL_N * lifted.lifter_direction(45.0, 0.0)
+    W = p.helix.mass_kg * p.environment.g_m_s2
+    # to the FE tension's error at N = 4 (1.7e-4 N, test_lifted_cable_is_the_elastic_catenary)
+    assert values["values"]["tension_s0_N"] == pytest.approx(math.hypot(F[0], -F[2] - W), abs=3e-4)
+    assert 0 < values["values"]["sag_m"] < 0.1
