@@ -248,6 +248,7 @@ def stationary(params: Parameters, thrust_N=(0.0, 0.0, 0.0), comm=MPI.COMM_WORLD
     helix up (SceneError, before any work); raises SagError if Newton finds no state."""
     q = params.normalised()
     load = top_load(params, thrust_N, tangent_thrust_N)
+    check_holds(params, load)  # before any work
     warm = solver is not None
     if solver is None:
         solver = LiftedStationarySolver(params, load, comm, scene=params.name)

