@@ -85,6 +85,9 @@ def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
     from rawehelix import section_laws
     from rawehelix.references import shooting
     law = params.value("section.law")
+    if params.lifter.active:
+        return ("lifter.top = 'lifted': the references hold the top end fixed (the lifted "
+                "top's check is the elastic catenary, tests/test_lifted.py)")
     if twisted:
         return ("the state is twisted by the ends' torque (torque.top_Nm), and the "
                 "references are torque-free, planar rods")
