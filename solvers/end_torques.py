@@ -1,0 +1,175 @@
+"""The end torques of a dynamic run as UFL expressions of the state, one per end
+component that puts a torque on an end (parameters/end_components.py::torques):
+
+* ``torque_ramp`` (Eq. 69) at the top: the constant c.mN that set_time sets;
+* ``controller`` (Eq. 40, integrated) at the ground: ts_forms.controller_torque;
+* ``rotor`` at the top: Q(alpha_t(1)) - J alpha_tt(1), the aerodynamic torque of its
+  table at the hub's wind and its spin inertia (forms/end_torques.py);
+* ``generator`` at the ground: tau(alpha_t(0)) (MPPT, constant or tabulated torque,
+  rated-power cap), or Eq. (40) where its law holds a speed (the paper's).
+
+:data:`TORQUE_FORMS` is the registry's UFL half: a component's name -> the builder of
+its torque.  :class:`EndTorques` sums the active ones at each end.  Without a rotor and
+a generator (their null objects) the formulation keeps the paper's forms untouched
+(:attr:`EndTorques.machine` is False), bit for bit.
+
+All normalised (Eqs. 25-29): torques by GJ / L0, spins by 1 / t_scale, powers by
+M g L0 / t_scale, energies by M g L0."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import ufl
+
+from rawehelix.forms import end_torques as forms
+from rawehelix.parameters import end_components
+
+
+@dataclass(frozen=True)
+class Machine:
+    """The rotor and the generator of a run, as numpy laws (operation/) and the hub's
+    wind: what :class:`EndTorques` normalises.  ``rotor`` or ``generator`` None: off."""
+
+    rotor: Any = None  # operation.rotor.RotorLaw: cp, tsr, radius_m, spin_inertia_kgm2, ...
+    generator: Any = None  # operation.generator.GeneratorLaw
+    wind_n_m_s: float = 0.0  # V_n, the wind along the rotor's axis at the hub [m/s]
+    air_density_kg_m3: float = 1.225
+
+    def __post_init__(self):
+        if self.rotor is not None and not (self.wind_n_m_s > 0 and math.isfinite(self.wind_n_m_s)):
+            raise ValueError(f"Machine: the hub's wind V_n = {self.wind_n_m_s!r} m/s must be > 0 "
+                             f"with a rotor")
+        if not self.air_density_kg_m3 > 0:
+            raise ValueError(f"Machine: air density {self.air_density_kg_m3!r} must be > 0")
+
+    @property
+    def active(self) -> bool:
+        return self.rotor is not None or self.generator is not None
+
+
+def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
+    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py)."""
+    law, v = machine.rotor, machine.wind_n_m_s
+    power = 0.5 * machine.air_density_kg_m3 * math.pi * law.radius_m**2 * v**3  # [W]
+    return forms.RotorTorque(cp_polynomial(law), power * q.t_scale / q.torque_scale,
+                             law.radius_m / (v * q.t_scale))
+
+
+def cp_polynomial(law) -> forms.PiecewisePolynomial:
+    """Cp(lambda) of a rotor law as the piecewise cubic that reproduces its interpolation
+    (operation/rotor.py: monotone cubic between its table's rows)."""
+    return forms.PiecewisePolynomial.fit(law.cp, law.table_tsr, 3)
+
+
+def rotor_inertia(machine: Machine, q) -> float:
+    """j = J L0 / (GJ t_scale^2): the rotor's spin inertia, normalised like -J alpha_tt
+    in the top's torque (Eq. 39)."""
+    return machine.rotor.spin_inertia_kgm2 / (q.torque_scale * q.t_scale**2)
+
+
+def generator_torque(machine: Machine, q) -> forms.GeneratorTorque:
+    """tau(omega~) of the machine's generator law (operation/generator.py: MPPT k Omega
+    |Omega|, a constant or tabulated torque held at its last row beyond it, the rated
+    cap), normalised."""
+    law = machine.generator
+    T, Mq = q.t_scale, q.torque_scale
+    rated = law.rated_power_W
+    table = None
+    if len(law.table_omega):  # its last row's torque beyond the table: one flat piece more
+        x, y = np.asarray(law.table_omega, float), np.asarray(law.table_torque, float)
+        x, y = np.append(x, x[-1] + max(1.0, x[-1])), np.append(y, y[-1])
+        table = forms.PiecewisePolynomial.linear(x, y).scaled(T, 1 / Mq)
+    return forms.GeneratorTorque(gain=law.k / (T**2 * Mq), constant=law.constant_Nm / Mq,
+                                 table=table, rated=None if rated is None else rated * T / Mq)
+
+
+@dataclass
+class EndTorques:
+    """The torques at s = 0 (``ground``) and s = 1 (``top``) of a formulation: built
+    once from the scene's active torque components (:data:`TORQUE_FORMS`)."""
+
+    machine: Machine = field(default_factory=Machine)
+    rotor: forms.RotorTorque | None = None
+    inertia: float = 0.0  # j, normalised
+    generator: forms.GeneratorTorque | None = None
+
+    @classmethod
+    def of(cls, params, q, machine: Machine) -> "EndTorques":
+        out = cls(machine)
+        for component in end_components.torques(params) + machine_components(machine):
+            TORQUE_FORMS[component.name].prepare(out, q)
+        return out
+
+    def driving(self, c, fields):
+        """The top's driving torque: the ramp's c.mN (Eq. 69) + the rotor's Q(alpha_t)."""
+        return c.mN if self.rotor is None else c.mN + self.rotor(fields.alpha_t)
+
+    def top(self, c, fields):
+        """The top's torque (Eq. 39): the driving torque - J alpha_tt (the rotor's inertia)."""
+        if self.rotor is None:
+            return self.driving(c, fields)
+        if fields.alpha_tt is None:
+            raise ValueError("EndTorques.top: the rotor's inertia needs the twist's acceleration")
+        return self.driving(c, fields) + forms.lumped_inertia(self.inertia, fields.alpha_tt)
+
+    def ground(self, fields, paper):
+        """The ground's torque (Eq. 38): the generator's law, or ``paper``, Eq. (40)'s
+        (ts_forms.controller_torque), where it holds a speed or there is none."""
+        return paper if self.generator is None else self.generator(fields.alpha_t)
+
+
+def machine_components(machine: Machine) -> tuple:
+    """The machine's end components (the rotor, the generator) that ``machine``
+    switches on but the scene's own registry entries do not (yet) list."""
+    return tuple(comp for name, on in (("rotor", machine.rotor), ("generator", machine.generator))
+                 if on is not None and (comp := _Component(name)))
+
+
+@dataclass(frozen=True)
+class _Component:
+    name: str
+
+
+class _Ramp:
+    @staticmethod
+    def prepare(out, q):  # c.mN, set by set_time (Eq. 69): nothing to prepare
+        pass
+
+
+class _Controller:
+    @staticmethod
+    def prepare(out, q):  # Eq. (40): EndTorques.ground's default
+        pass
+
+
+class _Rotor:
+    @staticmethod
+    def prepare(out, q):
+        out.rotor = rotor_torque(out.machine, q)
+        out.inertia = rotor_inertia(out.machine, q)
+
+
+class _Generator:
+    @staticmethod
+    def prepare(out, q):
+        out.generator = generator_torque(out.machine, q)
+
+
+#: the UFL half of the end components that load an end with a torque, by name
+TORQUE_FORMS = {"torque_ramp": _Ramp, "controller": _Controller, "rotor": _Rotor,
+                "generator": _Generator}
+
+
+def end_weights(mesh):
+    """(top, ground): UFL indicators of s = 1 and s = 0 on the end facets, which keep
+    each end's law off the other end (Q / alpha_t is singular at a ground at rest)."""
+    x = ufl.SpatialCoordinate(mesh)[0]
+    return ufl.gt(x, 0.5), ufl.lt(x, 0.5)
+
+
+__all__ = ["EndTorques", "Machine", "TORQUE_FORMS", "cp_polynomial", "end_weights",
+           "generator_torque", "rotor_inertia", "rotor_torque"]
