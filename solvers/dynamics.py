@@ -43,7 +43,7 @@ from rawehelix.parameters import Parameters
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
-from rawehelix.solvers.end_torques import EndTorques, Machine
+from rawehelix.solvers.end_torques import EndTorques, Machine, machine_of
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.probes import Probes
 from rawehelix.solvers.snes import (FloorConvergence, ReusedJacobian, SolverError, default_options,
@@ -102,7 +102,7 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         :meth:`from_stationary` passes the stationary solver's.
     machine
         The rotor at the top and the generator at the ground (solvers/end_torques.py);
-        default: none (the paper's ends).
+        default: the scene's (machine_of; none: the paper's ends).
     end_twist
         A prescribed end twist (the torsion test of Sec. 4): alpha(0) = 0 and
         alpha(1) = ``end_twist(t~)`` [rad, t~ normalised]; the end torques are
@@ -139,8 +139,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             if end_twist is not None and ts_type != "alpha2":
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
-            self.machine = machine if machine is not None else Machine()
-            ends = EndTorques.of(params, self.q, self.machine)
+            self.machine = machine if machine is not None else machine_of(params)
+            ends = EndTorques.of(self.q, self.machine)
             self.form = (SecondOrder(self.rod, bcs, ends) if ts_type == "alpha2"
                          else FirstOrder(self.rod, bcs, ends))
             if end_twist is not None:

@@ -6,12 +6,12 @@ component that puts a torque on an end (parameters/end_components.py::torques):
 * ``rotor`` at the top: Q(alpha_t(1)) - J alpha_tt(1), the aerodynamic torque of its
   table at the hub's wind and its spin inertia (forms/end_torques.py);
 * ``generator`` at the ground: tau(alpha_t(0)) (MPPT, constant or tabulated torque,
-  rated-power cap), or Eq. (40) where its law holds a speed (the paper's).
+  rated-power cap); off at ``law = "paper"``, which is the controller's Eq. (40).
 
-:data:`TORQUE_FORMS` is the registry's UFL half: a component's name -> the builder of
-its torque.  :class:`EndTorques` sums the active ones at each end.  Without a rotor and
-a generator (their null objects) the formulation keeps the paper's forms untouched
-(:attr:`EndTorques.machine` is False), bit for bit.
+:func:`machine_of` takes the active ones' numpy laws (operation/) through :data:`LAWS`,
+the registry's half here; :class:`EndTorques` makes their UFL torques.  Without a rotor
+and a generator (their null objects) the formulation keeps the paper's forms untouched
+(``Machine.active`` False), bit for bit.
 
 All normalised (Eqs. 25-29): torques by GJ / L0, spins by 1 / t_scale, powers by
 M g L0 / t_scale, energies by M g L0."""
@@ -26,6 +26,7 @@ import numpy as np
 import ufl
 
 from rawehelix.forms import end_torques as forms
+from rawehelix.operation import generator as generator_laws, rotor as rotor_laws, wind
 from rawehelix.parameters import end_components
 
 
@@ -89,8 +90,8 @@ def generator_torque(machine: Machine, q) -> forms.GeneratorTorque:
 
 @dataclass
 class EndTorques:
-    """The torques at s = 0 (``ground``) and s = 1 (``top``) of a formulation: built
-    once from the scene's active torque components (:data:`TORQUE_FORMS`)."""
+    """The machine's torques at s = 0 (``ground``) and s = 1 (``top``) of a
+    formulation, normalised (built once: :meth:`of`)."""
 
     machine: Machine = field(default_factory=Machine)
     rotor: forms.RotorTorque | None = None
@@ -98,10 +99,12 @@ class EndTorques:
     generator: forms.GeneratorTorque | None = None
 
     @classmethod
-    def of(cls, params, q, machine: Machine) -> "EndTorques":
+    def of(cls, q, machine: Machine) -> "EndTorques":
         out = cls(machine)
-        for component in end_components.torques(params) + machine_components(machine):
-            TORQUE_FORMS[component.name].prepare(out, q)
+        if machine.rotor is not None:
+            out.rotor, out.inertia = rotor_torque(machine, q), rotor_inertia(machine, q)
+        if machine.generator is not None:
+            out.generator = generator_torque(machine, q)
         return out
 
     def driving(self, c, fields):
@@ -112,8 +115,6 @@ class EndTorques:
         """The top's torque (Eq. 39): the driving torque - J alpha_tt (the rotor's inertia)."""
         if self.rotor is None:
             return self.driving(c, fields)
-        if fields.alpha_tt is None:
-            raise ValueError("EndTorques.top: the rotor's inertia needs the twist's acceleration")
         return self.driving(c, fields) + forms.lumped_inertia(self.inertia, fields.alpha_tt)
 
     def ground(self, fields, paper):
@@ -122,46 +123,34 @@ class EndTorques:
         return paper if self.generator is None else self.generator(fields.alpha_t)
 
 
-def machine_components(machine: Machine) -> tuple:
-    """The machine's end components (the rotor, the generator) that ``machine``
-    switches on but the scene's own registry entries do not (yet) list."""
-    return tuple(comp for name, on in (("rotor", machine.rotor), ("generator", machine.generator))
-                 if on is not None and (comp := _Component(name)))
+def machine_of(params) -> Machine:
+    """The scene's machine: the laws (operation/) of its active end components that
+    put a torque on an end (parameters/end_components.py::torques, through
+    :data:`LAWS`), the wind at the hub along the rotor's axis (the chord's direction for
+    ``axis = "tangent"``, the fixed top's) and the air's density."""
+    laws = {}
+    for component in end_components.torques(params):
+        laws.update(LAWS[component.name](params))
+    rotor = laws.get("rotor")
+    if rotor is None:
+        return Machine(generator=laws.get("generator"))
+    top = params.normalised().top_position(0.0)
+    v_n = float(rotor.normal_speed(wind.from_params(params).hub_speed, top / np.linalg.norm(top)))
+    return Machine(rotor, laws.get("generator"), v_n, wind.air_density(params))
 
 
-@dataclass(frozen=True)
-class _Component:
-    name: str
+def _rotor_law(params) -> dict:
+    return {"rotor": rotor_laws.from_params(params)}
 
 
-class _Ramp:
-    @staticmethod
-    def prepare(out, q):  # c.mN, set by set_time (Eq. 69): nothing to prepare
-        pass
+def _generator_law(params) -> dict:
+    return {"generator": generator_laws.from_params(params)}
 
 
-class _Controller:
-    @staticmethod
-    def prepare(out, q):  # Eq. (40): EndTorques.ground's default
-        pass
-
-
-class _Rotor:
-    @staticmethod
-    def prepare(out, q):
-        out.rotor = rotor_torque(out.machine, q)
-        out.inertia = rotor_inertia(out.machine, q)
-
-
-class _Generator:
-    @staticmethod
-    def prepare(out, q):
-        out.generator = generator_torque(out.machine, q)
-
-
-#: the UFL half of the end components that load an end with a torque, by name
-TORQUE_FORMS = {"torque_ramp": _Ramp, "controller": _Controller, "rotor": _Rotor,
-                "generator": _Generator}
+#: the laws of the end components that load an end with a torque, by the registry's
+#: name: the ramp (Eq. 69, c.mN) and the controller (Eq. 40) are the forms' own
+LAWS = {"torque_ramp": lambda p: {}, "controller": lambda p: {}, "rotor": _rotor_law,
+        "generator": _generator_law}
 
 
 def end_weights(mesh):
@@ -171,5 +160,5 @@ def end_weights(mesh):
     return ufl.gt(x, 0.5), ufl.lt(x, 0.5)
 
 
-__all__ = ["EndTorques", "Machine", "TORQUE_FORMS", "cp_polynomial", "end_weights",
-           "generator_torque", "rotor_inertia", "rotor_torque"]
+__all__ = ["EndTorques", "LAWS", "Machine", "cp_polynomial", "end_weights", "generator_torque",
+           "machine_of", "rotor_inertia", "rotor_torque"]
