@@ -140,9 +140,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
             self.machine = machine if machine is not None else machine_of(params)
-            ends = EndTorques.of(self.q, self.machine)
-            self.form = (SecondOrder(self.rod, bcs, ends) if ts_type == "alpha2"
-                         else FirstOrder(self.rod, bcs, ends))
+            ends = EndTorques.of(self.q, self.machine)  # the rotor's and generator's (issue 43)
+            self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
             if end_twist is not None:
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
@@ -183,10 +182,11 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         stationary = StationarySolver(params, comm, scene=scene)
         stationary.set_end_torques(ground=torque, top=torque)
         state = stationary.solve().state
-        state.w_t = np.zeros_like(state.w)
-        state.w_t[stationary.rod.dofs("twist")] = spin  # alpha = spin t + phi(s)
+        state.w_t = np.zeros_like(state.w)  # alpha = spin t + phi(s):
+        state.w_t[stationary.rod.dofs("twist")] = spin
         solver = cls(params, comm, options, rod=stationary.rod, machine=machine)
-        solver.set_state(state)
+        solver.set_state(state)  # Eq. (40)'s C: its ground torque balances the top's
+        solver.form.offset.value += torque
         return solver
 
     def residual_floor(self) -> float:

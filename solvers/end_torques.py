@@ -39,6 +39,7 @@ class Machine:
     generator: Any = None  # operation.generator.GeneratorLaw
     wind_n_m_s: float = 0.0  # V_n, the wind along the rotor's axis at the hub [m/s]
     air_density_kg_m3: float = 1.225
+    wind_hub_m_s: float = 0.0  # V, the wind's speed at the hub [m/s]
 
     def __post_init__(self):
         if self.rotor is not None and not (self.wind_n_m_s > 0 and math.isfinite(self.wind_n_m_s)):
@@ -50,6 +51,13 @@ class Machine:
     @property
     def active(self) -> bool:
         return self.rotor is not None or self.generator is not None
+
+    def thrust_N(self, omega_rad_s: float) -> float:
+        """The rotor's thrust at Omega [N] (0 without a rotor); its tip-speed ratio out of
+        the table raises operation.rotor.OutOfTable, naming the wind and rotor speeds."""
+        if self.rotor is None:
+            return 0.0
+        return float(self.rotor.thrust(omega_rad_s, self.wind_n_m_s, self.air_density_kg_m3))
 
 
 def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
@@ -135,8 +143,9 @@ def machine_of(params) -> Machine:
     if rotor is None:
         return Machine(generator=laws.get("generator"))
     top = params.normalised().top_position(0.0)
-    v_n = float(rotor.normal_speed(wind.from_params(params).hub_speed, top / np.linalg.norm(top)))
-    return Machine(rotor, laws.get("generator"), v_n, wind.air_density(params))
+    v_hub = wind.from_params(params).hub_speed
+    v_n = float(rotor.normal_speed(v_hub, top / np.linalg.norm(top)))
+    return Machine(rotor, laws.get("generator"), v_n, wind.air_density(params), v_hub)
 
 
 def _rotor_law(params) -> dict:

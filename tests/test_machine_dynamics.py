@@ -190,3 +190,35 @@ def test_first_order_form_carries_the_rotor_inertia():
     assert acc1.summary(first.q)["balance_of_work_in"] < 1e-4
     s1, s2 = (s.probes.values()["spin1"] for s in (first, second))
     assert abs(s1 - s2) < 1e-5 * abs(s2)
+
+
+def test_simulate_with_the_rotor_example_keeps_its_operating_point(tmp_path):
+    """`simulate rotor_example` (N = 4, 1 s): it starts at the rigid-shaft point of
+    operation/rigid_shaft.py (120.0005 rpm, 25.0002 N m at 6.6131 m/s) and keeps it
+    (rotor_rpm to 1e-6), writes the machine's columns (power_W = tau Omega at the ground,
+    thrust_N the law's at that speed, the hub's wind), and its summary's energy block
+    closes to 1e-4 of the work in (measured 2e-9: it is at rest in the rotating sense).
+    The paper's scene keeps its 8 columns and has no energy block."""
+    from rawehelix.operation.rigid_shaft import operating_points
+    from rawehelix.studies import simulate
+    p = scene.load("rotor_example", elements=4)
+    series = simulate.compute(p, until_s=1.0, progress=False)
+    m = end_torques.machine_of(p)
+    (point,) = operating_points(m.rotor, m.generator, m.wind_n_m_s, m.air_density_kg_m3)
+    out = series.write(tmp_path, pictures=False)
+    header = (out / "time_series.csv").read_text().splitlines()[0].split(",")
+    assert header[-4:] == ["rotor_rpm", "power_W", "thrust_N", "wind_hub_m_s"]
+    rows = series.rows
+    assert np.abs(rows[:, 8] / point.rotor_rpm - 1).max() < 1e-6
+    omega0 = rows[:, 1] * 2 * math.pi / 60
+    assert np.allclose(rows[:, 9], rows[:, 4] * omega0, rtol=1e-12)
+    assert rows[-1, 9] == pytest.approx(point.power_W, rel=1e-6)
+    assert rows[-1, 10] == pytest.approx(point.thrust_N, rel=1e-9)
+    assert np.all(rows[:, 11] == 6.6131)
+    energy = series.summary["energy"]
+    assert energy["work_in_J"] == pytest.approx(point.rotor_power_W * 1.0, rel=1e-5)
+    assert energy["balance_of_work_in"] < 1e-4
+    assert "energy: work in" in simulate.report(series)
+    paper = simulate.compute(scene.load("nominal_operation", elements=2), until_s=0.02,
+                             progress=False)
+    assert paper.rows.shape[1] == len(simulate.COLUMNS) and "energy" not in paper.summary
