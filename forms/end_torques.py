@@ -90,9 +90,23 @@ class RotorTorque:
     cp: PiecewisePolynomial  # Cp(lambda)
     power_n: Any
     lam_per_omega: Any
+    given_in_time = False  # a law of the spin: Eq. (40)'s feedforward cannot know it
 
-    def __call__(self, omega):
+    def __call__(self, omega, time=None):
         return self.power_n * self.cp(self.lam_per_omega * omega) / omega  # Q = P / Omega
+
+
+@dataclass(frozen=True)
+class RampTorque:
+    """A rotor whose torque is prescribed in time: the paper's ramp (69),
+    m_N0 (1 - exp(-t / t0)), whatever its spin (normalised; t0 > 0)."""
+
+    mN0: float
+    t0: float
+    given_in_time = True  # the paper's m_N(t): Eq. (40) feeds it forward
+
+    def __call__(self, omega, time):
+        return self.mN0 * (1 - ufl.exp(-time / self.t0))  # (69)
 
 
 @dataclass(frozen=True)

@@ -115,15 +115,23 @@ class EndTorques:
             out.generator = generator_torque(machine, q)
         return out
 
-    def driving(self, c, fields):
-        """The top's driving torque: the ramp's c.mN (Eq. 69) + the rotor's Q(alpha_t)."""
-        return c.mN if self.rotor is None else c.mN + self.rotor(fields.alpha_t)
+    def driving(self, c, fields, time):
+        """The top's driving torque: the ramp's c.mN (Eq. 69) + the rotor's Q(alpha_t)
+        (a law of the spin; forms.RampTorque: of the time)."""
+        return c.mN if self.rotor is None else c.mN + self.rotor(fields.alpha_t, time)
 
-    def top(self, c, fields):
+    def given(self, c, fields, time):
+        """The part of the top's torque that is a given function of time, m_N(t) of the
+        paper (the ramp, and a rotor's law of time): what Eq. (40) feeds forward."""
+        if self.rotor is None or not self.rotor.given_in_time:
+            return c.mN
+        return self.driving(c, fields, time)
+
+    def top(self, c, fields, time):
         """The top's torque (Eq. 39): the driving torque - J alpha_tt (the rotor's inertia)."""
         if self.rotor is None:
-            return self.driving(c, fields)
-        return self.driving(c, fields) + forms.lumped_inertia(self.inertia, fields.alpha_tt)
+            return self.driving(c, fields, time)
+        return self.driving(c, fields, time) + forms.lumped_inertia(self.inertia, fields.alpha_tt)
 
     def ground(self, fields, paper):
         """The ground's torque (Eq. 38): the generator's law, or ``paper``, Eq. (40)'s

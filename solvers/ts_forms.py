@@ -122,11 +122,12 @@ class _Formulation:
             return dataclasses.replace(c, m0=self.m0)
         ends = self.end_torques
         top, ground = end_weights(self.rod.mesh)  # each end's law on its own end only
-        paper = controller_torque(c, self.rod.q, fields, self.time, self.offset)  # (40)
+        given = dataclasses.replace(c, mN=ends.given(c, fields, self.time))  # m_N(t) of (40)
+        paper = controller_torque(given, self.rod.q, fields, self.time, self.offset)  # (40)
         self.m0 = ufl.conditional(ground, ends.ground(fields, paper), 0.0)
-        self.mN = ufl.conditional(top, ends.top(c, fields), 0.0)
+        self.mN = ufl.conditional(top, ends.top(c, fields, self.time), 0.0)
         # the top's work in: the torques but the rotor's inertia (its kinetic energy)
-        self.m_in = ufl.conditional(top, ends.driving(c, fields), 0.0)
+        self.m_in = ufl.conditional(top, ends.driving(c, fields, self.time), 0.0)
         return dataclasses.replace(c, m0=self.m0, mN=self.mN)
 
     def _compile(self, F, J, fields: Fields, c_dyn):

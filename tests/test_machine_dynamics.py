@@ -222,3 +222,38 @@ def test_simulate_with_the_rotor_example_keeps_its_operating_point(tmp_path):
     paper = simulate.compute(scene.load("nominal_operation", elements=2), until_s=0.02,
                              progress=False)
     assert paper.rows.shape[1] == len(simulate.COLUMNS) and "energy" not in paper.summary
+
+
+def test_a_rotor_whose_torque_is_the_papers_ramp_reproduces_nominal_operation(monkeypatch):
+    """nominal_operation (N = 4, 3 s: the ramp (69) to 69 % of its 25 N m under the
+    controller (40)) against the same scene with torque.top_Nm = 0 and a rotor whose
+    torque is the ramp in time (forms.RampTorque, no inertia) on the machine's path
+    (the ends' laws behind their end indicators, Eq. 40 as the ground's law): spins,
+    ground torque and tension agree to 1e-10 of their size at every 0.1 s (fixed 10 ms
+    steps: an adaptive step that flips on round-off would part them by its time error;
+    measured 5e-13)."""
+    p = scene.load("nominal_operation", elements=4, degree=3).replace(time={"dt_s": 0.01})
+    q = p.normalised()
+    fixed = {"ts_adapt_type": "none"}
+
+    def series(params, machine=None):
+        sv = DynamicsSolver.from_stationary(params, options=fixed) if machine is None else \
+            DynamicsSolver(params, options=fixed, machine=machine)
+        if machine is not None:
+            sv.set_state(StationarySolver(params).solve().state)
+        rows = []
+        sv.advance(3.0 / q.t_scale, output_every=0.1 / q.t_scale, on_output=lambda s: rows.append(
+            [s.probes.values()[k] for k in ("spin0", "spin1", "m0", "tension0")]))
+        return np.array(rows), sv
+
+    paper, _ = series(p)
+    ramp = forms.RampTorque(q.mN0, q.t0)
+    monkeypatch.setattr(end_torques.EndTorques, "of",
+                        classmethod(lambda cls, q_, m: cls(m, rotor=ramp)))
+    machine = end_torques.Machine(rotor="the paper's ramp", wind_n_m_s=1.0)
+    rotor_run, solver = series(p.replace(torque={"top_Nm": 0.0}), machine)
+    assert solver.form.end_torques is not None  # the machine's path, not the paper's
+    assert len(paper) == 31 and paper[-1, 2] > 15 / q.torque_scale
+    scale = np.abs(paper).max(axis=0)
+    print(f"\nramp rotor against nominal_operation: {np.abs(rotor_run - paper).max(axis=0) / scale}")
+    assert np.all(np.abs(rotor_run - paper) <= 1e-10 * scale)
