@@ -28,8 +28,9 @@ class EnergyAccount:
         self.stored0 = self.stored = None
 
     def __call__(self, solver):
-        e = solver.energy()  # collective
         t = solver.t
+        solver.form.set_time(t)  # the step's own time: alpha2 leaves t_{n + alpha_f} set
+        e = solver.energy()  # collective
         powers = {k: e[k] for k in POWERS}
         stored = e["kinetic"] + e["potential"] + e["rotor_kinetic"]
         if self._last is None:

@@ -8,6 +8,7 @@ settles back to after a gust.  Its time series gains :data:`COLUMNS`, its summar
 
 from __future__ import annotations
 
+from rawehelix.operation import generator
 from rawehelix.operation.rigid_shaft import operating_points
 from rawehelix.operation.rotor import OutOfTable
 from rawehelix.solvers.end_torques import Machine, machine_of
@@ -25,9 +26,11 @@ def of(params) -> Machine:
 
 
 def start_point(params, machine: Machine):
-    """The rigid-shaft operating point the run starts at: the stable one of the fastest
-    rotor; SceneError (exit 2) when the wind has none, naming the keys to change."""
-    points = [p for p in operating_points(machine.rotor, machine.generator, machine.wind_n_m_s,
+    """The rigid-shaft operating point the run starts at, against the scene's ground law
+    (the paper's Eq. 40 holds its target spin): the stable one of the fastest rotor;
+    SceneError (exit 2) when the wind has none, naming the keys to change."""
+    ground = generator.from_params(params)  # every law, the paper's too (None: no torque)
+    points = [p for p in operating_points(machine.rotor, ground, machine.wind_n_m_s,
                                           machine.air_density_kg_m3) if p.stable]
     if not points:
         raise SceneError(params.name, "wind.speed_m_s",
