@@ -227,6 +227,8 @@ def test_simulate_with_the_rotor_example_keeps_its_operating_point(tmp_path):
     assert energy["work_in_J"] == pytest.approx(point.rotor_power_W * 1.0, rel=1e-5)
     assert energy["balance_of_work_in"] < 1e-4
     assert "energy: work in" in simulate.report(series)
+    from test_docs import undocumented  # docs/reference/summary.md has every new field
+    assert undocumented(series.summary) == []
     paper = simulate.compute(scene.load("nominal_operation", elements=2), until_s=0.02,
                              progress=False)
     assert paper.rows.shape[1] == len(simulate.COLUMNS) and "energy" not in paper.summary
