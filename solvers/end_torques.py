@@ -148,10 +148,10 @@ def machine_of(params) -> Machine:
     for component in end_components.torques(params):
         laws.update(LAWS[component.name](params))
     rotor = laws.get("rotor")
-    if rotor is None:
-        return Machine(generator=laws.get("generator"))
-    top = params.normalised().top_position(0.0)
     v_hub = wind.from_params(params).hub_speed
+    if rotor is None:
+        return Machine(generator=laws.get("generator"), wind_hub_m_s=v_hub)
+    top = params.normalised().top_position(0.0)
     v_n = float(rotor.normal_speed(v_hub, top / np.linalg.norm(top)))
     return Machine(rotor, laws.get("generator"), v_n, wind.air_density(params), v_hub)
 
