@@ -57,6 +57,9 @@ class EndComponent:
     off: str  # its null object, as a scene spells it ("" : none, always on)
     active: Callable  # params -> bool: False at its null object
     check: Callable = lambda p: None  # params -> None: ParameterError for what it cannot run with
+    # (values, the scene's folder) -> its section, for a section that reads files beside
+    # the scene (a table); None: SECTION(**values)
+    read: Callable | None = None
 
     def __post_init__(self):
         if self.end not in ENDS or self.load not in LOADS:
@@ -75,13 +78,15 @@ END_COMPONENTS = (
     EndComponent("controller", "controller", Controller, "ground", "torque", "Eq. (40)",
                  "controller off", lambda p: p.controller.active),
     # issue 43: the machine in operation (operation/ has their laws)
-    EndComponent("rotor", "rotor", Rotor, "top", "torque", "issue 43: Q = 1/2 rho pi R^2 V^3 Cp / Omega",
-                 "no rotor.table", lambda p: p.rotor.active, rotor.check),
+    EndComponent("rotor", "rotor", Rotor, "top", "torque",
+                 "Q = 1/2 rho pi R^2 V_n^3 Cp / Omega (its table)", "no rotor.table",
+                 lambda p: p.rotor.active, rotor.check, Rotor.from_scene),
     EndComponent("generator", "generator", Generator, "ground", "torque",
-                 "issue 43: mppt k Omega^2, a torque table", "generator.law = 'paper'",
-                 lambda p: p.generator.active, generator.check),
-    EndComponent("lifter", "lifter", Lifter, "top", "force", "issue 43: the lifted top end",
-                 "lifter.top = 'fixed'", lambda p: p.lifter.active, lifter.check),
+                 "mppt k Omega^2, a torque table, or Eq. (40)", "generator.law = 'paper'",
+                 lambda p: p.generator.active, generator.check, Generator.from_scene),
+    EndComponent("lifter", "lifter", Lifter, "top", "force",
+                 "the lifted top end's balance of forces", "lifter.top = 'fixed'",
+                 lambda p: p.lifter.active, lifter.check),
 )
 #: every end component by name
 REGISTRY = {c.name: c for c in END_COMPONENTS}
@@ -106,6 +111,12 @@ def scene_sections() -> dict:
     return {c.KEY: c.SECTION for c in END_COMPONENTS}
 
 
+def scene_readers() -> dict:
+    """``[KEY]`` -> how the scene loader builds a section that reads files beside the
+    scene (studies/scene.py): ``read(values, folder)``."""
+    return {c.KEY: c.read for c in END_COMPONENTS if c.read is not None}
+
+
 def active(params) -> tuple[EndComponent, ...]:
     """The end components ``params`` switches on."""
     return tuple(c for c in END_COMPONENTS if c.active(params))
@@ -122,4 +133,4 @@ def torque_free() -> str:
 
 
 __all__ = ["END_COMPONENTS", "ENDS", "EndComponent", "LOADS", "REGISTRY", "active", "check",
-           "get", "scene_sections", "torque_free", "torques"]
+           "get", "scene_readers", "scene_sections", "torque_free", "torques"]
