@@ -58,25 +58,28 @@ def solver(params, machine: Machine, comm, options):
                 "wind_n_m_s": machine.wind_n_m_s, "tsr": point.tsr}
 
 
-def row(machine: Machine, spin0_rpm: float, spin1_rpm: float, ground_torque_Nm: float) -> tuple:
+def row(machine: Machine, t_s: float, spin0_rpm: float, spin1_rpm: float,
+        ground_torque_Nm: float) -> tuple:
     """The :data:`COLUMNS` at an output time (SI)."""
     return (spin1_rpm, ground_torque_Nm * spin0_rpm * RAD_S_PER_RPM,
-            machine.thrust_N(spin1_rpm * RAD_S_PER_RPM), machine.wind_hub_m_s)
+            thrust(machine, spin1_rpm * RAD_S_PER_RPM, t_s), machine.wind_hub_m_s)
+
+
+def thrust(machine: Machine, omega_rad_s: float, t_s: float) -> float:
+    """The rotor's thrust [N] at Omega; its tip-speed ratio out of the table (never a
+    silent extrapolation) is SolverError naming the wind and rotor speeds (exit 1)."""
+    try:
+        return machine.thrust_N(omega_rad_s)
+    except OutOfTable as err:
+        raise SolverError(f"{err}; the run stopped at t = {t_s:.4g} s (simulated), its series "
+                          f"kept up to there") from None
 
 
 def check_step(machine: Machine, solver) -> None:
-    """After each step: the rotor's tip-speed ratio inside its table (never a silent
-    extrapolation), else SolverError naming the wind and rotor speeds (exit 1)."""
-    if machine.rotor is None:
-        return
-    q = solver.q
-    omega = float(solver.probes.value("spin1")) / q.t_scale  # [rad/s]
-    try:
-        machine.thrust_N(omega)
-    except OutOfTable as err:
-        raise SolverError(f"{err}; the run stopped at t = {q.time_s(solver.t):.4g} s. Try a "
-                          f"rotor table over a wider tip-speed range, or a generator law that "
-                          f"holds the rotor inside it") from None
+    """After each step: the rotor's tip-speed ratio inside its table (:func:`thrust`)."""
+    if machine.rotor is not None:
+        q = solver.q
+        thrust(machine, float(solver.probes.value("spin1")) / q.t_scale, float(q.time_s(solver.t)))
 
 
-__all__ = ["COLUMNS", "check_step", "of", "row", "solver", "start_point"]
+__all__ = ["COLUMNS", "check_step", "of", "row", "solver", "start_point", "thrust"]

@@ -193,7 +193,7 @@ class _Recorder:
                float(q.torque_Nm(v["m0"])), float(q.tension_N(v["tension0"])),
                float(q.tension_N(v["tension1"])), float(q.length_m(lateral)))
         if self.machine is not None:
-            row += machine.row(self.machine, row[1], row[3], row[4])
+            row += machine.row(self.machine, row[0], row[1], row[3], row[4])
         self.rows.append(row)
         k = len(self.rows) - 1
         if k % self.limits_every == 0:

@@ -286,3 +286,24 @@ def test_simulate_with_the_papers_ground_law_holds_its_target():
     assert np.abs(series.rows[:, [1, 3, 8]] / 110 - 1).max() < 1e-6
     assert np.abs(series.rows[:, 4] / torque - 1).max() < 1e-6
     assert series.summary["energy"]["balance_of_work_in"] < 1e-4
+
+
+def test_a_rotor_leaving_its_table_stops_the_run(monkeypatch):
+    """rotor_example started at tip-speed ratio 9, past its table's 8 (the start point
+    forced there): the first step stops the run with SimulationError naming the wind and
+    the rotor speed (the command line's exit 1, the partial series kept), never a silent
+    extrapolation of Cp."""
+    import dataclasses
+
+    from rawehelix.operation.rigid_shaft import operating_points
+    from rawehelix.studies import machine, simulate
+    p = scene.load("rotor_example", elements=2)
+    m = end_torques.machine_of(p)
+    (point,) = operating_points(m.rotor, m.generator, m.wind_n_m_s, m.air_density_kg_m3)
+    fast = dataclasses.replace(point, omega_rad_s=9.0 * m.wind_n_m_s / m.rotor.radius_m)
+    monkeypatch.setattr(machine, "start_point", lambda params, ends: fast)
+    with pytest.raises(simulate.SimulationError, match=r"tip-speed ratio 9 at wind 4\.676 m/s "
+                       r"and rotor speed 200\.9 rpm") as err:
+        simulate.compute(p, until_s=0.5, progress=False)
+    assert "the run stopped at t = 0 s" in str(err.value)
+    assert err.value.partial.summary["complete"] is False
