@@ -105,6 +105,10 @@ class RampTorque:
     t0: float
     given_in_time = True  # the paper's m_N(t): Eq. (40) feeds it forward
 
+    def __post_init__(self):
+        if not self.t0 > 0:
+            raise ValueError(f"RampTorque: the rise time t0 = {self.t0!r} must be > 0")
+
     def __call__(self, omega, time):
         return self.mN0 * (1 - ufl.exp(-time / self.t0))  # (69)
 
@@ -119,6 +123,10 @@ class GeneratorTorque:
     constant: float = 0.0
     table: PiecewisePolynomial | None = None  # torque against omega
     rated: float | None = None
+
+    def __post_init__(self):
+        if self.rated is not None and not self.rated > 0:
+            raise ValueError(f"GeneratorTorque: the rated power {self.rated!r} must be > 0")
 
     def __call__(self, omega):
         tau = self.gain * omega * abs(omega) + self.constant
