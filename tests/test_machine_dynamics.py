@@ -307,3 +307,30 @@ def test_a_rotor_leaving_its_table_stops_the_run(monkeypatch):
         simulate.compute(p, until_s=0.5, progress=False)
     assert "the run stopped at t = 0 s" in str(err.value)
     assert err.value.partial.summary["complete"] is False
+
+
+def test_a_stiff_helix_spins_down_like_the_rigid_shaft():
+    """rotor_example with GJ x 1000 (a rigid shaft), started 1e-4 fast at its operating
+    point, fixed 5 ms steps for 1 s: the top's spin excess decays as exp(s t) with the
+    rigid shaft's rate s = d(Q - tau)/dOmega / (J + 2 M EI / EA) (operation/rigid_shaft's
+    slope; the rotor's J = 1.2 kg m^2 and the rod's own spin inertia 0.36 kg m^2, Eq. 27's
+    rotational inertia): fitted to 1e-3 (measured 1e-4; without the rotor's inertia the
+    rate would be 4.3 x).  It checks J's place and scale in the top's torque."""
+    from rawehelix.operation.rigid_shaft import operating_points
+    p = scene.load("rotor_example", elements=4).replace(helix={"GJ_Nm2": 1.4e5},
+                                                         time={"dt_s": 0.005})
+    m = end_torques.machine_of(p)
+    (point,) = operating_points(m.rotor, m.generator, m.wind_n_m_s, m.air_density_kg_m3)
+    q = p.normalised()
+    solver = DynamicsSolver.spinning(p, m, point.omega_rad_s * (1 + 1e-4) * q.t_scale,
+                                     point.rotor_torque_Nm / q.torque_scale,
+                                     options={"ts_adapt_type": "none"})
+    rows = []
+    solver.advance(1.0 / q.t_scale, output_every=0.1 / q.t_scale, on_output=lambda s: rows.append(
+        (q.time_s(s.t), s.probes.values()["spin1"] / q.t_scale / point.omega_rad_s - 1)))
+    t, excess = np.array(rows).T
+    inertia = m.rotor.spin_inertia_kgm2 + 2 * p.helix.mass_kg * p.helix.EI_Nm2 / p.helix.EA_N
+    rate = point.slope_Nms / inertia  # [1/s]
+    fitted = np.polyfit(t, np.log(excess), 1)[0]
+    print(f"\nrigid shaft: rate {rate:.6f} 1/s, fitted {fitted:.6f} 1/s")
+    assert fitted == pytest.approx(rate, rel=1e-3)
