@@ -10,14 +10,13 @@ from __future__ import annotations
 
 from rawehelix.operation import generator
 from rawehelix.operation.rigid_shaft import operating_points
-from rawehelix.operation.rotor import OutOfTable
+from rawehelix.operation.rotor import RPM, OutOfTable  # RPM: rad/s per rpm
 from rawehelix.solvers.end_torques import Machine, machine_of
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies.scene import SceneError
 
 #: the machine's columns of time_series.csv, after the helix's
 COLUMNS = ("rotor_rpm", "power_W", "thrust_N", "wind_hub_m_s")
-RAD_S_PER_RPM = 2.0 * 3.141592653589793 / 60.0
 
 
 def of(params) -> Machine:
@@ -61,8 +60,8 @@ def solver(params, machine: Machine, comm, options):
 def row(machine: Machine, t_s: float, spin0_rpm: float, spin1_rpm: float,
         ground_torque_Nm: float) -> tuple:
     """The :data:`COLUMNS` at an output time (SI)."""
-    return (spin1_rpm, ground_torque_Nm * spin0_rpm * RAD_S_PER_RPM,
-            thrust(machine, spin1_rpm * RAD_S_PER_RPM, t_s), machine.wind_hub_m_s)
+    return (spin1_rpm, ground_torque_Nm * spin0_rpm * RPM,
+            thrust(machine, spin1_rpm * RPM, t_s), machine.wind_hub_m_s)
 
 
 def thrust(machine: Machine, omega_rad_s: float, t_s: float) -> float:
