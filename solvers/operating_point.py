@@ -10,7 +10,8 @@ generator's torque).  Omega is the unknown that closes the torque balance
 (solvers/rigid_shaft_branch.py): without the helix's distributed loss the twist moment
 is constant along s, so Omega solves the rigid-shaft equation Q(Omega, V_n) = tau_gen
 (Omega) + L(Omega) exactly, and the rod enters only through V_n, the wind along the
-rotor's axis: ``axis = "tangent"`` reads it off the solved state's top tangent.
+rotor's axis (operation/rotor.py ``normal_speed``): ``rotor.axis = "tangent"`` reads it
+off the solved state's top tangent.
 
 How it is solved: a fixed point on the axis factor a = V_n / V_hub, around the SNES
 stationary solve (as solvers/tension_target.py wraps it around its secant):
@@ -38,31 +39,14 @@ from rawehelix.solvers.rigid_shaft_branch import Drive, stable
 MAX_SOLVES = 3
 #: the axis factor a = V_n / V_hub is converged to this
 AXIS_TOL = 1e-10
-#: the wind's direction in the rod's frame: -i_E (Eq. 14)
-WIND_DIRECTION = np.array([-1.0, 0.0, 0.0])
-
-
-def along_tangent(tangent: np.ndarray) -> float:
-    """The rotor's axis is the helix's end tangent: V_n = V_hub |t . e_wind|."""
-    return float(abs(np.dot(tangent, WIND_DIRECTION)) / np.linalg.norm(tangent))
-
-
-def facing_wind(tangent: np.ndarray) -> float:
-    """The rotor faces the wind: V_n = V_hub."""
-    return 1.0
-
-
-#: the rotor's axis by the scene's rotor.axis: the share of the hub's wind along it
-AXES = {"tangent": along_tangent, "wind": facing_wind}
-
-
 def top_tangent(s: np.ndarray, centre_line: np.ndarray, degree: int) -> np.ndarray:
-    """r'(1) of the FE centre line: the derivative at s = 1 of the degree-p polynomial
-    through the last cell's p + 1 Lagrange nodes (exact for the FE field)."""
+    """The unit tangent at s = 1 of the FE centre line: the derivative there of the
+    degree-p polynomial through the last cell's p + 1 Lagrange nodes (exact for the FE
+    field)."""
     order = np.argsort(s)
     s, x = np.asarray(s)[order][-(degree + 1):], np.asarray(centre_line)[order][-(degree + 1):]
-    return np.array([np.polyval(np.polyder(np.polyfit(s, x[:, k], degree)), 1.0)
-                     for k in range(3)])
+    t = np.array([np.polyval(np.polyder(np.polyfit(s, x[:, k], degree)), 1.0) for k in range(3)])
+    return t / np.linalg.norm(t)
 
 
 @dataclasses.dataclass
@@ -100,18 +84,22 @@ class OperatingPoint:
 class OperatingPointSolver:
     """The relative equilibrium at a wind speed (module docstring).  ``scene_at(V)``:
     the scene at the wind V [m/s] (the helix's drag, Eq. 14); ``hub_speed(V)``: the
-    rotor's wind [m/s]; ``axis``: an entry of :data:`AXES`; ``limits(params, solver)``:
-    the limits block of a solved state (None: not wanted).  Builds nothing until
-    :meth:`solve`."""
+    rotor's wind [m/s]; ``limits(params, solver)``: the limits block of a solved state
+    (None: not wanted).  Builds nothing until :meth:`solve`."""
 
-    def __init__(self, scene_at, drive: Drive, axis, hub_speed, comm, limits=None):
-        self.scene_at, self.drive, self.axis, self.hub_speed = scene_at, drive, axis, hub_speed
+    def __init__(self, scene_at, drive: Drive, hub_speed, comm, limits=None):
+        self.scene_at, self.drive, self.hub_speed = scene_at, drive, hub_speed
         self.comm, self.limits = comm, limits
         self.a = None  # the last point's axis factor
 
+    def axis(self, tangent) -> float:
+        """a = V_n / V_hub for the unit top tangent (the rotor's ``normal_speed``)."""
+        return float(self.drive.rotor.normal_speed(1.0, tangent))
+
     def first_axis_factor(self, params) -> float:
         """a of the chord (Eq. 66): the first guess at the first point."""
-        return self.axis(params.normalised().top_position())
+        chord = params.normalised().top_position()
+        return self.axis(chord / np.linalg.norm(chord))
 
     def solve(self, V: float, root) -> OperatingPoint:
         """The operating point at the wind V [m/s] on the branch whose root of the balance
@@ -142,7 +130,7 @@ class OperatingPointSolver:
         twist = solver.end_twist()  # collective
         block = self.limits(params, solver) if self.limits else None  # collective
         loss = self.drive.loss_Nm(omega)
-        slope = self.drive.slope_Nm_s(omega, v_n) if self.drive.held_speed() is None else -np.inf
+        slope = self.drive.slope_Nm_s(omega, v_n)
         out = OperatingPoint(
             wind_m_s=float(V), hub_wind_m_s=v_hub, v_n_m_s=float(v_n), omega_rad_s=float(omega),
             tsr=float(self.drive.rotor.tsr_of(omega, v_n)), torque_top_Nm=Q,

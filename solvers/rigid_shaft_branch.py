@@ -32,10 +32,10 @@ import numpy as np
 import scipy.optimize
 
 from rawehelix.errors import SolverError
+from rawehelix.operation import rigid_shaft
+from rawehelix.operation.rotor import OutOfTable
 from rawehelix.periodic_orbits.problem import DenseLU
 
-#: roots of G are bracketed on this many tip-speed ratios across the rotor's table
-BRACKET_SAMPLES = 400
 #: the scalar Newton at fixed V_n stops at |G| below this (normalised torque)
 TOL = 1e-12
 
@@ -46,13 +46,14 @@ class OutsideTable(SolverError):
 
 @dataclasses.dataclass(frozen=True)
 class Drive:
-    """What turns the helix: the rotor's and the generator's laws (operation/), the air
-    density [kg/m^3] and the helix's spin-drag loss Omega -> [N m] (None: off)."""
+    """What turns the helix: the rotor's and the generator's laws (operation/rotor.py,
+    operation/generator.py), the air density [kg/m^3] and the helix's spin-drag loss (an
+    object with ``torque(Omega)`` and ``dtorque_domega(Omega)`` [N m], None: off)."""
 
-    rotor: object  # operation.rotor.RotorLaw (or a law with its methods)
+    rotor: object  # operation.rotor.RotorLaw
     generator: object  # operation.generator.GeneratorLaw
     rho_kg_m3: float
-    loss: object = None  # Omega [rad/s] -> integrated loss torque [N m]
+    loss: object = None
 
     def __post_init__(self):
         if not self.rho_kg_m3 > 0:
@@ -60,65 +61,57 @@ class Drive:
 
     def held_speed(self) -> float | None:
         """The spin [rad/s] the generator holds (Eq. 40's integral action), or None."""
-        held = getattr(self.generator, "holds_speed", None)
-        return held() if callable(held) else held
+        return self.generator.holds_speed
 
     def loss_Nm(self, omega: float) -> float:
-        return 0.0 if self.loss is None else float(self.loss(omega))
-
-    def balance_Nm(self, omega: float, v_n: float) -> float:
-        """Q - tau_gen - L [N m] at Omega [rad/s], V_n [m/s] (rigid shaft)."""
-        Q = self.rotor_torque(omega, v_n)
-        return Q - self.generator.torque(omega) - self.loss_Nm(omega)
+        return 0.0 if self.loss is None else float(self.loss.torque(omega))
 
     def rotor_torque(self, omega: float, v_n: float) -> float:
         """Q = 1/2 rho pi R^2 V_n^3 Cp(lambda) / Omega [N m] (the rotor's law); a ratio
         outside its table raises :class:`OutsideTable`."""
         try:
             return float(self.rotor.torque(omega, v_n, self.rho_kg_m3))
-        except ValueError as err:  # operation.rotor.OutOfTable is a ValueError
+        except OutOfTable as err:
             raise OutsideTable(str(err)) from None
+
+    def generator_torque(self, omega: float, v_n: float) -> float:
+        """tau_gen [N m]: the law's, or Q - L where the generator holds the speed."""
+        if self.held_speed() is not None:
+            return self.rotor_torque(omega, v_n) - self.loss_Nm(omega)
+        return float(self.generator.torque(omega))
+
+    def balance_Nm(self, omega: float, v_n: float) -> float:
+        """Q - tau_gen - L [N m] at Omega [rad/s], V_n [m/s] (rigid shaft)."""
+        return self.rotor_torque(omega, v_n) - self.generator.torque(omega) - self.loss_Nm(omega)
 
     def slope_Nm_s(self, omega: float, v_n: float) -> float:
         """d(Q - tau_gen - L)/dOmega [N m s]: the rigid torsional mode's stiffness, < 0
-        where it is stable."""
+        where it is stable; the paper's law holding the speed contributes its speed gain
+        K2 (operation/rigid_shaft.py)."""
         try:
             dQ = float(self.rotor.dtorque_domega(omega, v_n, self.rho_kg_m3))
-        except ValueError as err:
+        except OutOfTable as err:
             raise OutsideTable(str(err)) from None
-        h = 1e-6 * max(abs(omega), 1.0)
-        dL = 0.0 if self.loss is None else (self.loss_Nm(omega + h) - self.loss_Nm(omega - h)) / (2 * h)
+        dL = 0.0 if self.loss is None else float(self.loss.dtorque_domega(omega))
+        if self.held_speed() is not None:
+            return dQ - dL - self.generator.K2
         return dQ - float(self.generator.dtorque_domega(omega)) - dL
 
-    def omega_range(self, v_n: float) -> tuple[float, float]:
-        """The spins [rad/s] whose tip-speed ratios the rotor's table covers at V_n."""
-        lam = np.asarray(self.rotor.tsr, dtype=float)
-        R = self.rotor.radius_m
-        return float(lam.min() * v_n / R), float(lam.max() * v_n / R)
-
     def roots(self, v_n: float) -> list[float]:
-        """Every spin [rad/s] of the table's range where the balance holds at V_n (the
-        speed a generator holds, if it is in range), ascending: sign changes on
-        BRACKET_SAMPLES spins, each refined by Brent's method."""
-        lo, hi = self.omega_range(v_n)
-        held = self.held_speed()
-        if held is not None:
-            return [held] if lo <= held <= hi else []
-        # the table's ends themselves are in range; stay a hair inside for round-off
-        w = np.linspace(lo, hi, BRACKET_SAMPLES)
-        w[0], w[-1] = lo * (1 + 1e-12), hi * (1 - 1e-12)
-        g = np.array([self.balance_Nm(x, v_n) for x in w])
-        out = [float(x) for x, y in zip(w, g) if y == 0.0]
-        for k in np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0):
-            out.append(float(scipy.optimize.brentq(self.balance_Nm, w[k], w[k + 1], args=(v_n,),
-                                                   xtol=1e-14, rtol=4 * np.finfo(float).eps)))
-        return sorted(out)
+        """Every spin [rad/s] in the table's range where the balance holds at V_n,
+        ascending (operation/rigid_shaft.py); none where the held speed is outside it."""
+        try:
+            return [p.omega_rad_s for p in rigid_shaft.operating_points(
+                self.rotor, self.generator, v_n, self.rho_kg_m3, self.loss)]
+        except OutOfTable:
+            return []
 
     def root_near(self, omega: float, v_n: float) -> float:
         """The root of the balance at V_n nearest ``omega`` by Newton (the held speed for
         a generator that holds one); SolverError if it does not converge."""
         held = self.held_speed()
         if held is not None:
+            self.rotor_torque(held, v_n)  # OutsideTable where the table has no such ratio
             return held
         x = omega
         for _ in range(50):
@@ -234,19 +227,19 @@ class RigidShaftProblem:
         return X
 
     def multipliers(self, X, f1_Hz: float, resolution=None) -> np.ndarray:
+        if self.drive.held_speed() is not None:
+            return np.array([0.0])  # the speed is held (Eq. 40): no fold in V_n
         slope = self._slope(X, f1_Hz)
         return np.array([math.exp(max(-700.0, min(700.0, slope / self.J * self.t)))])
 
     def _slope(self, X, v_n) -> float:
-        if self.drive.held_speed() is not None:
-            return -math.inf  # the controller's integral action holds it (Eq. 40)
         return self.drive.slope_Nm_s(float(X[0]) / self.t, v_n)
 
     def finish(self, X, f1_Hz: float, iterations: int, residual: float, start: float,
                resolution=None) -> RigidPoint:
         G = self._G(X, f1_Hz)
         slope = self._slope(X, f1_Hz)
-        mu = np.array([0.0]) if math.isinf(slope) else self.multipliers(X, f1_Hz)
+        mu = self.multipliers(X, f1_Hz)
         return RigidPoint(float(f1_Hz), np.asarray(X, dtype=float).copy(), mu, iterations,
                           float(residual), time.perf_counter() - start, slope, G=G)
 
@@ -293,6 +286,8 @@ class Segment:
             raise OutsideTable(f"the branch {self.index} has no operating point at V_n = "
                                f"{v_n:.6g} m/s (it spans {self.v_n[0]:.6g} .. {self.v_n[-1]:.6g})")
         guess = float(np.interp(v_n, self.v_n, self.omega))
+        if drive.held_speed() is not None:
+            return drive.root_near(guess, v_n)
         k = int(np.clip(np.searchsorted(self.v_n, v_n), 1, self.v_n.size - 1))
         a, b = sorted((self.omega[k - 1], self.omega[k]))
         if a < b:  # widen by the step: the root at v_n lies between the neighbours' roots

@@ -12,24 +12,50 @@ operating_point.py, solvers/rigid_shaft_branch.py) against what does not share i
   generator torque has a fold in V, one stable and one unstable branch, both roots
   equal to scipy's; a torque curve with two humps gives two stable points at one wind.
 
-The rotor and generator laws are the tests' own stand-ins (tests/operation_standins.py).
+The laws are operation/'s (Cp, CT: monotone cubic in the table); the independent roots
+are scipy's (brentq on scipy's PchipInterpolator of the same table).
 """
 
 import math
 
 import numpy as np
 import pytest
+import scipy.interpolate
 import scipy.optimize
 from mpi4py import MPI
 
-from operation_standins import ConstantTorque, Mppt, TableRotor, hump
-from rawehelix.members import Members  # noqa: F401  (the torque-twist curve's owner)
-from rawehelix.solvers.operating_point import MAX_SOLVES, OperatingPointSolver, along_tangent
+from rawehelix.operation.generator import GeneratorLaw
+from rawehelix.operation.rotor import RotorLaw
+from rawehelix.solvers.operating_point import MAX_SOLVES, OperatingPointSolver
 from rawehelix.solvers.rigid_shaft_branch import Drive, RigidShaftProblem, stable, trace
 from rawehelix.studies import scene
 
 RHO, R = 1.225, 1.0
 COS45 = math.cos(math.pi / 4)
+
+
+def TableRotor(lam, cp, ct, R):
+    return RotorLaw(lam, cp, ct, radius_m=R, spin_inertia_kgm2=2.0)
+
+
+def Mppt(k):
+    return GeneratorLaw("mppt", mppt_gain_Nms2=k)
+
+
+def ConstantTorque(torque_Nm):
+    return GeneratorLaw("torque", torque_Nm=torque_Nm)
+
+
+def hump(lam_opt=5.0, cp_max=0.4, n=41):
+    """A Cp table peaked at lam_opt (a row): cp_max (2 x - x^2) on x = lam / lam_opt in
+    (0, 2), n rows."""
+    x = np.linspace(0.05, 1.95, n)
+    return x * lam_opt, cp_max * (2 * x - x**2), 0.8 * x / (1 + x)
+
+
+def cp_of(lam, cp):
+    """Cp(lambda) by scipy's monotone cubic interpolant of the table."""
+    return scipy.interpolate.PchipInterpolator(lam, cp)
 
 
 def straight(N=4, model=(), **changes):
@@ -46,15 +72,16 @@ def points_at(params, drive, winds):
                    0.5 * min(winds), max(winds))
     seg = traced.segments[0]
     solver = OperatingPointSolver(lambda V: params.replace(environment={"wind_speed_m_s": V}),
-                                  drive, along_tangent, lambda V: V, MPI.COMM_SELF)
+                                  drive, lambda V: V, MPI.COMM_SELF)
     return [solver.solve(V, lambda vn: seg.root(drive, vn)) for V in winds]
 
 
 def table_root(lam, cp, k):
-    """lambda with Cp(lambda) = k lambda^3 / (1/2 rho pi R^5), Cp piecewise linear in the
-    table: scipy on the table, not the solver's laws."""
+    """lambda with Cp(lambda) = k lambda^3 / (1/2 rho pi R^5): scipy on the table, not the
+    solver's laws."""
     c = 0.5 * RHO * math.pi * R**5
-    f = lambda x: np.interp(x, lam, cp) - k * x**3 / c  # noqa: E731
+    Cp = cp_of(lam, cp)
+    f = lambda x: Cp(x) - k * x**3 / c  # noqa: E731
     x = np.linspace(lam[0], lam[-1], 2001)
     g = f(x)
     i = np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:]))
@@ -135,7 +162,8 @@ def scipy_roots(lam, cp, torque_Nm, v_n):
     """The spins [rad/s] with 1/2 rho pi R^3 V_n^2 Cp(lambda)/lambda = torque, scipy on
     the table."""
     c = 0.5 * RHO * math.pi * R**3 * v_n**2
-    f = lambda x: c * np.interp(x, lam, cp) / x - torque_Nm  # noqa: E731
+    Cp = cp_of(lam, cp)
+    f = lambda x: c * Cp(x) / x - torque_Nm  # noqa: E731
     x = np.linspace(lam[0], lam[-1], 4001)
     g = f(x)
     return [scipy.optimize.brentq(f, x[i], x[i + 1], xtol=1e-15) * v_n / R
@@ -151,7 +179,7 @@ def test_the_fold_in_wind_speed_is_stepped_past_and_marked():
     cq_max = 0.45 * (3 * 0.75**2 - 2 * 0.75**3) / (5 * 0.75)
     v_fold = math.sqrt(20.0 / (0.5 * RHO * math.pi * R**3 * cq_max))
     assert len(traced.folds) == 1
-    assert traced.folds[0] == pytest.approx(v_fold, rel=2e-3)  # the table's linear pieces
+    assert traced.folds[0] == pytest.approx(v_fold, rel=2e-3)  # the table's interpolant
     assert sorted(s.stable for s in traced.segments) == [False, True]
     for v_n in (11.0, 13.5):
         want = scipy_roots(lam, cp, 20.0, v_n)
