@@ -123,9 +123,9 @@ def operate(scene: Parameters, wind_m_s, comm=None):
     comm = _world(comm)
     from rawehelix.studies import operate as study
     winds = study.check_winds(wind_m_s)
-    study.drive_of(scene)  # a missing [rotor] or [generator] before any work
+    planned = study.plan(scene, winds)  # numpy: the refusals before any FE work
     scene = _ready(scene, "operate", comm)
-    return study.compute(scene, winds, comm)
+    return study.compute(scene, winds, comm, planned)
 
 
 def modes(scene: Parameters, count: int | None = None, comm=None):

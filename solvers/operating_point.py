@@ -49,6 +49,14 @@ def top_tangent(s: np.ndarray, centre_line: np.ndarray, degree: int) -> np.ndarr
     return t / np.linalg.norm(t)
 
 
+def chord_axis_factor(drive: Drive, q) -> float:
+    """a = V_n / V_hub along the chord's unit vector (Eq. 66, at the elevation Gamma0;
+    ``q`` the normalised scene): the first guess at the first point, and the window the
+    branches are traced over."""
+    chord = np.array([-np.cos(q.Gamma0), 0.0, -np.sin(q.Gamma0)])
+    return float(drive.rotor.normal_speed(1.0, chord))
+
+
 @dataclasses.dataclass
 class OperatingPoint:
     """A relative equilibrium at one wind speed, SI (arrays on rank 0)."""
@@ -98,8 +106,7 @@ class OperatingPointSolver:
 
     def first_axis_factor(self, params) -> float:
         """a of the chord (Eq. 66): the first guess at the first point."""
-        chord = params.normalised().top_position()
-        return self.axis(chord / np.linalg.norm(chord))
+        return chord_axis_factor(self.drive, params.normalised())
 
     def solve(self, V: float, root) -> OperatingPoint:
         """The operating point at the wind V [m/s] on the branch whose root of the balance

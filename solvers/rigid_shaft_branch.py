@@ -285,9 +285,19 @@ class Segment:
         if not self.covers(v_n):
             raise OutsideTable(f"the branch {self.index} has no operating point at V_n = "
                                f"{v_n:.6g} m/s (it spans {self.v_n[0]:.6g} .. {self.v_n[-1]:.6g})")
-        guess = float(np.interp(v_n, self.v_n, self.omega))
+        lam_lo, lam_hi = drive.rotor.tsr_range  # the spins the table has at v_n
+        w_lo, w_hi = (x * v_n / drive.rotor.radius_m for x in (lam_lo, lam_hi))
+        guess = float(np.clip(np.interp(v_n, self.v_n, self.omega), w_lo, w_hi))
         if drive.held_speed() is not None:
             return drive.root_near(guess, v_n)
+        k = int(np.clip(np.searchsorted(self.v_n, v_n), 1, self.v_n.size - 1))
+        a, b = np.clip(sorted((self.omega[k - 1], self.omega[k])), w_lo, w_hi)
+        if a < b:  # the root at v_n lies between the neighbours' roots (a graph)
+            ga, gb = drive.balance_Nm(a, v_n), drive.balance_Nm(b, v_n)
+            if ga * gb <= 0:
+                return float(scipy.optimize.brentq(drive.balance_Nm, a, b, args=(v_n,),
+                                                   xtol=1e-14, rtol=4 * np.finfo(float).eps))
+        return drive.root_near(guess, v_n)
         k = int(np.clip(np.searchsorted(self.v_n, v_n), 1, self.v_n.size - 1))
         a, b = sorted((self.omega[k - 1], self.omega[k]))
         if a < b:  # widen by the step: the root at v_n lies between the neighbours' roots

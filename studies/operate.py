@@ -150,27 +150,67 @@ class _Limits:
         return own.block()
 
 
-def compute(params: Parameters, winds, comm=MPI.COMM_WORLD) -> Operate:
-    """The operating points at the wind speeds ``winds`` [m/s] (module docstring)."""
-    start = time.perf_counter()
-    winds = check_winds(winds)
+@dataclass
+class Plan:
+    """What a run knows before any FE work: the laws, the traced branches of the torque
+    balance (numpy only), the chord's axis factor a0 = V_n / V_hub and V -> V_hub."""
+
+    drive: Drive
+    traced: object  # solvers/rigid_shaft_branch.py::Traced
+    a0: float
+    hub: object  # V [m/s] -> V_hub [m/s]
+
+    def uncovered(self, winds) -> list[float]:
+        """The wind speeds no branch reaches (at the chord's axis factor)."""
+        return [V for V in winds
+                if not any(seg.covers(self.a0 * self.hub(V)) for seg in self.traced.segments)]
+
+    def span_m_s(self) -> str:
+        """The wind speeds [m/s] the branches reach, in words."""
+        scale = self.a0 * self.hub(1.0)  # V_hub is proportional to V (operation/wind.py)
+        return ", ".join(f"{seg.v_n[0] / scale:.3g} to {seg.v_n[-1] / scale:.3g}"
+                         for seg in self.traced.segments) or "none"
+
+
+def plan(params: Parameters, winds, key: str = "wind_m_s", text: str | None = None) -> Plan:
+    """The run's :class:`Plan`; SceneError on ``key`` (``text``: the value as given) where
+    a wind speed has no operating point inside the rotor's table.  Numpy only."""
+    from rawehelix.solvers.operating_point import chord_axis_factor
     drive = drive_of(params)
     q = params.normalised()
     hub = hub_speed(params)
-    limits = _Limits(params)
-    solver = OperatingPointSolver(lambda V: at_wind(params, V), drive, hub, comm,
-                                  limits=limits)
-    a0 = solver.first_axis_factor(params)
+    a0 = chord_axis_factor(drive, q)
     problem = RigidShaftProblem(drive, q.t_scale, q.torque_scale)
     traced = trace(problem, a0 * hub(winds[0]) * (1 - WINDOW_MARGIN),
                    min(1.0, a0 * (1 + WINDOW_MARGIN)) * hub(winds[-1]))
-    if not traced.segments:
-        raise SceneError("--wind", f"{winds[0]:g}:{winds[-1]:g}",
-                         f"no operating point of the rotor and generator in "
-                         f"{winds[0]:g} .. {winds[-1]:g} m/s inside the rotor's table "
-                         f"(tip-speed ratios {drive.rotor.tsr_range[0]:g} .. "
-                         f"{drive.rotor.tsr_range[1]:g}); try other wind speeds or another "
-                         f"generator.mppt_gain_Nms2")
+    out = Plan(drive, traced, a0, hub)
+    missing = out.uncovered(winds)
+    if missing:
+        lo, hi = drive.rotor.tsr_range
+        raise SceneError(key, text or f"{winds[0]:g} .. {winds[-1]:g} m/s",
+                         f"no operating point of the rotor and generator inside the rotor's "
+                         f"table (tip-speed ratios {lo:g} to {hi:g}) at {_listed(missing)} m/s; "
+                         f"they have operating points from {out.span_m_s()} m/s: choose wind "
+                         f"speeds there, or extend the rotor's table")
+    return out
+
+
+def _listed(values, most: int = 4) -> str:
+    shown = ", ".join(f"{v:g}" for v in values[:most])
+    return shown + (f" and {len(values) - most} more" if len(values) > most else "")
+
+
+def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None = None
+            ) -> Operate:
+    """The operating points at the wind speeds ``winds`` [m/s] (module docstring);
+    ``planned``: the run's :func:`plan` if already made."""
+    start = time.perf_counter()
+    winds = check_winds(winds)
+    p_ = planned or plan(params, winds)
+    drive, traced, hub = p_.drive, p_.traced, p_.hub
+    limits = _Limits(params)
+    solver = OperatingPointSolver(lambda V: at_wind(params, V), drive, hub, comm,
+                                  limits=limits)
     points, entries, details, stop, first = [], [], [], None, None
     solves = 0
     for V in winds:
@@ -202,9 +242,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD) -> Operate:
                     f"(branch {branch}, s = {hit['s_m']:.3f} m)")
             break
     if not points:
-        raise SceneError("--wind", f"{winds[0]:g}:{winds[-1]:g}",
-                         "no operating point at these wind speeds inside the rotor's table; "
-                         f"the branches span V_n = {_span(traced)} m/s along the rotor's axis")
+        raise SolverError(f"no operating point was solved at {_listed(winds)} m/s: {stop}")
     block = limits.run.block()
     block["first_limit"] = first
     summary = {
@@ -225,10 +263,6 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD) -> Operate:
     }
     return Operate(params, points, comm.bcast(summary if comm.rank == 0 else None, root=0),
                    rank=comm.rank)
-
-
-def _span(traced) -> str:
-    return ", ".join(f"{s.v_n[0]:.3g} .. {s.v_n[-1]:.3g}" for s in traced.segments)
 
 
 def _entry(p, branch: int) -> dict:

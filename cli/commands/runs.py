@@ -168,6 +168,7 @@ def _operate(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies.store import outdir as outdir_check
     from rawehelix.studies import operate
     winds = operate.parse_wind(args.wind)
+    operate.plan(params, winds, key="--wind", text=args.wind)  # numpy: refuses before any work
     outdir_check.check(outdir, "operate", points=len(winds))
     result = rh.operate(params, winds, comm=comm)
     return _written(comm, result, operate.report(result), outdir)
