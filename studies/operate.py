@@ -29,6 +29,7 @@ from mpi4py import MPI
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.operating_point import OperatingPointSolver
+from rawehelix.solvers.stationary import SlackError
 from rawehelix.solvers.rigid_shaft_branch import Drive, OutsideTable, RigidShaftProblem, trace
 from rawehelix.studies.analysis import structure_limits
 from rawehelix.studies.store import writers
@@ -220,8 +221,14 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
                 p = solver.solve(V, lambda vn, seg=seg: seg.root(drive, vn))
             except OutsideTable:
                 continue  # this branch does not reach V (or its table ends before)
+            except SlackError as err:  # the whole helix slack: the slack limit, reached
+                reached.append((seg.index, {"kind": "slack", "s_m": None, "t_s": None,
+                                            "why": str(err)}))
+                continue
             except SolverError as err:
-                stop = f"at {V:g} m/s the relative equilibrium on branch {seg.index} failed: {err}"
+                stop = (f"at {V:g} m/s the relative equilibrium on branch {seg.index} failed "
+                        f"({err}); the points before it are kept: a run with more --elements, "
+                        f"or --wind below {V:g}, avoids it")
                 break
             solves += p.stationary_solves
             points.append(p)
@@ -238,8 +245,9 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
         if reached:
             branch, hit = reached[0]
             first = {**hit, "wind_m_s": V, "branch": branch}
+            where = "" if hit["s_m"] is None else f", s = {hit['s_m']:.3f} m"
             stop = (f"the helix reaches its first limit, {hit['kind']}, at {V:g} m/s "
-                    f"(branch {branch}, s = {hit['s_m']:.3f} m)")
+                    f"(branch {branch}{where})")
             break
     if not points:
         raise SolverError(f"no operating point was solved at {_listed(winds)} m/s: {stop}")
@@ -304,8 +312,9 @@ def report(result: Operate) -> str:
                      + ("" if e["stable"] else "  unstable"))
     first = s["first_limit"]
     lines.append("  first limit: " + (f"{first['kind']} at {first['wind_m_s']:g} m/s (branch "
-                                      f"{first['branch']}, s = {first['s_m']:.3f} m)"
-                                      if first else "none in the wind speeds run"))
+                                      f"{first['branch']}"
+                                      + ("" if first["s_m"] is None else f", s = {first['s_m']:.3f} m")
+                                      + ")" if first else "none in the wind speeds run"))
     lines.append(f"  stopped: {s['stopped']}")
     for note in s["notes"]:
         lines.append(f"  note: {note}")
