@@ -251,6 +251,8 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
             break
     if not points:
         raise SolverError(f"no operating point was solved at {_listed(winds)} m/s: {stop}")
+    # V_n = a V_hub with a the solved points' mean axis factor, V_hub proportional to V
+    scale = float(np.mean([p.v_n_m_s / p.hub_wind_m_s for p in points])) * hub(1.0)
     block = limits.run.block()
     block["first_limit"] = first
     summary = {
@@ -258,7 +260,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
         "degree": params.discretisation.degree, "ranks": comm.size,
         "wind_m_s": winds, "rotor_axis": drive.rotor.axis,
         "points": entries, "details": details,
-        "folds": [{"v_n_m_s": float(v)} for v in traced.folds],
+        "folds": [{"v_n_m_s": float(v), "wind_m_s": float(v / scale)} for v in traced.folds],
         "branches": [{"branch": s.index, "stable": s.stable,
                       "v_n_m_s": [float(s.v_n[0]), float(s.v_n[-1])]} for s in traced.segments],
         "limits": block, "first_limit": first,
@@ -319,5 +321,6 @@ def report(result: Operate) -> str:
     for note in s["notes"]:
         lines.append(f"  note: {note}")
     for fold in s["folds"]:
-        lines.append(f"  fold at V_n = {fold['v_n_m_s']:.4g} m/s along the rotor's axis")
+        lines.append(f"  fold at V = {fold['wind_m_s']:.4g} m/s (V_n = {fold['v_n_m_s']:.4g} m/s "
+                     "along the rotor's axis): a branch turns back in the wind there")
     return "\n".join(lines)
