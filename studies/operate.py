@@ -27,6 +27,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError, SolverError
+from rawehelix.operation.rotor import RPM  # rad/s per rpm
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.operating_point import OperatingPointSolver
 from rawehelix.solvers.stationary import SlackError
@@ -39,11 +40,12 @@ log = logging.getLogger("rawehelix")
 #: the window of V_n traced, beyond the chord's share of --wind (the top tangent turns
 #: from the chord by the sag's angle: a few degrees on the paper's helix)
 WINDOW_MARGIN = 0.15
+#: the most wind speeds a run takes (each a few stationary solves and a record)
+MAX_WINDS = 2000
 #: the keys of each point of summary.json (the issue's)
 POINT_KEYS = ("wind_m_s", "rotor_rpm", "tsr", "power_W", "rotor_power_W", "torque_top_Nm",
               "torque_ground_Nm", "thrust_N", "tension_max_N", "tension_min_N", "twist_deg",
               "stable", "branch")
-RPM = 60.0 / (2.0 * np.pi)  # rpm per rad/s
 
 
 def parse_wind(text: str) -> list[float]:
@@ -56,20 +58,19 @@ def parse_wind(text: str) -> list[float]:
     if not (0 < lo <= hi and step > 0 and np.isfinite(lo + hi + step)):
         raise SceneError("--wind", text, "must be LO:HI:STEP with 0 < LO <= HI and STEP > 0 "
                          "(m/s)")
-    count = int(np.floor((hi - lo) / step + 1e-9)) + 1
+    count = float(np.floor((hi - lo) / step + 1e-9)) + 1
     if count > MAX_WINDS:
-        raise SceneError("--wind", text, f"gives {count} wind speeds; at most {MAX_WINDS} "
+        raise SceneError("--wind", text, f"gives {count:.6g} wind speeds; at most {MAX_WINDS} "
                          "(a larger STEP)")
-    return [float(lo + k * step) for k in range(count)]
-
-
-#: the most wind speeds a run takes (each a few stationary solves and a record)
-MAX_WINDS = 2000
+    return [float(lo + k * step) for k in range(int(count))]
 
 
 def check_winds(winds) -> list[float]:
     """The API's ``wind_m_s``: finite, > 0, at most MAX_WINDS, ascending."""
-    w = sorted(float(x) for x in np.atleast_1d(winds))
+    try:
+        w = sorted(float(x) for x in np.atleast_1d(winds))
+    except (TypeError, ValueError):
+        w = []
     if not w or not all(np.isfinite(x) and x > 0 for x in w) or len(w) > MAX_WINDS:
         raise SceneError("wind_m_s", str(list(winds)),
                          f"must be 1 to {MAX_WINDS} finite wind speeds > 0 m/s")
@@ -235,7 +236,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
             entries.append(_entry(p, seg.index))
             details.append(_detail(p, seg.index))
             log.info("operate: %g m/s (branch %d): %.1f rpm, P %.1f W, T %.1f .. %.1f N, %d "
-                     "solves", V, seg.index, p.omega_rad_s * RPM, p.power_W,
+                     "solves", V, seg.index, p.omega_rad_s / RPM, p.power_W,
                      entries[-1]["tension_min_N"] or 0.0, entries[-1]["tension_max_N"] or 0.0,
                      p.stationary_solves)
             if p.limits and p.limits.get("first_limit"):
@@ -278,7 +279,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
 def _entry(p, branch: int) -> dict:
     """A point of summary.json: exactly :data:`POINT_KEYS`."""
     T = p.tension_N
-    return {"wind_m_s": p.wind_m_s, "rotor_rpm": p.omega_rad_s * RPM, "tsr": p.tsr,
+    return {"wind_m_s": p.wind_m_s, "rotor_rpm": p.omega_rad_s / RPM, "tsr": p.tsr,
             "power_W": p.power_W, "rotor_power_W": p.rotor_power_W,
             "torque_top_Nm": p.torque_top_Nm, "torque_ground_Nm": p.torque_ground_Nm,
             "thrust_N": p.thrust_N,
