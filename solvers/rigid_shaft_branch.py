@@ -33,10 +33,21 @@ import numpy as np
 import scipy.optimize
 
 from rawehelix.errors import SolverError
-from rawehelix.operation import rigid_shaft
 from rawehelix.operation.rotor import OutOfTable
+from rawehelix.periodic_orbits.continuation import StepGuard
 from rawehelix.periodic_orbits.problem import DenseLU
 
+#: the speeds V_n inside a window where branches are also sought (their roots not yet
+#: traced): a branch that begins inside the window (a fold, the table's edge) is found
+#: where it spans one of them
+SEEDS = 24
+#: the largest relative change of Omega between two points of a branch (SpinStep)
+MAX_SPIN_STEP = 0.05
+#: the roots are bracketed on this many spins between two adjacent rows of the table
+SAMPLES = 64
+#: ... a hair inside the table's ends (relative), so that round-off in Omega R / V_n
+#: does not step outside it
+ROUND_OFF = 1e-12
 #: the scalar Newton at fixed V_n stops at |G| below this (normalised torque)
 TOL = 1e-12
 
@@ -93,13 +104,27 @@ class Drive:
         return dQ - float(self.generator.dtorque_domega(omega)) - dL
 
     def roots(self, v_n: float) -> list[float]:
-        """Every spin [rad/s] in the table's range where the balance holds at V_n,
-        ascending (operation/rigid_shaft.py); none where the held speed is outside it."""
-        try:
-            return [p.omega_rad_s for p in rigid_shaft.operating_points(
-                self.rotor, self.generator, v_n, self.rho_kg_m3, self.loss)]
-        except OutOfTable:
-            return []
+        """Every spin [rad/s] where the balance holds at V_n with its tip-speed ratio
+        inside the table (a hair, ROUND_OFF, inside its ends), ascending: sign changes on
+        SAMPLES spins between adjacent rows, each refined by Brent's method.  The held
+        speed of a generator that holds one, where the table has it."""
+        lam = np.asarray(self.rotor.table_tsr, dtype=float)
+        lam = np.clip(lam, lam[0] * (1 + ROUND_OFF), lam[-1] * (1 - ROUND_OFF))
+        R = self.rotor.radius_m
+        held = self.held_speed()
+        if held is not None:
+            return [held] if lam[0] <= held * R / v_n <= lam[-1] else []
+        w = np.unique(np.concatenate([np.linspace(a, b, SAMPLES + 1)
+                                      for a, b in zip(lam[:-1], lam[1:])])) * v_n / R
+        w = w[w > 0]
+        g = (np.asarray(self.rotor.torque(w, v_n, self.rho_kg_m3), dtype=float)
+             - np.asarray(self.generator.torque(w), dtype=float)
+             - (0.0 if self.loss is None else np.asarray(self.loss.torque(w), dtype=float)))
+        out = [float(x) for x, y in zip(w, g) if y == 0.0]
+        for k in np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0):
+            out.append(float(scipy.optimize.brentq(self.balance_Nm, w[k], w[k + 1], args=(v_n,),
+                                                   xtol=1e-14, rtol=4 * np.finfo(float).eps)))
+        return sorted(out)
 
     def root_near(self, omega: float, v_n: float) -> float:
         """The root of the balance at V_n nearest ``omega`` by Newton (the held speed for
@@ -119,6 +144,20 @@ class Drive:
                 return x
         raise SolverError(f"the torque balance at V_n = {v_n:.6g} m/s did not converge from "
                           f"{omega:.6g} rad/s")
+
+
+class SpinStep(StepGuard):
+    """Branch's step guard on the spin: a corrected point whose Omega differs from the
+    last point's by more than MAX_SPIN_STEP of it is refused (a shorter step), so that
+    the corrector cannot land on a neighbouring branch where two are close (near a fold,
+    or where the torque coefficient has humps)."""
+
+    def admit(self, prev, orbit, samples):
+        X = orbit.X if orbit is not None else samples
+        if X is None:
+            return None
+        change = abs(float(X[0]) - float(prev.X[0])) / max(abs(float(prev.X[0])), 1e-300)
+        return None if change <= MAX_SPIN_STEP else 0.5
 
 
 def stable(slope_Nm_s: float, eigenvalues=None) -> bool:
@@ -181,12 +220,13 @@ class RigidShaftProblem:
         return self.drive.slope_Nm_s(omega, v_n) / (self.m * self.t)
 
     def residual(self, X, f1_Hz: float, jacobian: bool = False, resolution=None):
+        """(G, the state X as the point's "samples" (what :class:`SpinStep` reads), dG/dX)."""
         try:
             G = self._G(X, f1_Hz)
             J = np.array([[self._dG(X, f1_Hz)]]) if jacobian else None
         except OutsideTable as err:
             raise SolverError(str(err)) from None  # the corrector retries a shorter step
-        return G, None, J
+        return G, np.array(X, dtype=float), J
 
     def residual_f1(self, X, f1_Hz: float, resolution: int, G=None) -> np.ndarray:
         h = 1e-6 * max(abs(f1_Hz), 1.0)
@@ -306,17 +346,34 @@ class Traced:
     notes: list
     points: int  # branch points traced
 
+    def at(self, drive: Drive, v_n: float) -> list:
+        """Every root of the balance at V_n (:meth:`Drive.roots`, each once) as (branch,
+        root): ``root(v_n')`` the root near it at a nearby V_n' on the segment that
+        reaches it (the first, where several do), or a new index past the segments for a
+        root that no traced segment reaches (a continuation that jumped a branch)."""
+        out, spare = [], len(self.segments)
+        for w in drive.roots(v_n):
+            seg = next((s for s in self.segments if s.covers(v_n) and _reaches(s, drive, v_n, w)),
+                       None)
+            if seg is None:
+                out.append((spare, lambda vn, w=w: drive.root_near(w * vn / v_n, vn)))
+                spare += 1
+            else:
+                out.append((seg.index, lambda vn, s=seg: s.root(drive, vn)))
+        return out
+
+
+def _reaches(seg: Segment, drive: Drive, v_n: float, omega: float) -> bool:
+    """Whether the segment's root at V_n is ``omega`` [rad/s]."""
+    try:
+        return abs(seg.root(drive, v_n) - omega) <= 1e-8 * max(1.0, abs(omega))
+    except SolverError:
+        return False
+
 
 def _on(segments, drive: Drive, omega: float, v_n: float) -> bool:
     """Whether the root ``omega`` at V_n lies on a segment already traced."""
-    for seg in segments:
-        if seg.covers(v_n):
-            try:
-                if abs(seg.root(drive, v_n) - omega) <= 1e-8 * max(1.0, abs(omega)):
-                    return True
-            except SolverError:
-                pass
-    return False
+    return any(seg.covers(v_n) and _reaches(seg, drive, v_n, omega) for seg in segments)
 
 
 def _split(points, problem, first_index: int) -> list:
@@ -354,33 +411,46 @@ def _held(drive: Drive, vn_lo: float, vn_hi: float) -> Traced:
                            stable(drive.slope_Nm_s(omega, 0.5 * (lo + hi))))], [], [], v.size)
 
 
-def trace(problem: RigidShaftProblem, vn_lo: float, vn_hi: float, ds_max: float = 0.5,
-          max_points: int = 400) -> Traced:
-    """Every branch of the balance through [vn_lo, vn_hi] [m/s]: traced by Branch from
-    each root at vn_lo upwards and from each root at vn_hi not yet met downwards, through
-    folds, until it leaves the window or the rotor's table ends."""
+def _one_way(problem, omega, v0, v1, direction, ds_max, max_points, notes, folds):
+    """The points of Branch's trace from the root ``omega`` at V_n = v0 towards v1, through
+    folds, until it leaves the window or the rotor's table ends (noted); its folds
+    appended to ``folds`` once each."""
     from rawehelix.periodic_orbits.continuation import Branch
+    branch = Branch(problem, ds=0.1, ds_max=ds_max, ds_min=1e-6, tol=1e-10,
+                    guards=(SpinStep(),))
+    try:
+        branch.trace(problem.point_at(omega, v0), v1, direction=direction, max_points=max_points)
+    except SolverError:  # the corrector failed with the smallest step: the table ends
+        last = branch.points[-1]
+        notes.append(f"the rotor's table ends at V_n = {last.v_n:.4g} m/s, "
+                     f"{last.X[0] / problem.t:.4g} rad/s")
+    for f in branch.folds:  # once where the branch lands on it (a table's corner)
+        if not any(abs(f["f1_Hz"] - v) <= 1e-9 * v for v in folds):
+            folds.append(f["f1_Hz"])
+    return branch.points
 
+
+def trace(problem: RigidShaftProblem, vn_lo: float, vn_hi: float, ds_max: float = 0.5,
+          max_points: int = 400, seeds: int = SEEDS) -> Traced:
+    """Every branch of the balance through [vn_lo, vn_hi] [m/s], traced by Branch through
+    folds until it leaves the window or the rotor's table ends: from each root at vn_lo
+    upwards, at vn_hi downwards, and from each root at ``seeds`` speeds between them that
+    no branch has met yet both ways (a branch that starts or ends at the table's edge,
+    or at a fold, inside the window)."""
     drive = problem.drive
     if drive.held_speed() is not None:
         return _held(drive, vn_lo, vn_hi)
     segments, folds, notes, count = [], [], [], 0
-    for v0, v1, direction in ((vn_lo, vn_hi, 1.0), (vn_hi, vn_lo, -1.0)):
+    starts = [(vn_lo, ((vn_hi, 1.0),)), (vn_hi, ((vn_lo, -1.0),))]
+    starts += [(v, ((vn_lo, -1.0), (vn_hi, 1.0))) for v in np.linspace(vn_lo, vn_hi, seeds)[1:-1]]
+    for v0, ways in starts:
         for omega in drive.roots(v0):
             if _on(segments, drive, omega, v0):
                 continue
-            branch = Branch(problem, ds=0.1, ds_max=ds_max, ds_min=1e-6, tol=1e-10)
-            try:
-                branch.trace(problem.point_at(omega, v0), v1, direction=direction,
-                             max_points=max_points)
-            except SolverError:  # the corrector failed with the smallest step: the table ends
-                last = branch.points[-1]
-                notes.append(f"the rotor's table ends at V_n = {last.v_n:.4g} m/s, "
-                             f"{last.X[0] / problem.t:.4g} rad/s")
-            count += len(branch.points)
-            for f in branch.folds:  # once where the branch lands on it (a table's corner)
-                if not any(abs(f["f1_Hz"] - v) <= 1e-9 * v for v in folds):
-                    folds.append(f["f1_Hz"])
-            if len(branch.points) >= 2:
-                segments += _split(branch.points, problem, len(segments))
+            parts = [_one_way(problem, omega, v0, v1, d, ds_max, max_points, notes, folds)
+                     for v1, d in ways]
+            points = parts[0][::-1] + parts[1][1:] if len(parts) == 2 else parts[0]
+            count += len(points)
+            if len(points) >= 2:
+                segments += _split(points, problem, len(segments))
     return Traced(segments, folds, notes, count)

@@ -163,9 +163,9 @@ class Plan:
     hub: object  # V [m/s] -> V_hub [m/s]
 
     def uncovered(self, winds) -> list[float]:
-        """The wind speeds no branch reaches (at the chord's axis factor)."""
-        return [V for V in winds
-                if not any(seg.covers(self.a0 * self.hub(V)) for seg in self.traced.segments)]
+        """The wind speeds without a root of the balance in the rotor's table (at the
+        chord's axis factor)."""
+        return [V for V in winds if not self.drive.roots(self.a0 * self.hub(V))]
 
     def span_m_s(self) -> str:
         """The wind speeds [m/s] the branches reach, in words."""
@@ -215,32 +215,37 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
                                   limits=limits)
     points, entries, details, stop, first = [], [], [], None, None
     solves = 0
+    notes = list(traced.notes)
     for V in winds:
         reached = []
-        for seg in traced.segments:
+        a = solver.a if solver.a is not None else p_.a0
+        for branch, root in traced.at(drive, a * hub(V)):  # every root at V, each once
+            if branch >= len(traced.segments) and not any("not reached" in n for n in notes):
+                notes.append(f"branch {branch} (from {V:g} m/s) was not reached by the "
+                             "continuation: its points are the balance's roots at each wind")
             try:
-                p = solver.solve(V, lambda vn, seg=seg: seg.root(drive, vn))
+                p = solver.solve(V, root)
             except OutsideTable:
-                continue  # this branch does not reach V (or its table ends before)
+                continue  # the branch leaves the table between a's guess and its value
             except SlackError as err:  # the whole helix slack: the slack limit, reached
-                reached.append((seg.index, {"kind": "slack", "s_m": None, "t_s": None,
-                                            "why": str(err)}))
+                reached.append((branch, {"kind": "slack", "s_m": None, "t_s": None,
+                                         "why": str(err)}))
                 continue
             except SolverError as err:
-                stop = (f"at {V:g} m/s the relative equilibrium on branch {seg.index} failed "
+                stop = (f"at {V:g} m/s the relative equilibrium on branch {branch} failed "
                         f"({err}); the points before it are kept: a run with more --elements, "
                         f"or --wind below {V:g}, avoids it")
                 break
             solves += p.stationary_solves
             points.append(p)
-            entries.append(_entry(p, seg.index))
-            details.append(_detail(p, seg.index))
+            entries.append(_entry(p, branch))
+            details.append(_detail(p, branch))
             log.info("operate: %g m/s (branch %d): %.1f rpm, P %.1f W, T %.1f .. %.1f N, %d "
-                     "solves", V, seg.index, p.omega_rad_s / RPM, p.power_W,
+                     "solves", V, branch, p.omega_rad_s / RPM, p.power_W,
                      entries[-1]["tension_min_N"] or 0.0, entries[-1]["tension_max_N"] or 0.0,
                      p.stationary_solves)
             if p.limits and p.limits.get("first_limit"):
-                reached.append((seg.index, p.limits["first_limit"]))
+                reached.append((branch, p.limits["first_limit"]))
         if stop:
             break
         if reached:
@@ -266,7 +271,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
                       "v_n_m_s": [float(s.v_n[0]), float(s.v_n[-1])]} for s in traced.segments],
         "limits": block, "first_limit": first,
         "stopped": stop or "the last wind speed of --wind",
-        "notes": traced.notes,
+        "notes": notes,
         "stationary_solves": {"total": solves, "max_per_point": max(
             p.stationary_solves for p in points)},
         "branch_points_traced": traced.points,

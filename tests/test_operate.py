@@ -69,10 +69,14 @@ def test_mppt_runs_at_the_best_tip_speed_ratio_and_the_first_limit_stops_the_cur
     assert first["kind"] in s["stopped"]
 
 
-def _torque_scene(tmp_path, torque_Nm):
+def _torque_scene(tmp_path, torque_Nm, table=None):
     """rotor_example with a constant generator torque (its own folder: the table's path
-    is relative to the scene)."""
-    shutil.copy(SCENES / "rotor_example.csv", tmp_path / "rotor_example.csv")
+    is relative to the scene); ``table``: (tsr, cp, ct) instead of rotor_example.csv."""
+    if table is None:
+        shutil.copy(SCENES / "rotor_example.csv", tmp_path / "rotor_example.csv")
+    else:
+        rows = "\n".join(f"{x!r},{y!r},{z!r}" for x, y, z in zip(*table))
+        (tmp_path / "rotor_example.csv").write_text("tsr,cp,ct\n" + rows + "\n")
     text = (SCENES / "rotor_example.toml").read_text()
     head, _, rest = text.partition("[generator]")
     _, _, tail = rest.partition("[wind]")
@@ -81,8 +85,35 @@ def _torque_scene(tmp_path, torque_Nm):
     return scene
 
 
-@pytest.mark.parametrize("wind, says", [
-    ("4:x", "--wind: 4:x: must be LO:HI:STEP in m/s"),
+def test_coexisting_stable_points_are_all_in_points_with_their_branch(tmp_path):
+    """A rotor whose torque coefficient Cq = Cp / tsr has several humps, under a constant
+    5 N m: at one wind the balance has several roots; every one is a point of
+    summary.json, the stable ones on different branches, and their spins are scipy's
+    roots of 1/2 rho pi R^3 V_n^2 Cq(tsr) = 5 N m at the point's V_n."""
+    import numpy as np
+    import scipy.interpolate
+    import scipy.optimize
+    lam = np.linspace(0.5, 10.0, 96)
+    cq = 0.03 + 0.012 * np.sin(lam * 2 * np.pi / 4.0) - 0.002 * lam
+    scene = _torque_scene(tmp_path, 5.0, (lam, cq * lam, 0.5 + 0 * lam))
+    res = rh.operate(rh.load_scene(str(scene), elements=2), [5.5], comm=MPI.COMM_SELF)
+    pts, det = res.summary["points"], res.summary["details"]
+    stable = [p["branch"] for p in pts if p["stable"]]
+    assert len(stable) >= 2 and len(set(stable)) == len(stable)
+    v_n = det[0]["v_n_m_s"]
+    assert all(d["v_n_m_s"] == pytest.approx(v_n, rel=1e-9) for d in det)  # one torque
+    Cp = scipy.interpolate.PchipInterpolator(lam, cq * lam)
+    c = 0.5 * 1.225 * math.pi * 2.0**3 * v_n**2
+    f = lambda x: c * Cp(x) / x - 5.0  # noqa: E731
+    x = np.linspace(lam[0], lam[-1], 4001)
+    g = f(x)
+    roots = [scipy.optimize.brentq(f, x[i], x[i + 1], xtol=1e-15) * v_n / 2.0
+             for i in np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:]))]
+    got = sorted(p["rotor_rpm"] * math.pi / 30 for p in pts)
+    assert got == pytest.approx(roots, rel=1e-9)
+
+
+@pytest.mark.parametrize("wind, says", [  # a malformed --wind: tests/test_faults.py's row
     ("9:4:1", "must be LO:HI:STEP with 0 < LO <= HI and STEP > 0"),
     ("1:12:1", "no operating point of the rotor and generator inside the rotor's table"),
 ])
