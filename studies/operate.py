@@ -99,6 +99,22 @@ class Operate:
         return outdir
 
 
+def fixed_top(params: Parameters) -> None:
+    """SceneError where the top end is not held at [ends]' position: a relative
+    equilibrium needs the top still (Eq. 70's circle moves it), and the lifted top's
+    equilibrium is not this solver's (its top is held at the chord's end)."""
+    if params.ends.circle_radius_m > 0:
+        raise SceneError(params.name, "ends.circle_radius_m",
+                         f"{params.ends.circle_radius_m:g} > 0: the circle of Eq. (70) moves "
+                         "the top end, so the helix has no relative equilibrium for 'operate': "
+                         "run with --set ends.circle_radius_m=0")
+    if params.lifter.active:
+        raise SceneError(params.name, "lifter.top",
+                         f"{params.lifter.top!r}: 'operate' solves the operating points with "
+                         "the top end held at [ends]' position; set lifter.top = \"fixed\" "
+                         "(--set 'lifter.top=\"fixed\"')")
+
+
 def drive_of(params: Parameters) -> Drive:
     """The rotor's and the generator's laws of the scene (operation/); SceneError where
     the scene has none."""
@@ -178,6 +194,7 @@ def plan(params: Parameters, winds, key: str = "wind_m_s", text: str | None = No
     """The run's :class:`Plan`; SceneError on ``key`` (``text``: the value as given) where
     a wind speed has no operating point inside the rotor's table.  Numpy only."""
     from rawehelix.solvers.operating_point import chord_axis_factor
+    fixed_top(params)
     drive = drive_of(params)
     q = params.normalised()
     hub = hub_speed(params)
