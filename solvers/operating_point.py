@@ -34,7 +34,7 @@ import time
 
 import numpy as np
 
-from rawehelix.solvers.rigid_shaft_branch import Drive, stable
+from rawehelix.solvers.torque_balance import Drive, stable
 
 #: the stationary solves an operating point may take (the issue's cost)
 MAX_SOLVES = 3

@@ -1,15 +1,11 @@
-"""The operating points' torque balance as a problem that the existing pseudo-arclength
-:class:`~rawehelix.periodic_orbits.continuation.Branch` continues, in the wind along the
-rotor's axis V_n [m/s] (Branch's continuation parameter, which it calls ``f1_Hz``).
-
-At a relative equilibrium without the helix's own distributed loss the twist moment is
-constant along s (Eq. 31 with alpha_t uniform and no distributed torque), so the spin
-Omega closes the rigid-shaft balance
+"""The operating points' torque balance (solvers/torque_balance.py) as a problem that
+the existing pseudo-arclength :class:`~rawehelix.periodic_orbits.continuation.Branch`
+continues, in the wind along the rotor's axis V_n [m/s] (Branch's continuation
+parameter, which it calls ``f1_Hz``):
 
     G(Omega, V_n) = [Q(Omega, V_n) - tau_gen(Omega) - L(Omega)] / (GJ / L0) = 0,
 
-Q the rotor's aerodynamic torque, tau_gen the generator's, L the helix's integrated
-spin-drag loss (0 when off), normalised as the rod solvers are (X = Omega t_scale, G in
+normalised as the rod solvers are (X = Omega t_scale, G in
 GJ / L0).  G depends on the rod only through V_n, which the rod's top tangent sets
 (solvers/operating_point.py): continued in V_n, the balance is exact and numpy only.
 A generator that holds its speed (the paper's Eq. 40 with its integral action) has
@@ -30,12 +26,11 @@ import math
 import time
 
 import numpy as np
-import scipy.optimize
 
 from rawehelix.errors import SolverError
-from rawehelix.operation.rotor import OutOfTable
 from rawehelix.periodic_orbits.continuation import StepGuard
 from rawehelix.periodic_orbits.problem import DenseLU
+from rawehelix.solvers.torque_balance import Drive, OutsideTable, stable
 
 #: the speeds V_n inside a window where branches are also sought (their roots not yet
 #: traced): a branch that begins inside the window (a fold, the table's edge) is found
@@ -43,107 +38,6 @@ from rawehelix.periodic_orbits.problem import DenseLU
 SEEDS = 24
 #: the largest relative change of Omega between two points of a branch (SpinStep)
 MAX_SPIN_STEP = 0.05
-#: the roots are bracketed on this many spins between two adjacent rows of the table
-SAMPLES = 64
-#: ... a hair inside the table's ends (relative), so that round-off in Omega R / V_n
-#: does not step outside it
-ROUND_OFF = 1e-12
-#: the scalar Newton at fixed V_n stops at |G| below this (normalised torque)
-TOL = 1e-12
-
-
-class OutsideTable(SolverError):
-    """The balance asked the rotor's table for a tip-speed ratio it does not have."""
-
-
-@dataclasses.dataclass(frozen=True)
-class Drive:
-    """What turns the helix: the rotor's and the generator's laws (operation/rotor.py,
-    operation/generator.py), the air density [kg/m^3] and the helix's spin-drag loss (an
-    object with ``torque(Omega)`` and ``dtorque_domega(Omega)`` [N m], None: off)."""
-
-    rotor: object  # operation.rotor.RotorLaw
-    generator: object  # operation.generator.GeneratorLaw
-    rho_kg_m3: float
-    loss: object = None
-
-    def __post_init__(self):
-        if not self.rho_kg_m3 > 0:
-            raise ValueError(f"Drive: air density {self.rho_kg_m3!r} must be > 0 kg/m^3")
-
-    def held_speed(self) -> float | None:
-        """The spin [rad/s] the generator holds (Eq. 40's integral action), or None."""
-        return self.generator.holds_speed
-
-    def loss_Nm(self, omega: float) -> float:
-        return 0.0 if self.loss is None else float(self.loss.torque(omega))
-
-    def rotor_torque(self, omega: float, v_n: float) -> float:
-        """Q = 1/2 rho pi R^2 V_n^3 Cp(lambda) / Omega [N m] (the rotor's law); a ratio
-        outside its table raises :class:`OutsideTable`."""
-        try:
-            return float(self.rotor.torque(omega, v_n, self.rho_kg_m3))
-        except OutOfTable as err:
-            raise OutsideTable(str(err)) from None
-
-    def balance_Nm(self, omega: float, v_n: float) -> float:
-        """Q - tau_gen - L [N m] at Omega [rad/s], V_n [m/s] (rigid shaft)."""
-        return self.rotor_torque(omega, v_n) - self.generator.torque(omega) - self.loss_Nm(omega)
-
-    def slope_Nm_s(self, omega: float, v_n: float) -> float:
-        """d(Q - tau_gen - L)/dOmega [N m s]: the rigid torsional mode's stiffness, < 0
-        where it is stable; the paper's law holding the speed contributes its speed gain
-        K2 (operation/rigid_shaft.py)."""
-        try:
-            dQ = float(self.rotor.dtorque_domega(omega, v_n, self.rho_kg_m3))
-        except OutOfTable as err:
-            raise OutsideTable(str(err)) from None
-        dL = 0.0 if self.loss is None else float(self.loss.dtorque_domega(omega))
-        if self.held_speed() is not None:
-            return dQ - dL - self.generator.K2
-        return dQ - float(self.generator.dtorque_domega(omega)) - dL
-
-    def roots(self, v_n: float) -> list[float]:
-        """Every spin [rad/s] where the balance holds at V_n with its tip-speed ratio
-        inside the table (a hair, ROUND_OFF, inside its ends), ascending: sign changes on
-        SAMPLES spins between adjacent rows, each refined by Brent's method.  The held
-        speed of a generator that holds one, where the table has it."""
-        lam = np.asarray(self.rotor.table_tsr, dtype=float)
-        lam = np.clip(lam, lam[0] * (1 + ROUND_OFF), lam[-1] * (1 - ROUND_OFF))
-        R = self.rotor.radius_m
-        held = self.held_speed()
-        if held is not None:
-            return [held] if lam[0] <= held * R / v_n <= lam[-1] else []
-        w = np.unique(np.concatenate([np.linspace(a, b, SAMPLES + 1)
-                                      for a, b in zip(lam[:-1], lam[1:])])) * v_n / R
-        w = w[w > 0]
-        g = (np.asarray(self.rotor.torque(w, v_n, self.rho_kg_m3), dtype=float)
-             - np.asarray(self.generator.torque(w), dtype=float)
-             - (0.0 if self.loss is None else np.asarray(self.loss.torque(w), dtype=float)))
-        out = [float(x) for x, y in zip(w, g) if y == 0.0]
-        for k in np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0):
-            out.append(float(scipy.optimize.brentq(self.balance_Nm, w[k], w[k + 1], args=(v_n,),
-                                                   xtol=1e-14, rtol=4 * np.finfo(float).eps)))
-        return sorted(out)
-
-    def root_near(self, omega: float, v_n: float) -> float:
-        """The root of the balance at V_n nearest ``omega`` by Newton (the held speed for
-        a generator that holds one); SolverError if it does not converge."""
-        held = self.held_speed()
-        if held is not None:
-            self.rotor_torque(held, v_n)  # OutsideTable where the table has no such ratio
-            return held
-        x = omega
-        for _ in range(50):
-            g = self.balance_Nm(x, v_n)
-            if abs(g) <= TOL * max(1.0, abs(self.rotor_torque(x, v_n))):
-                return x
-            step = g / self.slope_Nm_s(x, v_n)
-            x = x - step
-            if abs(step) <= 1e-15 * abs(x):
-                return x
-        raise SolverError(f"the torque balance at V_n = {v_n:.6g} m/s did not converge from "
-                          f"{omega:.6g} rad/s")
 
 
 class SpinStep(StepGuard):
@@ -158,15 +52,6 @@ class SpinStep(StepGuard):
             return None
         change = abs(float(X[0]) - float(prev.X[0])) / max(abs(float(prev.X[0])), 1e-300)
         return None if change <= MAX_SPIN_STEP else 0.5
-
-
-def stable(slope_Nm_s: float, eigenvalues=None) -> bool:
-    """Whether an operating point is stable: every eigenvalue of the linearisation
-    about it in the left half plane where they are given (the full linearisation), else
-    the rigid torsional mode's d(Q - tau_gen - L)/dOmega < 0."""
-    if eigenvalues is not None and len(eigenvalues):
-        return bool(np.all(np.real(eigenvalues) < 0))
-    return bool(slope_Nm_s < 0)
 
 
 @dataclasses.dataclass
@@ -313,8 +198,7 @@ class Segment:
         if not self.covers(v_n):
             raise OutsideTable(f"the branch {self.index} has no operating point at V_n = "
                                f"{v_n:.6g} m/s (it spans {self.v_n[0]:.6g} .. {self.v_n[-1]:.6g})")
-        lam_lo, lam_hi = drive.rotor.tsr_range  # the spins the table has at v_n
-        w_lo, w_hi = (x * v_n / drive.rotor.radius_m for x in (lam_lo, lam_hi))
+        w_lo, w_hi = drive.omega_range(v_n)
         guess = float(np.clip(np.interp(v_n, self.v_n, self.omega), w_lo, w_hi))
         if drive.held_speed() is not None:
             return drive.root_near(guess, v_n)
@@ -323,16 +207,7 @@ class Segment:
         if a < b:  # the root at v_n lies between the neighbours' roots (a graph)
             ga, gb = drive.balance_Nm(a, v_n), drive.balance_Nm(b, v_n)
             if ga * gb <= 0:
-                return float(scipy.optimize.brentq(drive.balance_Nm, a, b, args=(v_n,),
-                                                   xtol=1e-14, rtol=4 * np.finfo(float).eps))
-        return drive.root_near(guess, v_n)
-        k = int(np.clip(np.searchsorted(self.v_n, v_n), 1, self.v_n.size - 1))
-        a, b = sorted((self.omega[k - 1], self.omega[k]))
-        if a < b:  # widen by the step: the root at v_n lies between the neighbours' roots
-            ga, gb = drive.balance_Nm(a, v_n), drive.balance_Nm(b, v_n)
-            if ga * gb < 0:
-                return float(scipy.optimize.brentq(drive.balance_Nm, a, b, args=(v_n,),
-                                                   xtol=1e-14, rtol=4 * np.finfo(float).eps))
+                return drive.bracketed(a, b, v_n)
         return drive.root_near(guess, v_n)
 
 

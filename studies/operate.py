@@ -31,7 +31,8 @@ from rawehelix.operation.rotor import RPM  # rad/s per rpm
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.operating_point import OperatingPointSolver
 from rawehelix.solvers.stationary import SlackError
-from rawehelix.solvers.rigid_shaft_branch import Drive, OutsideTable, RigidShaftProblem, trace
+from rawehelix.solvers.rigid_shaft_branch import RigidShaftProblem, trace
+from rawehelix.solvers.torque_balance import Drive, OutsideTable
 from rawehelix.studies.analysis import structure_limits
 from rawehelix.studies.store import writers
 

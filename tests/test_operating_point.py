@@ -27,7 +27,8 @@ from mpi4py import MPI
 from rawehelix.operation.generator import GeneratorLaw
 from rawehelix.operation.rotor import RotorLaw
 from rawehelix.solvers.operating_point import MAX_SOLVES, OperatingPointSolver
-from rawehelix.solvers.rigid_shaft_branch import Drive, RigidShaftProblem, stable, trace
+from rawehelix.solvers.rigid_shaft_branch import RigidShaftProblem, trace
+from rawehelix.solvers.torque_balance import Drive, stable
 from rawehelix.studies import scene
 
 RHO, R = 1.225, 1.0
@@ -122,7 +123,6 @@ def test_twist_is_Q_L0_over_GJ_for_the_solid_section(GJ):
 def test_twist_follows_the_members_torque_twist_curve():
     """The tensegrity section carrying the torque (self-stressed, unlaid): the end-to-end
     twist is L0 tau with members.py's Q(eps, 0, tau) = Q at the FE's (uniform) strain."""
-    from rawehelix.solvers.probes import SectionProbe  # noqa: F401
     section = {"law": "tensegrity", "torsion": "members", "self_stress_N": 646.0,
                "bar_EA_N": 2e4}
     p = straight(N=4, model={"kinematics": "extensible"}, section=section)
