@@ -14,7 +14,9 @@ is): its torque is whatever balances Q.
 
 The problem gives Branch what it asks of a periodic-orbit problem (residual, its
 Jacobians in X and V_n, a Newton at fixed V_n, the finished point) and nothing about
-periods: ``resolution`` is 0, there are no samples.  The point's "multiplier" is
+periods: ``resolution`` is 0, and its "samples" are X itself, which the step guard
+:class:`SpinStep` reads.  Branches are sought from both ends of the window and from
+SEEDS speeds inside it (:func:`trace`).  The point's "multiplier" is
 exp(lambda t_scale) of the rigid torsional mode, lambda = dG/dOmega / J (J the rotor's
 spin inertia): 1 at a fold, < 1 where the point is stable.
 """
