@@ -6,7 +6,9 @@ relative equilibrium (Eq. 31 with no distributed torque), so these roots are the
 helix's operating points exactly.  A root is ``stable`` when
 d(Q - tau - loss)/dOmega < 0 there (a faster rotor meets a net braking torque).  The
 paper's law (Eq. 40 with k1 > 0) holds Omega at its target: one point, stable when its
-speed gain K2 exceeds dQ/dOmega - dloss/dOmega.
+speed gain K2 exceeds dQ/dOmega - dloss/dOmega.  Stable here is the rigid shaft's: the
+helix's torsional compliance adds a mode that only the linearisation about the helix's
+relative equilibrium sees.
 
 The roots are bracketed on a grid in Omega (:data:`SAMPLES` intervals between
 adjacent table rows) and refined by bisection to :data:`XTOL` relative: a root of even
