@@ -33,6 +33,7 @@ from rawehelix.solvers.operating_point import OperatingPointSolver
 from rawehelix.solvers.stationary import SlackError
 from rawehelix.solvers.rigid_shaft_branch import RigidShaftProblem, trace
 from rawehelix.solvers.torque_balance import Drive, OutsideTable
+from rawehelix.studies import schemes
 from rawehelix.studies.analysis import structure_limits
 from rawehelix.studies.store import writers
 
@@ -98,6 +99,14 @@ class Operate:
                                        self.params.title or self.params.name)
         writers.write_json(outdir / "summary.json", self.summary)
         return outdir
+
+
+def fe_scheme(params: Parameters) -> None:
+    """SceneError for a scheme without the FE stationary solve (the spline reference)."""
+    if not schemes.of(params).fe_assembled:
+        raise SceneError(params.name, "discretisation.scheme",
+                         f"{params.discretisation.scheme!r}: 'operate' solves the FE rod's "
+                         "relative equilibria; run with --scheme fe")
 
 
 def fixed_top(params: Parameters) -> None:
@@ -195,6 +204,7 @@ def plan(params: Parameters, winds, key: str = "wind_m_s", text: str | None = No
     """The run's :class:`Plan`; SceneError on ``key`` (``text``: the value as given) where
     a wind speed has no operating point inside the rotor's table.  Numpy only."""
     from rawehelix.solvers.operating_point import chord_axis_factor
+    fe_scheme(params)
     fixed_top(params)
     drive = drive_of(params)
     q = params.normalised()

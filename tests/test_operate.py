@@ -136,8 +136,10 @@ def test_bad_wind_exits_2_in_one_line_and_writes_nothing(tmp_path, wind, says):
      "ends.circle_radius_m: 0.1 > 0: the circle of Eq. (70) moves the top end"),
     ({"lifter": {"top": "lifted", "force_N": 500.0}},
      "lifter.top: 'lifted': 'operate' solves the operating points with the top end held"),
+    ({"discretisation": {"scheme": "spline"}},
+     "discretisation.scheme: 'spline': 'operate' solves the FE rod's relative equilibria"),
 ])
-def test_a_top_end_that_is_not_held_is_refused_before_any_work(changes, says):
+def test_what_operate_cannot_solve_is_refused_before_any_work(changes, says):
     p = rh.load_scene("rotor_example", elements=2).replace(**changes)
     with pytest.raises(rh.SceneError, match=says.replace("(", r"\(").replace(")", r"\)")):
         operate.plan(p, [5.0])
