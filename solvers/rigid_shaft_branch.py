@@ -189,6 +189,13 @@ class Segment:
     omega: np.ndarray  # [rad/s] at v_n
     stable: bool
 
+    def __post_init__(self):
+        self.v_n, self.omega = (np.asarray(x, dtype=float) for x in (self.v_n, self.omega))
+        if self.v_n.shape != self.omega.shape or self.v_n.size < 2 or \
+                np.any(np.diff(self.v_n) < 0):
+            raise ValueError(f"Segment {self.index}: V_n must ascend and match Omega, with "
+                             f"two points or more (got {self.v_n.size} and {self.omega.size})")
+
     def covers(self, v_n: float) -> bool:
         return bool(self.v_n[0] <= v_n <= self.v_n[-1])
 

@@ -109,6 +109,18 @@ def fe_scheme(params: Parameters) -> None:
                          "relative equilibria; run with --scheme fe")
 
 
+def elastic_twist(params: Parameters) -> None:
+    """SceneError for a hysteretic torsion: its static twist under a torque depends on
+    how the torque was applied, so a relative equilibrium has no one state."""
+    hysteresis = params.model.torsion_hysteresis
+    if hysteresis.active:
+        raise SceneError(params.name, "torsion_hysteresis.rho",
+                         f"{hysteresis.rho:g} < 1 (hysteretic torsion): the twist under the "
+                         "rotor's torque depends on how the torque was applied, so 'operate' "
+                         "has no one relative equilibrium to give; run with "
+                         "--set torsion_hysteresis.rho=1")
+
+
 def fixed_top(params: Parameters) -> None:
     """SceneError where the top end is not held at [ends]' position: a relative
     equilibrium needs the top still (Eq. 70's circle moves it), and the lifted top's
@@ -205,6 +217,7 @@ def plan(params: Parameters, winds, key: str = "wind_m_s", text: str | None = No
     a wind speed has no operating point inside the rotor's table.  Numpy only."""
     from rawehelix.solvers.operating_point import chord_axis_factor
     fe_scheme(params)
+    elastic_twist(params)
     fixed_top(params)
     drive = drive_of(params)
     q = params.normalised()

@@ -136,6 +136,8 @@ def test_bad_wind_exits_2_in_one_line_and_writes_nothing(tmp_path, wind, says):
      "ends.circle_radius_m: 0.1 > 0: the circle of Eq. (70) moves the top end"),
     ({"lifter": {"top": "lifted", "force_N": 500.0}},
      "lifter.top: 'lifted': 'operate' solves the operating points with the top end held"),
+    ({"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 0.5}},
+     "torsion_hysteresis.rho: 0.5 < 1 (hysteretic torsion)"),
     ({"discretisation": {"scheme": "spline"}},
      "discretisation.scheme: 'spline': 'operate' solves the FE rod's relative equilibria"),
 ])
