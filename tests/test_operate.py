@@ -145,3 +145,27 @@ def test_what_operate_cannot_solve_is_refused_before_any_work(changes, says):
     p = rh.load_scene("rotor_example", elements=2).replace(**changes)
     with pytest.raises(rh.SceneError, match=says.replace("(", r"\(").replace(")", r"\)")):
         operate.plan(p, [5.0])
+
+
+def test_the_figure_names_the_branches_the_fold_and_the_first_limit(tmp_path, monkeypatch):
+    """power_curve.png from a summary with a stable and an unstable branch: each branch
+    in the legend once, the unstable one dashed, the fold and the first limit drawn."""
+    from rawehelix.studies.present import operate_figure
+    from rawehelix.studies.store import writers
+    kept = {}
+    finish = writers._finish
+    monkeypatch.setattr(writers, "_finish",
+                        lambda fig, path, title: kept.setdefault("fig", fig) and finish(fig, path, title))
+    s = json.loads((Path(rh.__file__).parent / "docs" / "operate" / "torque_N8" /
+                    "summary.json").read_text())
+    s["folds"][0]["wind_m_s"] = 7.0  # inside the plotted winds
+    operate_figure.power_curve_png(tmp_path / "p.png", s, "t")
+    top = kept["fig"].axes[0]
+    labels = top.get_legend_handles_labels()[1]
+    assert labels == ["branch 0", "branch 1", "fold", "unstable (dashed)"]
+    styles = {line.get_label(): line.get_linestyle() for line in top.lines}
+    assert styles["branch 0"] == "-" and styles["branch 1"] == "--"
+    assert any(abs(line.get_xdata()[0] - 11.0) < 1e-12 and line.get_linestyle() == ":"
+               for line in top.lines)  # the first limit's wind speed
+    assert any("first limit: slack" in t.get_text() for t in top.texts)
+    assert (tmp_path / "p.png").stat().st_size > 10_000
