@@ -73,6 +73,10 @@ FAULTS = [
       "--set", "generator.torque_Nm=500", "--set", "generator.mppt_gain_Nms2=0"], 2,
      "wind.speed_m_s: 6.6131 m/s (V_n = 4.676 m/s along the rotor's axis) gives the rotor no "
      "stable operating point"),
+    # issue 43: operate's wind speeds and a scene without a rotor
+    (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
+    (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
+     "rotor: 'operate' needs a [rotor] section"),
 ]
 
 
