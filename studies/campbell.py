@@ -1,0 +1,229 @@
+"""`rawehelix campbell SCENE --wind LO:HI:STEP`: the Campbell diagram of the helix about
+its operating points (issue 43, part 3).
+
+For each wind speed (at the wind's reference height):
+
+1. the operating points of the rotor and the generator: every root of the rigid shaft's
+   Q(Omega, V_n) = tau(Omega) (operation/rigid_shaft.py).  Without the helix's own
+   spin-drag loss the twist moment is constant along s at a relative equilibrium
+   (Eq. 31 with no distributed torque), so these are the helix's operating points exactly;
+   the helix's shape is the stationary state under that end torque, the ground's twist
+   held (solvers/stationary.py ``set_end_torques``);
+2. the modes about it (solvers/spin_modes.py): the rod's F linearised at U = that state,
+   V = (0, Omega) in the twist, A = 0, with the rotor's spin inertia and aerodynamic
+   damping -dQ/dOmega at the top's twist, the generator's dtau/dOmega (or Eq. 40's k1, k2)
+   at the ground's; the lowest ``per_family`` modes of each family, their frequencies [Hz]
+   and damping ratios, and the point's stability (max Re lambda);
+3. along each branch (the k-th root at each wind), every crossing of the 1P, 2P and BP
+   lines (B = rotor.blades) with a mode (studies/campbell_lines.py).
+
+V_n, the wind along the rotor's axis: axis "wind" takes the hub's wind; axis "tangent"
+its component along the helix's end tangent, here of the torque-free stationary state
+at that wind (the fixed top's shape barely moves with the torque).  Computing writes
+nothing; :meth:`CampbellResult.write` writes summary.json and campbell.png.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from rawehelix.errors import SceneError
+from rawehelix.parameters import Parameters
+from rawehelix.solvers.spin_modes import (EndLoads, RelativeEquilibrium, SpinModalSolver,
+                                          damping_ratio, frequency_Hz)
+from rawehelix.solvers.stationary import StationarySolver
+from rawehelix.studies import campbell_lines
+
+PER_FAMILY = 2  # modes of each family followed across the operating points
+
+
+@dataclass
+class CampbellPoint:
+    """One operating point and its modes, in SI."""
+
+    wind_m_s: float  # at the wind's reference height
+    branch: int  # the k-th operating point at this wind, by rotor speed
+    rotor_rpm: float
+    wind_normal_m_s: float  # V_n along the rotor's axis
+    torque_Nm: float  # the twist moment, constant along s: Q = tau
+    loads: EndLoads
+    stable: bool
+    max_real_part_per_s: float
+    modes: list = field(default_factory=list)  # dicts: family, index, frequency_Hz, ...
+
+    def entry(self) -> dict:
+        return {"wind_m_s": self.wind_m_s, "branch": self.branch, "rotor_rpm": self.rotor_rpm,
+                "wind_normal_m_s": self.wind_normal_m_s, "torque_Nm": self.torque_Nm,
+                "rotor_dtorque_domega_Nms": self.loads.rotor_dtorque_domega_Nms,
+                "generator_dtorque_domega_Nms": self.loads.generator_dtorque_domega_Nms,
+                "stable": self.stable, "max_real_part_per_s": self.max_real_part_per_s,
+                "modes": self.modes}
+
+
+@dataclass
+class CampbellResult:
+    scene: str
+    title: str
+    blades: int
+    points: list
+    crossings: list
+    elements: int
+    wall_s: float
+    envelope: dict | None = None  # an envelope summary: the forced helix's slack band
+
+    @property
+    def summary(self) -> dict:
+        bands = campbell_lines.slack_bands_Hz(self.envelope) if self.envelope else []
+        crossings = [{**c, "in_slack_band": any(lo <= c["frequency_Hz"] <= hi
+                                                for lo, hi in bands)} if self.envelope else c
+                     for c in self.crossings]
+        return {"scene": self.scene, "elements": self.elements, "blades": self.blades,
+                "lines": [campbell_lines.line_name(n) for n in campbell_lines.orders(self.blades)],
+                "points": [p.entry() for p in self.points], "crossings": crossings,
+                "slack_bands_Hz": bands, "wall_s": self.wall_s}
+
+    def write(self, outdir) -> Path:
+        from rawehelix.studies.present.campbell_figure import campbell_png
+        from rawehelix.studies.store import writers
+        outdir = Path(outdir)
+        outdir.mkdir(parents=True, exist_ok=True)
+        summary = self.summary
+        writers.write_json(outdir / "summary.json", summary)
+        campbell_png(outdir / "campbell.png", summary, self.title)
+        return outdir
+
+
+def mode_entries(solver: SpinModalSolver, modes, per_family: int) -> list[dict]:
+    """The lowest ``per_family`` oscillating modes of each family, by frequency."""
+    out, seen = [], {}
+    for m in sorted(modes, key=lambda m: abs(m.eigenvalue.imag)):
+        if m.family not in solver.families or m.eigenvalue.imag == 0:
+            continue
+        k = seen.get(m.family, 0)
+        if k >= per_family:
+            continue
+        seen[m.family] = k + 1
+        lam = m.eigenvalue / solver.q.t_scale
+        out.append({"family": m.family, "index": k, "frequency_Hz": frequency_Hz(m, solver.q),
+                    "damping_ratio": damping_ratio(m),
+                    "eigenvalue_per_s": [lam.real, lam.imag]})
+    return out
+
+
+def point_modes(params: Parameters, omega_rad_s: float, torque_Nm: float, loads: EndLoads,
+                comm=MPI.COMM_SELF, per_family: int = PER_FAMILY, scene: str = "scene"):
+    """(solver, modes) about the relative equilibrium of spin ``omega_rad_s`` under the
+    end torque ``torque_Nm`` (both ends, Eqs. 38-39) with the end ``loads``."""
+    stationary = StationarySolver(params, comm, scene=scene)
+    m = torque_Nm / stationary.rod.q.torque_scale
+    stationary.set_end_torques(ground=m, top=m)
+    state = stationary.solve().state
+    solver = SpinModalSolver(params, comm, scene=scene, rod=stationary.rod)
+    solver.linearise_at(RelativeEquilibrium(state, omega_rad_s, loads))
+    return solver, solver.solve(per_family=per_family, keep_vectors=False,
+                                require_families=False)
+
+
+def at_wind(params: Parameters, wind_m_s: float) -> Parameters:
+    """The scene at the wind ``wind_m_s`` (its [wind] section's reference speed, or the
+    paper's uniform environment.wind_speed_m_s)."""
+    if params.wind.active:
+        return params.replace(wind={"speed_m_s": float(wind_m_s)})
+    return params.replace(environment={"wind_speed_m_s": float(wind_m_s)})
+
+
+def end_tangent(params: Parameters, comm) -> np.ndarray:
+    """The helix's unit tangent at the top of the torque-free stationary state (a
+    quadratic through the last three nodes: O(h^2))."""
+    result = StationarySolver(params, comm).solve()
+    tangent = None
+    if comm.rank == 0:
+        s, x = result.s, result.centre_line
+        order = np.argsort(s)
+        s, x = s[order][-3:], x[order][-3:]
+        coeffs = [np.polyfit(s, x[:, i], 2) for i in range(3)]
+        t = np.array([np.polyval(np.polyder(c), 1.0) for c in coeffs])
+        tangent = t / np.linalg.norm(t)
+    return comm.bcast(tangent, root=0)
+
+
+def end_loads(params: Parameters, rotor, generator, omega, v_n, rho) -> EndLoads:
+    """The rotor's and the generator's linearised laws at the point."""
+    speed_held = generator is not None and generator.holds_speed is not None
+    dtau = 0.0 if generator is None or speed_held else float(generator.dtorque_domega(omega))
+    c = params.controller
+    return EndLoads(rotor_inertia_kgm2=rotor.spin_inertia_kgm2,
+                    rotor_dtorque_domega_Nms=float(rotor.dtorque_domega(omega, v_n, rho)),
+                    generator_dtorque_domega_Nms=dtau,
+                    k1=c.k1 if speed_held else 0.0, k2=c.k2 if speed_held else 0.0)
+
+
+def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER_FAMILY,
+            envelope: dict | None = None, progress=None) -> CampbellResult:
+    """The Campbell diagram over ``winds`` [m/s] (module docstring)."""
+    from rawehelix.operation import generator as generator_law
+    from rawehelix.operation import rigid_shaft, rotor as rotor_law, wind as wind_law
+    start = time.perf_counter()
+    rotor = rotor_law.from_params(params)
+    if rotor is None:
+        raise SceneError("[rotor]", "absent", "campbell needs the scene's rotor (radius_m, "
+                         "spin_inertia_kgm2, blades, table): see studies/scenes/example.toml")
+    generator = generator_law.from_params(params)
+    rho = wind_law.air_density(params)
+    points = []
+    for wind in winds:
+        p = at_wind(params, wind)
+        v_hub = wind_law.from_params(p).hub_speed
+        v_n = float(rotor.normal_speed(v_hub, end_tangent(p, comm)
+                                       if rotor.axis == "tangent" else None))
+        for branch, op in enumerate(rigid_shaft.operating_points(rotor, generator, v_n, rho)):
+            loads = end_loads(p, rotor, generator, op.omega_rad_s, v_n, rho)
+            solver, modes = point_modes(p, op.omega_rad_s, op.rotor_torque_Nm, loads, comm,
+                                        per_family, scene=params.name)
+            points.append(CampbellPoint(
+                wind_m_s=float(wind), branch=branch, rotor_rpm=op.rotor_rpm,
+                wind_normal_m_s=v_n, torque_Nm=op.rotor_torque_Nm, loads=loads,
+                stable=solver.stable(modes), max_real_part_per_s=solver.max_real_part(modes),
+                modes=mode_entries(solver, modes, per_family)))
+            if progress is not None:
+                progress(points[-1])
+    return CampbellResult(scene=params.name, title=params.title or params.name,
+                          blades=rotor.blades, points=points,
+                          crossings=campbell_lines.crossings(tracks(points), rotor.blades),
+                          elements=params.discretisation.elements,
+                          wall_s=time.perf_counter() - start, envelope=envelope)
+
+
+def tracks(points: list[CampbellPoint]) -> dict:
+    """{(branch, family, index): [(rotor_rpm, frequency_Hz, wind_m_s)]}: each mode along
+    its branch."""
+    out = {}
+    for p in points:
+        for m in p.modes:
+            out.setdefault((p.branch, m["family"], m["index"]), []).append(
+                (p.rotor_rpm, m["frequency_Hz"], p.wind_m_s))
+    return out
+
+
+def report(result: CampbellResult) -> str:
+    """The table ``rawehelix campbell`` prints."""
+    lines = [f"{result.title}: {len(result.points)} operating points, "
+             f"{len(result.crossings)} crossings of the {', '.join(result.summary['lines'])} lines"]
+    for p in result.points:
+        lowest = {}
+        for m in p.modes:
+            lowest.setdefault(m["family"], m["frequency_Hz"])
+        modes = ", ".join(f"{k} {v:.3g} Hz" for k, v in lowest.items())
+        lines.append(f"  V = {p.wind_m_s:6.2f} m/s  branch {p.branch}  {p.rotor_rpm:8.2f} rpm  "
+                     f"{'stable  ' if p.stable else 'UNSTABLE'}  max Re {p.max_real_part_per_s:+.3g}"
+                     f" /s  {modes}")
+    for c in result.crossings:
+        lines.append(f"  crossing {c['line']:>3} x {c['family']} {c['mode']}: "
+                     f"{c['frequency_Hz']:.4g} Hz at {c['rotor_rpm']:.2f} rpm, "
+                     f"V = {c['wind_m_s']:.3g} m/s")
+    return "\n".join(lines)

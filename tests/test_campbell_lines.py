@@ -1,0 +1,59 @@
+"""The Campbell diagram's lines and crossings (studies/campbell_lines.py) against closed
+forms, and its figure from a summary."""
+
+import json
+
+import pytest
+
+from rawehelix.studies import campbell_lines
+from rawehelix.studies.present.campbell_figure import campbell_png
+
+
+def test_orders_hold_each_line_once():
+    assert campbell_lines.orders(3) == (1, 2, 3)
+    assert campbell_lines.orders(2) == (1, 2)
+    assert campbell_lines.orders(1) == (1, 2)
+    with pytest.raises(ValueError, match="rotor.blades"):
+        campbell_lines.orders(0)
+
+
+def test_crossings_of_linear_modes_are_exact():
+    """A mode f = a + b rpm (Hz) meets the line n rpm / 60 at rpm = a / (n/60 - b): linear
+    interpolation is exact for it; the wind interpolates the same way."""
+    a, b = 3.0, 0.01
+    rpm = [0.0, 40.0, 80.0, 120.0, 160.0]
+    wind = [2.0 + 0.05 * r for r in rpm]
+    track = [(r, a + b * r, v) for r, v in zip(rpm, wind)]
+    found = campbell_lines.crossings({(0, "lateral_in_plane", 0): track[::-1]}, blades=3)
+    expected = {f"{n}P": a / (n / 60 - b) for n in (1, 2, 3)}
+    expected = {k: r for k, r in expected.items() if 0 <= r <= 160}
+    assert {c["line"] for c in found} == set(expected) == {"2P", "3P"}
+    for c in found:
+        r = expected[c["line"]]
+        assert c["rotor_rpm"] == pytest.approx(r, rel=1e-12)
+        assert c["frequency_Hz"] == pytest.approx(a + b * r, rel=1e-12)
+        assert c["wind_m_s"] == pytest.approx(2.0 + 0.05 * r, rel=1e-12)
+        assert (c["family"], c["mode"], c["branch"]) == ("lateral_in_plane", 1, 0)
+
+
+def test_a_mode_above_every_line_has_no_crossing():
+    track = [(r, 50.0 + r, 5.0) for r in (10.0, 20.0, 30.0)]
+    assert campbell_lines.crossings({(0, "torsional", 0): track}, blades=3) == []
+
+
+def test_slack_band_from_an_envelope_summary():
+    envelope = {"ticks": [{"branch": [{"f1_Hz": 0.8, "first_limit": None},
+                                      {"f1_Hz": 0.9, "first_limit": "slack"},
+                                      {"f1_Hz": 1.0, "first_limit": {"kind": "slack"}},
+                                      {"f1_Hz": 1.1, "first_limit": "moment_saturation"}]}]}
+    assert campbell_lines.slack_bands_Hz(envelope) == [(0.9, 1.0)]
+
+
+def test_figure_from_a_summary(tmp_path):
+    summary = {"lines": ["1P", "2P", "3P"], "slack_bands_Hz": [(0.9, 1.0)],
+               "points": [{"rotor_rpm": r, "branch": 0, "stable": r < 100, "modes": [
+                   {"family": "lateral_in_plane", "index": 0, "frequency_Hz": 3 + 0.01 * r}]}
+                   for r in (40.0, 80.0, 120.0)],
+               "crossings": [{"rotor_rpm": 100.0, "frequency_Hz": 4.0, "line": "3P"}]}
+    path = campbell_png(tmp_path / "campbell.png", json.loads(json.dumps(summary)), "t")
+    assert path.stat().st_size > 1000
