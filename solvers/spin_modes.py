@@ -60,6 +60,21 @@ class EndLoads:
             if getattr(self, name) < 0:
                 raise ParameterError(f"end loads {name}", getattr(self, name), "must be >= 0")
 
+    @classmethod
+    def of_laws(cls, rotor, generator, omega_rad_s: float, v_n_m_s: float, rho_kg_m3: float,
+                controller) -> "EndLoads":
+        """The rotor's and the generator's laws (operation/rotor.py, operation/generator.py)
+        linearised at the spin ``omega_rad_s`` and the wind ``v_n_m_s`` along the rotor's
+        axis; ``generator`` None: no ground torque.  The paper's law (Eq. 40 with k1 > 0,
+        ``generator.holds_speed``) enters by the scene's ``controller`` k1 and k2."""
+        held = generator is not None and generator.holds_speed is not None
+        dtau = 0.0 if generator is None or held else float(generator.dtorque_domega(omega_rad_s))
+        return cls(rotor_inertia_kgm2=float(rotor.spin_inertia_kgm2),
+                   rotor_dtorque_domega_Nms=float(rotor.dtorque_domega(omega_rad_s, v_n_m_s,
+                                                                        rho_kg_m3)),
+                   generator_dtorque_domega_Nms=dtau,
+                   k1=controller.k1 if held else 0.0, k2=controller.k2 if held else 0.0)
+
     def normalised(self, q) -> dict:
         """The coefficients of forms/end_loads.py's terms for the groups ``q``."""
         J_rod = rod_polar_inertia_kgm2(q)
@@ -136,7 +151,19 @@ def damping_ratio(mode: Mode) -> float:
 def stability(point: RelativeEquilibrium, solver: SpinModalSolver, per_family: int = 2
               ) -> tuple[bool, float]:
     """(stable, max_real_part [1/s]) of ``point`` on ``solver``'s rod: the lowest
-    ``per_family`` modes of each family and the slow real roots around them."""
+    ``per_family`` modes of each family and the slow real roots around them (the
+    rigid shaft's (Q' - tau') / J among them)."""
     solver.linearise_at(point)
     modes = solver.solve(per_family=per_family, keep_vectors=False, require_families=False)
     return solver.stable(modes), solver.max_real_part(modes)
+
+
+def stability_at(stationary, state: RodState, omega_rad_s: float, loads: EndLoads,
+                 per_family: int = 2) -> tuple[bool, float]:
+    """:func:`stability` of the relative equilibrium a StationarySolver ``stationary`` has
+    just solved (``state``: its result's, under the operating torque) at the spin
+    ``omega_rad_s`` [rad/s] with the end ``loads`` (:meth:`EndLoads.of_laws`): the modal
+    solver is built on the stationary solver's rod."""
+    solver = SpinModalSolver(stationary.params, stationary.rod.comm, stationary.scene,
+                             rod=stationary.rod)
+    return stability(RelativeEquilibrium(state, omega_rad_s, loads), solver, per_family)

@@ -152,17 +152,6 @@ def end_tangent(params: Parameters, comm) -> np.ndarray:
     return comm.bcast(tangent, root=0)
 
 
-def end_loads(params: Parameters, rotor, generator, omega, v_n, rho) -> EndLoads:
-    """The rotor's and the generator's linearised laws at the point."""
-    speed_held = generator is not None and generator.holds_speed is not None
-    dtau = 0.0 if generator is None or speed_held else float(generator.dtorque_domega(omega))
-    c = params.controller
-    return EndLoads(rotor_inertia_kgm2=rotor.spin_inertia_kgm2,
-                    rotor_dtorque_domega_Nms=float(rotor.dtorque_domega(omega, v_n, rho)),
-                    generator_dtorque_domega_Nms=dtau,
-                    k1=c.k1 if speed_held else 0.0, k2=c.k2 if speed_held else 0.0)
-
-
 def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER_FAMILY,
             envelope: dict | None = None, progress=None) -> CampbellResult:
     """The Campbell diagram over ``winds`` [m/s] (module docstring)."""
@@ -182,7 +171,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER
         v_n = float(rotor.normal_speed(v_hub, end_tangent(p, comm)
                                        if rotor.axis == "tangent" else None))
         for branch, op in enumerate(rigid_shaft.operating_points(rotor, generator, v_n, rho)):
-            loads = end_loads(p, rotor, generator, op.omega_rad_s, v_n, rho)
+            loads = EndLoads.of_laws(rotor, generator, op.omega_rad_s, v_n, rho, p.controller)
             solver, modes = point_modes(p, op.omega_rad_s, op.rotor_torque_Nm, loads, comm,
                                         per_family, scene=params.name)
             points.append(CampbellPoint(

@@ -10,7 +10,7 @@ from mpi4py import MPI
 
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.solvers.spin_modes import (EndLoads, RelativeEquilibrium, SpinModalSolver,
-                                          stability)
+                                          stability, stability_at)
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene
 
@@ -23,7 +23,11 @@ def solver_at(N: int, gravity_drag: bool = True):
         p = p.replace(model={"gravity": False, "drag": False})
     stationary = StationarySolver(p, MPI.COMM_SELF)
     result = stationary.solve()
+    solver_at.stationary[N, gravity_drag] = stationary
     return SpinModalSolver(p, MPI.COMM_SELF, rod=stationary.rod), result.state
+
+
+solver_at.stationary = {}
 
 
 def rod_inertia(params) -> float:
@@ -84,6 +88,9 @@ def test_stability_follows_the_net_damping(dQ, dtau):
     rigid = (dQ - dtau) / (J_tip + rod_inertia(solver.params))  # [1/s]
     stable, growth = stability(point, solver)
     assert stable == (rigid < 0)
+    # the same from the stationary solver that found the state (i43-operate's way)
+    assert stability_at(solver_at.stationary[4, True], state, 12.0, point.loads) == \
+        pytest.approx((stable, growth), rel=1e-9, abs=1e-12)
     modes = solver.solve(per_family=2, keep_vectors=False, require_families=False)
     real = [m.eigenvalue.real / solver.q.t_scale for m in modes if m.eigenvalue.imag == 0
             and abs(m.eigenvalue) > 1e-6]
@@ -97,3 +104,36 @@ def test_end_loads_refuse_what_they_cannot_be():
         EndLoads(rotor_inertia_kgm2=-1.0)
     with pytest.raises(ParameterError, match="must be finite"):
         EndLoads(generator_dtorque_domega_Nms=math.nan)
+
+
+class _Rotor:  # the operation.rotor.RotorLaw names the linearisation reads (a stand-in)
+    spin_inertia_kgm2 = 2.5
+
+    @staticmethod
+    def dtorque_domega(omega, v_n, rho):
+        return -0.5 * rho * v_n * omega
+
+
+class _Generator:
+    def __init__(self, holds):
+        self.holds_speed = 12.0 if holds else None
+
+    @staticmethod
+    def dtorque_domega(omega):
+        return 2 * 0.3 * omega  # MPPT k Omega^2, k = 0.3 N m s^2
+
+
+class _Controller:
+    k1, k2 = 4.0, 0.7
+
+
+@pytest.mark.parametrize("holds", [False, True])
+def test_end_loads_of_the_laws(holds):
+    """The rotor's J and dQ/dOmega at (Omega, V_n); the generator's dtau/dOmega, or with
+    the paper's law holding the speed (Eq. 40, k1 > 0) its k1 and k2 instead."""
+    loads = EndLoads.of_laws(_Rotor(), _Generator(holds), 10.0, 8.0, 1.2, _Controller())
+    assert loads.rotor_inertia_kgm2 == 2.5
+    assert loads.rotor_dtorque_domega_Nms == pytest.approx(-0.5 * 1.2 * 8.0 * 10.0)
+    assert loads.generator_dtorque_domega_Nms == (0.0 if holds else pytest.approx(6.0))
+    assert (loads.k1, loads.k2) == ((4.0, 0.7) if holds else (0.0, 0.0))
+    assert EndLoads.of_laws(_Rotor(), None, 10.0, 8.0, 1.2, _Controller()).k1 == 0.0
