@@ -40,6 +40,47 @@ from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import campbell_lines
 
 PER_FAMILY = 2  # modes of each family followed across the operating points
+MAX_WINDS = 2000  # the most wind speeds a run takes (each a few solves and a record)
+
+
+def parse_wind(text: str) -> list[float]:
+    """``--wind LO:HI:STEP`` [m/s] -> the wind speeds, LO to HI inclusive; SceneError
+    on --wind naming what is allowed."""
+    try:
+        lo, hi, step = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise SceneError("--wind", text, "must be LO:HI:STEP in m/s, e.g. 4:16:0.5") from None
+    if not (0 < lo <= hi and step > 0 and np.isfinite(lo + hi + step)):
+        raise SceneError("--wind", text, "must be LO:HI:STEP with 0 < LO <= HI and STEP > 0 "
+                         "(m/s)")
+    count = int(np.floor((hi - lo) / step + 1e-9)) + 1
+    if count > MAX_WINDS:
+        raise SceneError("--wind", text, f"gives {count} wind speeds; at most {MAX_WINDS} "
+                         "(a larger STEP)")
+    return [float(lo + k * step) for k in range(count)]
+
+
+def check_winds(winds) -> list[float]:
+    """The API's ``wind_m_s``: finite, > 0, at most MAX_WINDS; ascending."""
+    w = sorted(float(x) for x in np.atleast_1d(winds))
+    if not w or not all(np.isfinite(x) and x > 0 for x in w) or len(w) > MAX_WINDS:
+        raise SceneError("wind_m_s", str(list(winds)),
+                         f"must be 1 to {MAX_WINDS} finite wind speeds > 0 m/s")
+    return w
+
+
+def read_envelope(folder) -> dict:
+    """The summary of an ``envelope`` run's output folder; SceneError on --envelope."""
+    import json
+    path = Path(folder) / "summary.json"
+    try:
+        summary = json.loads(path.read_text())
+    except (OSError, ValueError):
+        summary = None
+    if not isinstance(summary, dict) or not isinstance(summary.get("ticks"), list):
+        raise SceneError("--envelope", str(folder), "must be the output folder of a finished "
+                         "'rawehelix envelope' run (its summary.json with 'ticks')")
+    return summary
 
 
 @dataclass
