@@ -86,9 +86,6 @@ class ModalSolver:
     ends : the end components' lumped terms (forms/end_loads.py), or None.
     """
 
-    #: the twist's least kinetic-energy fraction in a zero eigenvalue (the rigid rotation)
-    RIGID_FRACTION = 0.99
-
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
                  rod: RodDiscretisation | None = None, ends=None):
         self.params, self.comm, self.scene = params, comm, scene
@@ -239,7 +236,7 @@ class ModalSolver:
                 continue  # the conjugate of a mode kept
             fractions, comps = self.classifier.energy_fractions(xr, xi)
             if abs(lam) < zero_abs:
-                if fractions["torsional"] < self.RIGID_FRACTION:
+                if not self.is_rigid_rotation(fractions):
                     raise SolverError(f"{self.scene}: a zero eigenvalue {lam:.3e} that is not a "
                                       f"rigid rotation (fractions {fractions})")
                 if rigid is not None:
@@ -261,6 +258,11 @@ class ModalSolver:
         return modes
 
     # -- classification and checks ------------------------------------------------------
+    def is_rigid_rotation(self, fractions: dict) -> bool:
+        """A zero eigenvalue is the rigid rotation alpha = const: its vector's kinetic
+        energy is the twist's."""
+        return fractions["torsional"] >= 0.99
+
     def block_residuals(self, lam: complex, xr, xi) -> dict:
         return self.classifier.block_residuals(lam, xr, xi)
 

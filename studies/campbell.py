@@ -125,8 +125,10 @@ class CampbellResult:
                      for c in self.crossings]
         return {"scene": self.scene, "elements": self.elements, "blades": self.blades,
                 "lines": [campbell_lines.line_name(n) for n in campbell_lines.orders(self.blades)],
-                "points": [p.entry() for p in self.points], "crossings": crossings,
-                "slack_bands_Hz": bands, "wall_s": self.wall_s}
+                "points": [p.entry() for p in self.points],
+                "tracks": [{"branch": b, "family": f, "points": [list(x) for x in sorted(t)]}
+                           for (b, f, _), t in tracks(self.points).items()],
+                "crossings": crossings, "slack_bands_Hz": bands, "wall_s": self.wall_s}
 
     def write(self, outdir) -> Path:
         from rawehelix.studies.present.campbell_figure import campbell_png
@@ -230,14 +232,15 @@ def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER
 
 
 def tracks(points: list[CampbellPoint]) -> dict:
-    """{(branch, family, index): [(rotor_rpm, frequency_Hz, wind_m_s)]}: each mode along
-    its branch."""
-    out = {}
+    """{(branch, family, track): [(rotor_rpm, frequency_Hz, wind_m_s, index)]}: each mode
+    followed along its branch by its frequency (campbell_lines.follow)."""
+    by = {}
     for p in points:
-        for m in p.modes:
-            out.setdefault((p.branch, m["family"], m["index"]), []).append(
-                (p.rotor_rpm, m["frequency_Hz"], p.wind_m_s))
-    return out
+        for family in {m["family"] for m in p.modes}:
+            freqs = [m["frequency_Hz"] for m in p.modes if m["family"] == family]
+            by.setdefault((p.branch, family), []).append((p.rotor_rpm, p.wind_m_s, freqs))
+    return {(branch, family, k): track for (branch, family), pts in by.items()
+            for k, track in enumerate(campbell_lines.follow(pts))}
 
 
 def report(result: CampbellResult) -> str:

@@ -23,7 +23,7 @@ def test_crossings_of_linear_modes_are_exact():
     a, b = 3.0, 0.01
     rpm = [0.0, 40.0, 80.0, 120.0, 160.0]
     wind = [2.0 + 0.05 * r for r in rpm]
-    track = [(r, a + b * r, v) for r, v in zip(rpm, wind)]
+    track = [(r, a + b * r, v, 0) for r, v in zip(rpm, wind)]
     found = campbell_lines.crossings({(0, "lateral_in_plane", 0): track[::-1]}, blades=3)
     expected = {f"{n}P": a / (n / 60 - b) for n in (1, 2, 3)}
     expected = {k: r for k, r in expected.items() if 0 <= r <= 160}
@@ -37,8 +37,23 @@ def test_crossings_of_linear_modes_are_exact():
 
 
 def test_a_mode_above_every_line_has_no_crossing():
-    track = [(r, 50.0 + r, 5.0) for r in (10.0, 20.0, 30.0)]
+    track = [(r, 50.0 + r, 5.0, 0) for r in (10.0, 20.0, 30.0)]
     assert campbell_lines.crossings({(0, "torsional", 0): track}, blades=3) == []
+
+
+def test_a_mode_that_appears_starts_its_own_track():
+    """rotor_example's torsional family at N = 4: at 54 rpm the slow mode is overdamped
+    (2.51, 4.96 Hz oscillate); from 72 rpm it oscillates at 0.30-0.41 Hz below the 2.5 Hz
+    mode.  The 2.5 Hz mode keeps its track (its rank changes from 1st to 2nd), the slow
+    one starts a new track, and no crossing joins 2.51 Hz to 0.30 Hz."""
+    points = [(54.3, 3.0, [2.511, 4.955]), (72.4, 4.0, [0.302, 2.529]),
+              (90.4, 5.0, [0.373, 2.531])]
+    tracks = campbell_lines.follow(points)
+    assert [[(r, f, k) for r, f, _, k in t] for t in tracks] == [
+        [(54.3, 2.511, 0), (72.4, 2.529, 1), (90.4, 2.531, 1)], [(54.3, 4.955, 1)],
+        [(72.4, 0.302, 0), (90.4, 0.373, 0)]]
+    found = campbell_lines.crossings({(0, "torsional", k): t for k, t in enumerate(tracks)}, 3)
+    assert all(c["frequency_Hz"] > 2.4 or c["rotor_rpm"] >= 72.4 for c in found), found
 
 
 def test_slack_band_from_an_envelope_summary():
@@ -51,9 +66,10 @@ def test_slack_band_from_an_envelope_summary():
 
 def test_figure_from_a_summary(tmp_path):
     summary = {"lines": ["1P", "2P", "3P"], "slack_bands_Hz": [(0.9, 1.0)],
-               "points": [{"rotor_rpm": r, "branch": 0, "stable": r < 100, "modes": [
-                   {"family": "lateral_in_plane", "index": 0, "frequency_Hz": 3 + 0.01 * r}]}
-                   for r in (40.0, 80.0, 120.0)],
+               "points": [{"rotor_rpm": r, "branch": 0, "stable": r < 100}
+                          for r in (40.0, 80.0, 120.0)],
+               "tracks": [{"branch": 0, "family": "lateral_in_plane",
+                           "points": [[r, 3 + 0.01 * r, 5.0, 0] for r in (40.0, 80.0, 120.0)]}],
                "crossings": [{"rotor_rpm": 100.0, "frequency_Hz": 4.0, "line": "3P"}]}
     path = campbell_png(tmp_path / "campbell.png", json.loads(json.dumps(summary)), "t")
     assert path.stat().st_size > 1000

@@ -26,39 +26,44 @@ def campbell_png(path: Path, summary: dict, title: str) -> Path:
 
 
 def draw(ax, summary: dict):
+    """Each track of summary["tracks"] ([rotor_rpm, frequency_Hz, wind_m_s, index] along
+    a branch), crosses at its unstable points, the lines, crossings and slack bands."""
     points = summary["points"]
-    rpm = np.array([p["rotor_rpm"] for p in points]) if points else np.zeros(1)
-    top_rpm = float(rpm.max()) * 1.05 if rpm.max() > 0 else 1.0
+    top_rpm = 1.05 * max([p["rotor_rpm"] for p in points] + [1e-9])
+    unstable = {(p["branch"], p["rotor_rpm"]) for p in points if not p["stable"]}
     labelled = set()
-    tracks = {}
-    for p in points:
-        for m in p["modes"]:
-            tracks.setdefault((p["branch"], m["family"], m["index"]), []).append(
-                (p["rotor_rpm"], m["frequency_Hz"], p["stable"]))
-    f_max = 0.0
-    for (branch, family, index), track in tracks.items():
-        track.sort()
-        x, f, stable = (np.array(v) for v in zip(*track))
-        f_max = max(f_max, float(f.max()))
-        label = FAMILY_LABELS.get(family, family) if family not in labelled else None
-        labelled.add(family)
+    for track in summary.get("tracks", []):
+        family, branch = track["family"], track["branch"]
+        x = np.array([t[0] for t in track["points"]])
+        f = np.array([t[1] for t in track["points"]])
         colour = COLOURS.get(family, "k")
-        ax.plot(x, f, "-", color=colour, marker="o", ms=3, label=label)
-        unstable = ~stable.astype(bool)
-        if unstable.any():
-            ax.plot(x[unstable], f[unstable], "x", color=colour, ms=7)
-    for name in summary.get("lines", []):
-        n = int(name[:-1])
+        ax.plot(x, f, "-", color=colour, marker="o", ms=3,
+                label=None if family in labelled else FAMILY_LABELS.get(family, family))
+        labelled.add(family)
+        bad = np.array([(branch, r) in unstable for r in x], dtype=bool)
+        if bad.any():
+            ax.plot(x[bad], f[bad], "x", color=colour, ms=8,
+                    label=None if "unstable" in labelled else "unstable point")
+            labelled.add("unstable")
+    orders = [int(name[:-1]) for name in summary.get("lines", [])]
+    for n in orders:
         ax.plot([0.0, top_rpm], [0.0, n * top_rpm * LINE_RPM_HZ], "k--", lw=0.8)
-        ax.annotate(name, (top_rpm, n * top_rpm * LINE_RPM_HZ), fontsize=8, ha="right")
-    for k, c in enumerate(summary.get("crossings", [])):
+        ax.annotate(f"{n}P", (top_rpm, n * top_rpm * LINE_RPM_HZ), fontsize=8, ha="right",
+                    va="bottom")
+    crossings = summary.get("crossings", [])
+    for k, c in enumerate(crossings):
         ax.plot(c["rotor_rpm"], c["frequency_Hz"], "s", mfc="none", mec="k", ms=9,
                 label="crossing" if k == 0 else None)
-    for k, (lo, hi) in enumerate(summary.get("slack_bands_Hz", [])):
+    bands = summary.get("slack_bands_Hz", [])
+    for k, (lo, hi) in enumerate(bands):
         ax.axhspan(lo, hi, color="tab:purple", alpha=0.15,
                    label="forced helix slackens (Sec. 5.3)" if k == 0 else None)
+    # the lines' region: modes far above the highest line cannot cross it
+    f_top = 1.5 * max(orders + [1]) * top_rpm * LINE_RPM_HZ
+    f_top = max([f_top] + [c["frequency_Hz"] * 1.1 for c in crossings]
+                + [hi * 1.1 for _, hi in bands])
     ax.set_xlim(0.0, top_rpm)
-    ax.set_ylim(0.0, 1.1 * max(f_max, 1e-9))
+    ax.set_ylim(0.0, f_top)
     ax.set_xlabel("rotor speed [rpm]")
     ax.set_ylabel("frequency [Hz]")
     ax.grid(alpha=0.3)
