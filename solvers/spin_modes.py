@@ -153,6 +153,20 @@ class SpinModalSolver(ModalSolver):
         return max(m.eigenvalue.real for m in modes) <= STABILITY_TOL
 
 
+def static_modal_solver(params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene"
+                        ) -> ModalSolver:
+    """``modes``' solver about the torque-free stationary state: with a scene's
+    ``[rotor]``, its spin inertia lumped at the top's twist (the limit Omega -> 0 of the
+    linearisation about an operating point); the plain :class:`ModalSolver` otherwise."""
+    J = params.rotor.spin_inertia_kgm2 if params.rotor.active else 0.0
+    if J == 0.0:
+        return ModalSolver.from_stationary(params, comm, scene=scene)
+    solver = SpinModalSolver.from_stationary(params, comm, scene=scene)
+    solver.linearise_at(RelativeEquilibrium(solver.stationary_result.state, 0.0,
+                                            EndLoads(rotor_inertia_kgm2=J)))
+    return solver
+
+
 def frequency_Hz(mode: Mode, q) -> float:
     """|Im lambda| / (2 pi t_scale)."""
     return abs(mode.eigenvalue.imag) / (2 * math.pi * q.t_scale)
