@@ -33,7 +33,7 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError
-from rawehelix.parameters import Parameters
+from rawehelix.parameters import Parameters, end_components
 from rawehelix.solvers.spin_modes import (EndLoads, RelativeEquilibrium, SpinModalSolver,
                                           damping_ratio, frequency_Hz)
 from rawehelix.solvers.stationary import StationarySolver
@@ -203,8 +203,17 @@ def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER
     start = time.perf_counter()
     rotor = rotor_law.from_params(params)
     if rotor is None:
-        raise SceneError("[rotor]", "absent", "campbell needs the scene's rotor (radius_m, "
-                         "spin_inertia_kgm2, blades, table): see studies/scenes/example.toml")
+        raise SceneError(params.name, "rotor", "'campbell' needs a [rotor] section (radius_m, "
+                         "spin_inertia_kgm2, blades, table or cp/ct/tsr; see "
+                         "studies/scenes/example.toml)")
+    # the linearisation holds both ends' positions (Eqs. 35-36): a top moved by a
+    # position or force component (the circle, the lifter) is not its problem
+    moving = [c for c in end_components.active(params) if c.end == "top" and c.load != "torque"]
+    if moving:
+        c = moving[0]
+        raise SceneError(params.name, c.KEY, f"'campbell' linearises about a fixed top end "
+                         f"(Eqs. 35-36), and the scene's top is moved by its {c.name} "
+                         f"({c.equation}): switch it off in the scene ({c.off})")
     generator = generator_law.from_params(params)
     rho = wind_law.air_density(params)
     points = []
