@@ -95,6 +95,13 @@ class StationarySolver:
         self.rod.c.m0.value = ground
         self.rod.c.mN.value = top
 
+    def end_twist(self) -> float | None:
+        """alpha(L0) - alpha(0) [rad] of the full rod's state, on rank 0 (None elsewhere).
+        Collective."""
+        rod = self.rod
+        s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
+        return None if alpha is None else float(alpha[-1, 0] - alpha[0, 0])
+
     def _check_taut(self, result):
         """Eq. (22) is Hooke's law for a taut helix; a compressed one is slack
         (bars and tethers cannot carry it) and the model does not hold."""

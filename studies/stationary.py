@@ -201,10 +201,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
 
 def twist_of(solver) -> float | None:
     """alpha(L0) - alpha(0) [rad] of the solver's state, on rank 0.  Collective."""
-    from rawehelix.solvers import fields
-    rod = solver.rod
-    s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
-    return None if alpha is None else float(alpha[-1, 0] - alpha[0, 0])
+    return solver.end_twist()
 
 
 def ends_block(params: Parameters, mean_tension_N: float) -> dict:

@@ -62,6 +62,10 @@ FAULTS = [
      "--quantity: tension: unknown quantity"),
     (["calibrate", "stationary_table2", "--fit", "helix.EI_Nm2", "--target", "nosuch=1"], 2,
      "--target: nosuch: unknown quantity"),
+    # issue 43: operate's wind speeds and a scene without a rotor
+    (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
+    (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
+     "rotor: 'operate' needs a [rotor] section"),
     # the Campbell diagram: its wind list, its envelope folder, a scene with no rotor
     (["campbell", "rotor_example", "--wind", "6:3:1"], 2, "--wind: 6:3:1: must be LO:HI:STEP"),
     (["campbell", "rotor_example", "--wind", "3:6:1", "--envelope", "nowhere"], 2,
