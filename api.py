@@ -168,7 +168,7 @@ def campbell(scene: Parameters, wind_m_s, envelope: dict | None = None, comm=Non
     comm = _world(comm)
     scene = _ready(scene, "campbell", comm)
     from rawehelix.studies import campbell as study
-    return study.compute(scene, study.check_winds(wind_m_s), comm=comm, envelope=envelope)
+    return study.compute(scene, wind_m_s, comm=comm, envelope=envelope)
 
 
 def response(scene: Parameters, f1_Hz=None, comm=None):

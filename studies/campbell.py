@@ -1,26 +1,21 @@
 """`rawehelix campbell SCENE --wind LO:HI:STEP`: the Campbell diagram of the helix about
-its operating points (issue 43, part 3).
+its operating points.
 
-For each wind speed (at the wind's reference height):
-
-1. the operating points of the rotor and the generator: every root of the rigid shaft's
-   Q(Omega, V_n) = tau(Omega) (operation/rigid_shaft.py).  Without the helix's own
-   spin-drag loss the twist moment is constant along s at a relative equilibrium
-   (Eq. 31 with no distributed torque), so these are the helix's operating points exactly;
-   the helix's shape is the stationary state under that end torque, the ground's twist
-   held (solvers/stationary.py ``set_end_torques``);
-2. the modes about it (solvers/spin_modes.py): the rod's F linearised at U = that state,
+1. The operating points are ``operate``'s (studies/operate.py): at each wind speed, every
+   relative equilibrium of the rotor and the generator on every branch of the torque
+   balance, up to the helix's first limit (the curve stops there, as the power curve);
+2. at each, the helix's shape is the stationary state under its end torque (solved again
+   on a rod the modal solver shares: the same scene, torque and so the same state), and
+   the modes about it (solvers/spin_modes.py): the rod's F linearised at U = that state,
    V = (0, Omega) in the twist, A = 0, with the rotor's spin inertia and aerodynamic
    damping -dQ/dOmega at the top's twist, the generator's dtau/dOmega (or Eq. 40's k1, k2)
-   at the ground's; the lowest ``per_family`` modes of each family, their frequencies [Hz]
-   and damping ratios, and the point's stability (max Re lambda);
-3. along each branch (the k-th root at each wind), every crossing of the 1P, 2P and BP
-   lines (B = rotor.blades) with a mode (studies/campbell_lines.py).
+   at the ground's; the lowest ``per_family`` modes of each family, their frequencies
+   [Hz] and damping ratios, and the point's stability (max Re lambda);
+3. along each branch, every crossing of the 1P, 2P and BP lines (B = rotor.blades) with
+   a mode followed by its frequency (studies/campbell_lines.py).
 
-V_n, the wind along the rotor's axis: axis "wind" takes the hub's wind; axis "tangent"
-its component along the helix's end tangent, here of the torque-free stationary state
-at that wind (the fixed top's shape barely moves with the torque).  Computing writes
-nothing; :meth:`CampbellResult.write` writes summary.json and campbell.png.
+The top end must be fixed (Eqs. 35-36): a lifted or circling top is refused.  Computing
+writes nothing; :meth:`CampbellResult.write` writes summary.json and campbell.png.
 """
 
 from __future__ import annotations
@@ -29,7 +24,6 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError
@@ -37,36 +31,9 @@ from rawehelix.parameters import Parameters, end_components
 from rawehelix.solvers.spin_modes import (EndLoads, RelativeEquilibrium, SpinModalSolver,
                                           damping_ratio, frequency_Hz)
 from rawehelix.solvers.stationary import StationarySolver
-from rawehelix.studies import campbell_lines
+from rawehelix.studies import campbell_lines, operate
 
 PER_FAMILY = 2  # modes of each family followed across the operating points
-MAX_WINDS = 2000  # the most wind speeds a run takes (each a few solves and a record)
-
-
-def parse_wind(text: str) -> list[float]:
-    """``--wind LO:HI:STEP`` [m/s] -> the wind speeds, LO to HI inclusive; SceneError
-    on --wind naming what is allowed."""
-    try:
-        lo, hi, step = (float(x) for x in text.split(":"))
-    except ValueError:
-        raise SceneError("--wind", text, "must be LO:HI:STEP in m/s, e.g. 4:16:0.5") from None
-    if not (0 < lo <= hi and step > 0 and np.isfinite(lo + hi + step)):
-        raise SceneError("--wind", text, "must be LO:HI:STEP with 0 < LO <= HI and STEP > 0 "
-                         "(m/s)")
-    count = int(np.floor((hi - lo) / step + 1e-9)) + 1
-    if count > MAX_WINDS:
-        raise SceneError("--wind", text, f"gives {count} wind speeds; at most {MAX_WINDS} "
-                         "(a larger STEP)")
-    return [float(lo + k * step) for k in range(count)]
-
-
-def check_winds(winds) -> list[float]:
-    """The API's ``wind_m_s``: finite, > 0, at most MAX_WINDS; ascending."""
-    w = sorted(float(x) for x in np.atleast_1d(winds))
-    if not w or not all(np.isfinite(x) and x > 0 for x in w) or len(w) > MAX_WINDS:
-        raise SceneError("wind_m_s", str(list(winds)),
-                         f"must be 1 to {MAX_WINDS} finite wind speeds > 0 m/s")
-    return w
 
 
 def read_envelope(folder) -> dict:
@@ -116,6 +83,8 @@ class CampbellResult:
     elements: int
     wall_s: float
     envelope: dict | None = None  # an envelope summary: the forced helix's slack band
+    stopped: str = ""  # why the operating points stop (operate: the first limit, ...)
+    first_limit: dict | None = None  # operate's first limit of the helix, or None
 
     @property
     def summary(self) -> dict:
@@ -128,7 +97,8 @@ class CampbellResult:
                 "points": [p.entry() for p in self.points],
                 "tracks": [{"branch": b, "family": f, "points": [list(x) for x in sorted(t)]}
                            for (b, f, _), t in tracks(self.points).items()],
-                "crossings": crossings, "slack_bands_Hz": bands, "wall_s": self.wall_s}
+                "crossings": crossings, "slack_bands_Hz": bands, "stopped": self.stopped,
+                "first_limit": self.first_limit, "wall_s": self.wall_s}
 
     def write(self, outdir) -> Path:
         from rawehelix.studies.present.campbell_figure import campbell_png
@@ -172,72 +142,48 @@ def point_modes(params: Parameters, omega_rad_s: float, torque_Nm: float, loads:
                                 require_families=False)
 
 
-def at_wind(params: Parameters, wind_m_s: float) -> Parameters:
-    """The scene at the wind ``wind_m_s`` (its [wind] section's reference speed, or the
-    paper's uniform environment.wind_speed_m_s)."""
-    if params.wind.active:
-        return params.replace(wind={"speed_m_s": float(wind_m_s)})
-    return params.replace(environment={"wind_speed_m_s": float(wind_m_s)})
-
-
-def end_tangent(params: Parameters, comm) -> np.ndarray:
-    """The helix's unit tangent at the top of the torque-free stationary state (a
-    quadratic through the last three nodes: O(h^2))."""
-    result = StationarySolver(params, comm).solve()
-    tangent = None
-    if comm.rank == 0:
-        s, x = result.s, result.centre_line
-        order = np.argsort(s)
-        s, x = s[order][-3:], x[order][-3:]
-        coeffs = [np.polyfit(s, x[:, i], 2) for i in range(3)]
-        t = np.array([np.polyval(np.polyder(c), 1.0) for c in coeffs])
-        tangent = t / np.linalg.norm(t)
-    return comm.bcast(tangent, root=0)
-
-
-def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER_FAMILY,
-            envelope: dict | None = None, progress=None) -> CampbellResult:
-    """The Campbell diagram over ``winds`` [m/s] (module docstring)."""
-    from rawehelix.operation import generator as generator_law
-    from rawehelix.operation import rigid_shaft, rotor as rotor_law, wind as wind_law
-    start = time.perf_counter()
-    rotor = rotor_law.from_params(params)
-    if rotor is None:
-        raise SceneError(params.name, "rotor", "'campbell' needs a [rotor] section (radius_m, "
-                         "spin_inertia_kgm2, blades, table or cp/ct/tsr; see "
-                         "studies/scenes/example.toml)")
-    # the linearisation holds both ends' positions (Eqs. 35-36): a top moved by a
-    # position or force component (the circle, the lifter) is not its problem
+def refuse_moving_top(params: Parameters):
+    """The linearisation holds both ends' positions (Eqs. 35-36): a top moved by a
+    position or force component (the circle, the lifter) is refused, naming it."""
     moving = [c for c in end_components.active(params) if c.end == "top" and c.load != "torque"]
     if moving:
         c = moving[0]
         raise SceneError(params.name, c.KEY, f"'campbell' linearises about a fixed top end "
                          f"(Eqs. 35-36), and the scene's top is moved by its {c.name} "
                          f"({c.equation}): switch it off in the scene ({c.off})")
-    generator = generator_law.from_params(params)
-    rho = wind_law.air_density(params)
+
+
+def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER_FAMILY,
+            envelope: dict | None = None, progress=None) -> CampbellResult:
+    """The Campbell diagram over ``winds`` [m/s] (module docstring): ``operate``'s
+    operating points, each linearised."""
+    start = time.perf_counter()
+    refuse_moving_top(params)
+    winds = operate.check_winds(winds)
+    planned = operate.plan(params, winds)  # refuses a scene without a rotor, a wind off its table
+    drive = planned.drive
+    operating = operate.compute(params, winds, comm=comm, planned=planned)
     points = []
-    for wind in winds:
-        p = at_wind(params, wind)
-        v_hub = wind_law.from_params(p).hub_speed
-        v_n = float(rotor.normal_speed(v_hub, end_tangent(p, comm)
-                                       if rotor.axis == "tangent" else None))
-        for branch, op in enumerate(rigid_shaft.operating_points(rotor, generator, v_n, rho)):
-            loads = EndLoads.of_laws(rotor, generator, op.omega_rad_s, v_n, rho, p.controller)
-            solver, modes = point_modes(p, op.omega_rad_s, op.rotor_torque_Nm, loads, comm,
-                                        per_family, scene=params.name)
-            points.append(CampbellPoint(
-                wind_m_s=float(wind), branch=branch, rotor_rpm=op.rotor_rpm,
-                wind_normal_m_s=v_n, torque_Nm=op.rotor_torque_Nm, loads=loads,
-                stable=solver.stable(modes), max_real_part_per_s=solver.max_real_part(modes),
-                modes=mode_entries(solver, modes, per_family)))
-            if progress is not None:
-                progress(points[-1])
+    for op, entry in zip(operating.points, operating.summary["points"]):
+        p = operate.at_wind(params, op.wind_m_s)
+        loads = EndLoads.of_laws(drive.rotor, drive.generator, op.omega_rad_s, op.v_n_m_s,
+                                 drive.rho_kg_m3, p.controller)
+        solver, modes = point_modes(p, op.omega_rad_s, op.torque_top_Nm, loads, comm,
+                                    per_family, scene=params.name)
+        points.append(CampbellPoint(
+            wind_m_s=op.wind_m_s, branch=entry["branch"], rotor_rpm=entry["rotor_rpm"],
+            wind_normal_m_s=op.v_n_m_s, torque_Nm=op.torque_top_Nm, loads=loads,
+            stable=solver.stable(modes), max_real_part_per_s=solver.max_real_part(modes),
+            modes=mode_entries(solver, modes, per_family)))
+        if progress is not None:
+            progress(points[-1])
     return CampbellResult(scene=params.name, title=params.title or params.name,
-                          blades=rotor.blades, points=points,
-                          crossings=campbell_lines.crossings(tracks(points), rotor.blades),
+                          blades=drive.rotor.blades, points=points,
+                          crossings=campbell_lines.crossings(tracks(points), drive.rotor.blades),
                           elements=params.discretisation.elements,
-                          wall_s=time.perf_counter() - start, envelope=envelope)
+                          wall_s=time.perf_counter() - start, envelope=envelope,
+                          stopped=operating.summary["stopped"],
+                          first_limit=operating.summary["first_limit"])
 
 
 def tracks(points: list[CampbellPoint]) -> dict:

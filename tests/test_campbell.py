@@ -74,5 +74,5 @@ def test_outputs_list_the_crossings(tmp_path):
 
 
 def test_a_scene_without_a_rotor_is_refused():
-    with pytest.raises(rh.SceneError, match=r"needs a \[rotor\] section"):
+    with pytest.raises(rh.SceneError, match=r"'operate' needs a \[rotor\] section"):
         campbell.compute(rh.load_scene("stationary_table2", elements=2), [5.0])

@@ -71,7 +71,7 @@ FAULTS = [
     (["campbell", "rotor_example", "--wind", "3:6:1", "--envelope", "nowhere"], 2,
      "--envelope: nowhere: must be the output folder of a finished 'rawehelix envelope' run"),
     (["campbell", "stationary_table2", "--elements", "2", "--wind", "3:6:1"], 2,
-     "stationary_table2: rotor: 'campbell' needs a [rotor] section"),
+     "stationary_table2: rotor: 'operate' needs a [rotor] section"),
     (["campbell", "rotor_example", "--elements", "2", "--wind", "3:6:1", "--set",
       'lifter.top="lifted"', "--set", "lifter.force_N=100"], 2,
      "rotor_example: lifter: 'campbell' linearises about a fixed top end"),

@@ -183,10 +183,12 @@ def _campbell_arguments(p):
 
 
 def _campbell(rh, params, args, outdir, comm) -> int:
-    from rawehelix.studies import campbell
+    from rawehelix.studies import campbell, operate
     from rawehelix.studies.store import outdir as outdir_check
-    winds = campbell.parse_wind(args.wind)
+    winds = operate.parse_wind(args.wind)
     envelope = campbell.read_envelope(args.envelope) if args.envelope is not None else None
+    campbell.refuse_moving_top(params)
+    operate.plan(params, winds, key="--wind", text=args.wind)  # numpy: refuses before any work
     outdir_check.check(outdir, "campbell", points=len(winds))
     result = rh.campbell(params, wind_m_s=winds, envelope=envelope, comm=comm)
     if comm.rank == 0:
