@@ -76,3 +76,22 @@ def test_outputs_list_the_crossings(tmp_path):
 def test_a_scene_without_a_rotor_is_refused():
     with pytest.raises(rh.SceneError, match=r"'operate' needs a \[rotor\] section"):
         campbell.compute(rh.load_scene("stationary_table2", elements=2), [5.0])
+
+
+def test_one_rod_serves_every_wind():
+    """The point solvers reuse one rod across wind speeds (only v_w0 changes): the modes
+    at 6 m/s after 3 m/s are those of fresh solvers at 6 m/s, bit for bit; a scene that
+    changes another group is refused by the rod (and gets its own)."""
+    from rawehelix.solvers.spin_modes import EndLoads
+    from rawehelix.studies import operate
+    params = scene()
+    loads = EndLoads(rotor_inertia_kgm2=1.2, rotor_dtorque_domega_Nms=-0.5,
+                     generator_dtorque_domega_Nms=2.0)
+    reused = campbell.PointSolvers(MPI.COMM_SELF, "t")
+    reused.modes(operate.at_wind(params, 3.0), 6.0, 5.0, loads)
+    _, again = reused.modes(operate.at_wind(params, 6.0), 11.0, 20.0, loads)
+    _, fresh = campbell.PointSolvers(MPI.COMM_SELF, "t").modes(operate.at_wind(params, 6.0),
+                                                                11.0, 20.0, loads)
+    assert [m.eigenvalue for m in again] == [m.eigenvalue for m in fresh]
+    with pytest.raises(ValueError, match=r"changes \[.delta., .mu.\]"):  # EI: mu, delta
+        reused.stationary.rod.set_wind(params.replace(helix={"EI_Nm2": 9000.0}))
