@@ -151,7 +151,7 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
 
 
 def campbell(scene: Parameters, wind_m_s, envelope: dict | None = None, comm=None):
-    """The Campbell diagram of the helix (issue 43): at the operating points of the
+    """The Campbell diagram of the helix: at the operating points of the
     scene's ``[rotor]`` and ``[generator]`` at each wind speed, the lowest modes of each
     family about the relative equilibrium (the rotor's spin inertia and aerodynamic
     damping, the generator's dtau/dOmega in the torsional family), each point's

@@ -83,12 +83,14 @@ class CampbellResult:
     elements: int
     wall_s: float
     envelope: dict | None = None  # an envelope summary: the forced helix's slack band
+    envelope_value: float | None = None  # the scene's value of the envelope's key
     stopped: str = ""  # why the operating points stop (operate: the first limit, ...)
     first_limit: dict | None = None  # operate's first limit of the helix, or None
 
     @property
     def summary(self) -> dict:
-        bands = campbell_lines.slack_bands_Hz(self.envelope) if self.envelope else []
+        bands = (campbell_lines.slack_bands_Hz(self.envelope, self.envelope_value)
+                 if self.envelope else [])
         crossings = [{**c, "in_slack_band": any(lo <= c["frequency_Hz"] <= hi
                                                 for lo, hi in bands)} if self.envelope else c
                      for c in self.crossings]
@@ -97,7 +99,10 @@ class CampbellResult:
                 "points": [p.entry() for p in self.points],
                 "tracks": [{"branch": b, "family": f, "points": [list(x) for x in sorted(t)]}
                            for (b, f, _), t in tracks(self.points).items()],
-                "crossings": crossings, "slack_bands_Hz": bands, "stopped": self.stopped,
+                "crossings": crossings, "slack_bands_Hz": bands,
+                "slack_bands_of": ({"key": self.envelope.get("key"), "value": self.envelope_value}
+                                   if self.envelope else None),
+                "stopped": self.stopped,
                 "first_limit": self.first_limit, "wall_s": self.wall_s}
 
     def write(self, outdir) -> Path:
@@ -162,6 +167,17 @@ class PointSolvers:
                                             require_families=False)
 
 
+def scene_value(params: Parameters, envelope: dict | None):
+    """The scene's value of the envelope's key (``helix.EI_Nm2``), or None."""
+    if not envelope or "." not in str(envelope.get("key", "")):
+        return None
+    section, name = envelope["key"].split(".", 1)
+    try:
+        return float(getattr(getattr(params, section), name))
+    except (AttributeError, TypeError, ValueError):
+        return None
+
+
 def refuse_moving_top(params: Parameters):
     """The linearisation holds both ends' positions (Eqs. 35-36): a top moved by a
     position or force component (the circle, the lifter) is refused, naming it."""
@@ -201,6 +217,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER
                           crossings=campbell_lines.crossings(tracks(points), drive.rotor.blades),
                           elements=params.discretisation.elements,
                           wall_s=time.perf_counter() - start, envelope=envelope,
+                          envelope_value=scene_value(params, envelope),
                           stopped=operating.summary["stopped"],
                           first_limit=operating.summary["first_limit"])
 
@@ -229,8 +246,14 @@ def report(result: CampbellResult) -> str:
         lines.append(f"  V = {p.wind_m_s:6.2f} m/s  branch {p.branch}  {p.rotor_rpm:8.2f} rpm  "
                      f"{'stable  ' if p.stable else 'UNSTABLE'}  max Re {p.max_real_part_per_s:+.3g}"
                      f" /s  {modes}")
-    for c in result.crossings:
+    summary = result.summary
+    for c in summary["crossings"]:
         lines.append(f"  crossing {c['line']:>3} x {c['family']} {c['mode']}: "
                      f"{c['frequency_Hz']:.4g} Hz at {c['rotor_rpm']:.2f} rpm, "
-                     f"V = {c['wind_m_s']:.3g} m/s")
+                     f"V = {c['wind_m_s']:.3g} m/s"
+                     + ("  (in the forced helix's slack band)" if c.get("in_slack_band") else ""))
+    if summary["slack_bands_Hz"]:
+        lines.append("  the forced helix slackens at f1 in " + ", ".join(
+            f"{lo:.3g}-{hi:.3g} Hz" for lo, hi in summary["slack_bands_Hz"]))
+    lines.append(f"  stopped: {result.stopped}")
     return "\n".join(lines)

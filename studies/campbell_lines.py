@@ -96,16 +96,30 @@ def _crossing(family, index, branch, n, rpm, frequency, wind) -> dict:
             "frequency_Hz": frequency, "rotor_rpm": rpm, "wind_m_s": wind}
 
 
-def slack_bands_Hz(envelope: dict) -> list[tuple[float, float]]:
-    """The forcing frequencies f1 where the Sec. 5.3 forced helix first slackens: per tick
-    of an ``envelope`` summary, the f1 range of its branch points whose first limit is
-    slack (none if no point slackens)."""
-    bands = []
-    for tick in envelope.get("ticks", []):
-        f1 = [e["f1_Hz"] for e in tick.get("branch", []) if _kind(e.get("first_limit")) == "slack"]
-        if f1:
-            bands.append((min(f1), max(f1)))
-    return bands
+def slack_bands_Hz(envelope: dict, value=None) -> list[tuple[float, float]]:
+    """The forcing frequencies f1 where the Sec. 5.3 forced helix slackens, from an
+    ``envelope`` summary: along each tick's branch (in the order traced, through its
+    folds), each run of points whose first limit is slack spans [min f1, max f1]; the
+    runs merged where they overlap.  ``value``: only the tick whose value of the
+    envelope's key is nearest it (the scene's own value); None: every tick."""
+    ticks = envelope.get("ticks", [])
+    if value is not None and ticks:
+        ticks = [min(ticks, key=lambda t: abs(float(t["value"]) - float(value)))]
+    runs, run = [], []
+    for tick in ticks:
+        for e in tick.get("branch", []) + [None]:  # None: the end of the branch
+            if e is not None and _kind(e.get("first_limit")) == "slack":
+                run.append(float(e["f1_Hz"]))
+            elif run:
+                runs.append((min(run), max(run)))
+                run = []
+    merged = []
+    for lo, hi in sorted(runs):
+        if merged and lo <= merged[-1][1]:
+            merged[-1] = (merged[-1][0], max(hi, merged[-1][1]))
+        else:
+            merged.append((lo, hi))
+    return merged
 
 
 def _kind(first_limit):

@@ -57,11 +57,17 @@ def test_a_mode_that_appears_starts_its_own_track():
 
 
 def test_slack_band_from_an_envelope_summary():
-    envelope = {"ticks": [{"branch": [{"f1_Hz": 0.8, "first_limit": None},
-                                      {"f1_Hz": 0.9, "first_limit": "slack"},
-                                      {"f1_Hz": 1.0, "first_limit": {"kind": "slack"}},
-                                      {"f1_Hz": 1.1, "first_limit": "moment_saturation"}]}]}
-    assert campbell_lines.slack_bands_Hz(envelope) == [(0.9, 1.0)]
+    """Runs of slack points along each branch (through a fold: f1 goes back), merged
+    where they overlap; with a value, the nearest tick's only."""
+    def branch(*pairs):
+        return [{"f1_Hz": f, "first_limit": k} for f, k in pairs]
+    envelope = {"key": "helix.EI_Nm2", "ticks": [
+        {"value": 3000.0, "branch": branch((0.8, None), (0.9, "slack"), (1.0, {"kind": "slack"}),
+                                           (1.1, "moment_saturation"), (1.4, "slack"),
+                                           (1.6, "slack"), (1.5, "slack"))},
+        {"value": 6000.0, "branch": branch((0.95, "slack"), (1.2, "slack"), (1.3, None))}]}
+    assert campbell_lines.slack_bands_Hz(envelope, 3500.0) == [(0.9, 1.0), (1.4, 1.6)]
+    assert campbell_lines.slack_bands_Hz(envelope) == [(0.9, 1.2), (1.4, 1.6)]
 
 
 def test_figure_from_a_summary(tmp_path):
