@@ -75,6 +75,11 @@ class CampbellPoint:
 
 @dataclass
 class CampbellResult:
+    """The Campbell diagram: ``points`` (:class:`CampbellPoint`: each operating point's
+    modes and stability), ``crossings`` (dicts: family, mode, branch, line,
+    frequency_Hz, rotor_rpm, wind_m_s), ``summary`` (what summary.json holds) and
+    ``write(outdir)`` (summary.json, campbell.png)."""
+
     scene: str
     title: str
     blades: int
