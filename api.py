@@ -106,7 +106,7 @@ def stationary(scene: Parameters, comm=None):
 
 def operate(scene: Parameters, wind_m_s, comm=None):
     """The operating points of the scene's rotor (``[rotor]``) and generator
-    (``[generator]``) at the wind speeds ``wind_m_s`` [m/s] (issue 43): relative
+    (``[generator]``) at the wind speeds ``wind_m_s`` [m/s]: relative
     equilibria (the spin Omega closed by the torque balance, the helix's stationary state
     under the rotor's torque), every branch of the balance traced through folds in the
     wind, up to the helix's first limit.  An :class:`~rawehelix.studies.operate.Operate`

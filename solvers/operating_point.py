@@ -13,14 +13,15 @@ is constant along s, so Omega solves the rigid-shaft equation Q(Omega, V_n) = ta
 rotor's axis (operation/rotor.py ``normal_speed``): ``rotor.axis = "tangent"`` reads it
 off the solved state's top tangent.
 
-How it is solved: a fixed point on the axis factor a = V_n / V_hub, around the SNES
-stationary solve (as solvers/tension_target.py wraps it around its secant):
+How it is solved: a fixed point a = g(a) on the axis factor a = V_n / V_hub, around the
+SNES stationary solve (as solvers/tension_target.py wraps its secant around it):
 
     a_0 from the last point (or the chord); Omega_k the balance's root at a_k V_hub (scalar
-    Newton, numpy); the stationary state under Q(Omega_k); a_{k+1} its top tangent's,
+    Newton, numpy); the stationary state under Q(Omega_k); g(a_k) its top tangent's;
+    a_1 = g(a_0), then the secant on g(a) - a,
 
-stopped when |a_{k+1} - a_k| <= AXIS_TOL, after at most MAX_SOLVES stationary solves
-(the issue's cost).  da/dQ is the top tangent's turn per torque, ~1e-6 per N m on the
+stopped when |g(a_k) - a_k| <= AXIS_TOL, after at most MAX_SOLVES stationary solves
+(the issue's cost); the point reports that defect.  da/dQ is the top tangent's turn per torque, ~1e-6 per N m on the
 paper's helix, so a_1 is within AXIS_TOL of a_0 after the first point and one solve
 suffices; the first point takes two.  Each solve checks its converged reason
 (solvers/snes.py) and its tension (SlackError).
@@ -55,6 +56,17 @@ def chord_axis_factor(drive: Drive, q) -> float:
     branches are traced over."""
     chord = np.array([-np.cos(q.Gamma0), 0.0, -np.sin(q.Gamma0)])
     return float(drive.rotor.normal_speed(1.0, chord))
+
+
+def _next_axis_factor(tried) -> float:
+    """The next a of the fixed point a = g(a): the secant on g(a) - a through the last two
+    tries (the plain iterate g(a) after the first; the tangent's turn with the torque
+    makes g nearly constant, but a laid tensegrity's tension follows the torque)."""
+    if len(tried) < 2:
+        return tried[-1][1]
+    (a0, g0), (a1, g1) = tried[-2:]
+    f0, f1 = g0 - a0, g1 - a1
+    return g1 if f1 == f0 else a1 - f1 * (a1 - a0) / (f1 - f0)
 
 
 @dataclasses.dataclass
@@ -119,6 +131,7 @@ class OperatingPointSolver:
         solver = StationarySolver(params, self.comm, scene=params.name, planar=False)
         v_hub = float(self.hub_speed(V))
         a = self.a if self.a is not None else self.first_axis_factor(params)
+        tried = []  # (a, g(a)): the fixed point's secant
         for solves in range(1, MAX_SOLVES + 1):
             v_n = a * v_hub
             omega = root(v_n)
@@ -129,10 +142,13 @@ class OperatingPointSolver:
             tangent = None
             if self.comm.rank == 0:
                 tangent = top_tangent(result.s, result.centre_line, solver.rod.degree)
-            a_new = self.axis(self.comm.bcast(tangent, root=0))
-            defect, a = abs(a_new - a), a_new
+            g = self.axis(self.comm.bcast(tangent, root=0))
+            defect = abs(g - a)
+            tried.append((a, g))
             if defect <= AXIS_TOL:
                 break
+            a = _next_axis_factor(tried)
+        a = tried[-1][1]
         self.a = a
         twist = solver.end_twist()  # collective
         block = self.limits(params, solver) if self.limits else None  # collective

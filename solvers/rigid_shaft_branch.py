@@ -12,8 +12,9 @@ Q the rotor's aerodynamic torque, tau_gen the generator's, L the helix's integra
 spin-drag loss (0 when off), normalised as the rod solvers are (X = Omega t_scale, G in
 GJ / L0).  G depends on the rod only through V_n, which the rod's top tangent sets
 (solvers/operating_point.py): continued in V_n, the balance is exact and numpy only.
-A generator that holds its speed (the paper's Eq. 40 with its integral action)
-gives G = X - X*: its torque is whatever balances Q.
+A generator that holds its speed (the paper's Eq. 40 with its integral action) has
+one branch, Omega = Omega*, with nothing to continue (:func:`trace` gives it as it
+is): its torque is whatever balances Q.
 
 The problem gives Branch what it asks of a periodic-orbit problem (residual, its
 Jacobians in X and V_n, a Newton at fixed V_n, the finished point) and nothing about
@@ -73,12 +74,6 @@ class Drive:
             return float(self.rotor.torque(omega, v_n, self.rho_kg_m3))
         except OutOfTable as err:
             raise OutsideTable(str(err)) from None
-
-    def generator_torque(self, omega: float, v_n: float) -> float:
-        """tau_gen [N m]: the law's, or Q - L where the generator holds the speed."""
-        if self.held_speed() is not None:
-            return self.rotor_torque(omega, v_n) - self.loss_Nm(omega)
-        return float(self.generator.torque(omega))
 
     def balance_Nm(self, omega: float, v_n: float) -> float:
         """Q - tau_gen - L [N m] at Omega [rad/s], V_n [m/s] (rigid shaft)."""
@@ -179,15 +174,10 @@ class RigidShaftProblem:
 
     def _G(self, X, v_n) -> np.ndarray:
         omega = float(X[0]) / self.t
-        held = self.drive.held_speed()
-        if held is not None:
-            return np.array([(omega - held) * self.t])
         return np.array([self.drive.balance_Nm(omega, v_n) / self.m])
 
     def _dG(self, X, v_n) -> float:
         omega = float(X[0]) / self.t
-        if self.drive.held_speed() is not None:
-            return 1.0
         return self.drive.slope_Nm_s(omega, v_n) / (self.m * self.t)
 
     def residual(self, X, f1_Hz: float, jacobian: bool = False, resolution=None):
@@ -227,8 +217,6 @@ class RigidShaftProblem:
         return X
 
     def multipliers(self, X, f1_Hz: float, resolution=None) -> np.ndarray:
-        if self.drive.held_speed() is not None:
-            return np.array([0.0])  # the speed is held (Eq. 40): no fold in V_n
         slope = self._slope(X, f1_Hz)
         return np.array([math.exp(max(-700.0, min(700.0, slope / self.J * self.t)))])
 
@@ -351,6 +339,21 @@ def _split(points, problem, first_index: int) -> list:
     return out
 
 
+def _held(drive: Drive, vn_lo: float, vn_hi: float) -> Traced:
+    """The one branch of a generator that holds its speed (Eq. 40's integral action):
+    Omega = Omega* wherever the table has Omega* R / V_n, nothing to continue."""
+    omega = drive.held_speed()
+    lam_lo, lam_hi = drive.rotor.tsr_range
+    lo = max(vn_lo, omega * drive.rotor.radius_m / lam_hi)
+    hi = min(vn_hi, omega * drive.rotor.radius_m / lam_lo) if lam_lo > 0 else vn_hi
+    if not lo < hi:
+        return Traced([], [], [f"the held speed {omega:.4g} rad/s is outside the rotor's table "
+                               f"at V_n = {vn_lo:.4g} to {vn_hi:.4g} m/s"], 0)
+    v = np.linspace(lo, hi, 9)
+    return Traced([Segment(0, v, np.full_like(v, omega),
+                           stable(drive.slope_Nm_s(omega, 0.5 * (lo + hi))))], [], [], v.size)
+
+
 def trace(problem: RigidShaftProblem, vn_lo: float, vn_hi: float, ds_max: float = 0.5,
           max_points: int = 400) -> Traced:
     """Every branch of the balance through [vn_lo, vn_hi] [m/s]: traced by Branch from
@@ -359,6 +362,8 @@ def trace(problem: RigidShaftProblem, vn_lo: float, vn_hi: float, ds_max: float 
     from rawehelix.periodic_orbits.continuation import Branch
 
     drive = problem.drive
+    if drive.held_speed() is not None:
+        return _held(drive, vn_lo, vn_hi)
     segments, folds, notes, count = [], [], [], 0
     for v0, v1, direction in ((vn_lo, vn_hi, 1.0), (vn_hi, vn_lo, -1.0)):
         for omega in drive.roots(v0):

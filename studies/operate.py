@@ -27,8 +27,10 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.errors import SceneError, SolverError
+from rawehelix.operation.rotor import RPM  # rad/s per rpm
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.operating_point import OperatingPointSolver
+from rawehelix.solvers.stationary import SlackError
 from rawehelix.solvers.rigid_shaft_branch import Drive, OutsideTable, RigidShaftProblem, trace
 from rawehelix.studies.analysis import structure_limits
 from rawehelix.studies.store import writers
@@ -38,11 +40,12 @@ log = logging.getLogger("rawehelix")
 #: the window of V_n traced, beyond the chord's share of --wind (the top tangent turns
 #: from the chord by the sag's angle: a few degrees on the paper's helix)
 WINDOW_MARGIN = 0.15
+#: the most wind speeds a run takes (each a few stationary solves and a record)
+MAX_WINDS = 2000
 #: the keys of each point of summary.json (the issue's)
 POINT_KEYS = ("wind_m_s", "rotor_rpm", "tsr", "power_W", "rotor_power_W", "torque_top_Nm",
               "torque_ground_Nm", "thrust_N", "tension_max_N", "tension_min_N", "twist_deg",
               "stable", "branch")
-RPM = 60.0 / (2.0 * np.pi)  # rpm per rad/s
 
 
 def parse_wind(text: str) -> list[float]:
@@ -55,20 +58,19 @@ def parse_wind(text: str) -> list[float]:
     if not (0 < lo <= hi and step > 0 and np.isfinite(lo + hi + step)):
         raise SceneError("--wind", text, "must be LO:HI:STEP with 0 < LO <= HI and STEP > 0 "
                          "(m/s)")
-    count = int(np.floor((hi - lo) / step + 1e-9)) + 1
+    count = float(np.floor((hi - lo) / step + 1e-9)) + 1
     if count > MAX_WINDS:
-        raise SceneError("--wind", text, f"gives {count} wind speeds; at most {MAX_WINDS} "
+        raise SceneError("--wind", text, f"gives {count:.6g} wind speeds; at most {MAX_WINDS} "
                          "(a larger STEP)")
-    return [float(lo + k * step) for k in range(count)]
-
-
-#: the most wind speeds a run takes (each a few stationary solves and a record)
-MAX_WINDS = 2000
+    return [float(lo + k * step) for k in range(int(count))]
 
 
 def check_winds(winds) -> list[float]:
     """The API's ``wind_m_s``: finite, > 0, at most MAX_WINDS, ascending."""
-    w = sorted(float(x) for x in np.atleast_1d(winds))
+    try:
+        w = sorted(float(x) for x in np.atleast_1d(winds))
+    except (TypeError, ValueError):
+        w = []
     if not w or not all(np.isfinite(x) and x > 0 for x in w) or len(w) > MAX_WINDS:
         raise SceneError("wind_m_s", str(list(winds)),
                          f"must be 1 to {MAX_WINDS} finite wind speeds > 0 m/s")
@@ -220,15 +222,21 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
                 p = solver.solve(V, lambda vn, seg=seg: seg.root(drive, vn))
             except OutsideTable:
                 continue  # this branch does not reach V (or its table ends before)
+            except SlackError as err:  # the whole helix slack: the slack limit, reached
+                reached.append((seg.index, {"kind": "slack", "s_m": None, "t_s": None,
+                                            "why": str(err)}))
+                continue
             except SolverError as err:
-                stop = f"at {V:g} m/s the relative equilibrium on branch {seg.index} failed: {err}"
+                stop = (f"at {V:g} m/s the relative equilibrium on branch {seg.index} failed "
+                        f"({err}); the points before it are kept: a run with more --elements, "
+                        f"or --wind below {V:g}, avoids it")
                 break
             solves += p.stationary_solves
             points.append(p)
             entries.append(_entry(p, seg.index))
             details.append(_detail(p, seg.index))
             log.info("operate: %g m/s (branch %d): %.1f rpm, P %.1f W, T %.1f .. %.1f N, %d "
-                     "solves", V, seg.index, p.omega_rad_s * RPM, p.power_W,
+                     "solves", V, seg.index, p.omega_rad_s / RPM, p.power_W,
                      entries[-1]["tension_min_N"] or 0.0, entries[-1]["tension_max_N"] or 0.0,
                      p.stationary_solves)
             if p.limits and p.limits.get("first_limit"):
@@ -238,11 +246,14 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
         if reached:
             branch, hit = reached[0]
             first = {**hit, "wind_m_s": V, "branch": branch}
+            where = "" if hit["s_m"] is None else f", s = {hit['s_m']:.3f} m"
             stop = (f"the helix reaches its first limit, {hit['kind']}, at {V:g} m/s "
-                    f"(branch {branch}, s = {hit['s_m']:.3f} m)")
+                    f"(branch {branch}{where})")
             break
     if not points:
         raise SolverError(f"no operating point was solved at {_listed(winds)} m/s: {stop}")
+    # V_n = a V_hub with a the solved points' mean axis factor, V_hub proportional to V
+    scale = float(np.mean([p.v_n_m_s / p.hub_wind_m_s for p in points])) * hub(1.0)
     block = limits.run.block()
     block["first_limit"] = first
     summary = {
@@ -250,7 +261,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
         "degree": params.discretisation.degree, "ranks": comm.size,
         "wind_m_s": winds, "rotor_axis": drive.rotor.axis,
         "points": entries, "details": details,
-        "folds": [{"v_n_m_s": float(v)} for v in traced.folds],
+        "folds": [{"v_n_m_s": float(v), "wind_m_s": float(v / scale)} for v in traced.folds],
         "branches": [{"branch": s.index, "stable": s.stable,
                       "v_n_m_s": [float(s.v_n[0]), float(s.v_n[-1])]} for s in traced.segments],
         "limits": block, "first_limit": first,
@@ -268,7 +279,7 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
 def _entry(p, branch: int) -> dict:
     """A point of summary.json: exactly :data:`POINT_KEYS`."""
     T = p.tension_N
-    return {"wind_m_s": p.wind_m_s, "rotor_rpm": p.omega_rad_s * RPM, "tsr": p.tsr,
+    return {"wind_m_s": p.wind_m_s, "rotor_rpm": p.omega_rad_s / RPM, "tsr": p.tsr,
             "power_W": p.power_W, "rotor_power_W": p.rotor_power_W,
             "torque_top_Nm": p.torque_top_Nm, "torque_ground_Nm": p.torque_ground_Nm,
             "thrust_N": p.thrust_N,
@@ -304,11 +315,13 @@ def report(result: Operate) -> str:
                      + ("" if e["stable"] else "  unstable"))
     first = s["first_limit"]
     lines.append("  first limit: " + (f"{first['kind']} at {first['wind_m_s']:g} m/s (branch "
-                                      f"{first['branch']}, s = {first['s_m']:.3f} m)"
-                                      if first else "none in the wind speeds run"))
+                                      f"{first['branch']}"
+                                      + ("" if first["s_m"] is None else f", s = {first['s_m']:.3f} m")
+                                      + ")" if first else "none in the wind speeds run"))
     lines.append(f"  stopped: {s['stopped']}")
     for note in s["notes"]:
         lines.append(f"  note: {note}")
     for fold in s["folds"]:
-        lines.append(f"  fold at V_n = {fold['v_n_m_s']:.4g} m/s along the rotor's axis")
+        lines.append(f"  fold at V = {fold['wind_m_s']:.4g} m/s (V_n = {fold['v_n_m_s']:.4g} m/s "
+                     "along the rotor's axis): a branch turns back in the wind there")
     return "\n".join(lines)

@@ -216,3 +216,23 @@ def test_stability_is_one_function_that_takes_eigenvalues():
     assert stable(-1.0) and not stable(2.0)
     assert not stable(-1.0, eigenvalues=[-1.0, 0.5 + 3j])  # the full linearisation decides
     assert stable(2.0, eigenvalues=[-1.0, -0.1 + 3j])
+
+
+def test_the_papers_law_holds_the_speed_and_its_torque_balances_the_rotors():
+    """Eq. (40) with its integral action: Omega = the target at every wind, the ground's
+    torque = Q (no loss), the twist Q L0 / GJ; stable where its speed gain K2 exceeds
+    dQ/dOmega (operation/rigid_shaft.py's criterion)."""
+    lam, cp, ct = hump()
+    target = 120 * math.pi / 30
+    law = GeneratorLaw("paper", target_rad_s=target, integral_Nm=5.0, damping_Nms=3.0)
+    drive = Drive(TableRotor(lam, cp, ct, R), law, RHO)
+    p = straight()
+    for pt in points_at(p, drive, (8.0, 12.0)):
+        vn = pt.wind_m_s * COS45
+        assert pt.omega_rad_s == target
+        Q = 0.5 * RHO * math.pi * R**3 * vn**2 * float(cp_of(lam, cp)(target * R / vn)) / (
+            target * R / vn)
+        assert pt.torque_top_Nm == pytest.approx(Q, rel=1e-12)
+        assert pt.torque_ground_Nm == pt.torque_top_Nm
+        assert pt.twist_rad == pytest.approx(Q * p.helix.length_m / p.helix.GJ_Nm2, rel=1e-4)
+        assert pt.stable == (drive.rotor.dtorque_domega(target, vn, RHO) - 3.0 < 0)

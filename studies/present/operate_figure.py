@@ -43,15 +43,17 @@ def power_curve_png(path: Path, summary: dict, title: str) -> Path:
     fig, axes = plt.subplots(len(rows), 1, figsize=(7.5, 9.5), sharex=True)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     branches = len({p["branch"] for p in summary["points"]})
+    labelled = set()
     for b, stable, run in _runs(summary["points"], summary["details"]):
         V = [p["wind_m_s"] for p, _ in run]
+        label = f"branch {b}" if branches > 1 and b not in labelled else None
+        labelled.add(b)
         for ax, (label, values) in zip(axes, rows):
             y = np.array([[np.nan if v is None else v for v in values(p, d)] for p, d in run])
             for k in range(y.shape[1]):  # max and min: their own markers
                 ax.plot(V, y[:, k], "-" if stable else "--", marker=MARKERS[y.shape[1]][k],
                         ms=4, color=colours[b % len(colours)],
-                        label=(f"branch {b}" if branches > 1 else None) if stable and k == 0
-                        else None)
+                        label=label if ax is axes[0] and k == 0 else None)
     for ax, (label, _) in zip(axes, rows):
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
