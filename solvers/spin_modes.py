@@ -15,7 +15,11 @@ quadratic eigenproblem, the families of :mod:`.classify`).
 
 The rigid rotation of torque-free ends becomes the rigid shaft's mode: with J the
 rotor's and the rod's polar inertia, lambda = (Q' - tau') / J (rigid_shaft's
-stability d(Q - tau)/dOmega < 0); a positive real part is an unstable point.
+stability d(Q - tau)/dOmega < 0); a positive real part is an unstable point.  The
+flexible helix can lose a mode the rigid shaft keeps: with the paper's law holding
+the speed, the ground's damper k2 barely reaches the rotor's mode on the helix's twist
+(docs/explanation/campbell.md).  :func:`stability` and :func:`stability_at` give
+(stable, max_real_part [1/s]) for an operating point's verdict.
 """
 
 from __future__ import annotations
@@ -113,6 +117,13 @@ class RelativeEquilibrium:
 class SpinModalSolver(ModalSolver):
     """:class:`ModalSolver` with the end components' terms, about a relative equilibrium."""
 
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
+                 rod: RodDiscretisation | None = None):
+        rod = rod if rod is not None else RodDiscretisation(params, comm)
+        self.end_loads = EndLoadForms(
+            rod.model, rod.mesh, lambda v: dolfinx.fem.Constant(rod.mesh, PETSc.ScalarType(v)))
+        super().__init__(params, comm, scene, rod, ends=self.end_loads)
+
     def is_rigid_rotation(self, fractions: dict) -> bool:
         """With damping at the ends the free angle's zero is a simple eigenvalue next to
         the rigid shaft's real root (Q' - tau') / J, and SLEPc's vector for it is poor
@@ -131,13 +142,6 @@ class SpinModalSolver(ModalSolver):
         n = self.K.getLocalSize()[1]
         twist = self.rod.dofs("twist")
         return twist[twist < n]
-
-    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
-                 rod: RodDiscretisation | None = None):
-        rod = rod if rod is not None else RodDiscretisation(params, comm)
-        self.end_loads = EndLoadForms(
-            rod.model, rod.mesh, lambda v: dolfinx.fem.Constant(rod.mesh, PETSc.ScalarType(v)))
-        super().__init__(params, comm, scene, rod, ends=self.end_loads)
 
     def linearise_at(self, point: RelativeEquilibrium):
         """K, C, M about ``point`` (module docstring)."""
