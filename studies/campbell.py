@@ -228,14 +228,18 @@ def compute(params: Parameters, winds, comm=MPI.COMM_SELF, per_family: int = PER
 
 
 def tracks(points: list[CampbellPoint]) -> dict:
-    """{(branch, family, track): [(rotor_rpm, frequency_Hz, wind_m_s, index)]}: each mode
-    followed along its branch by its frequency (campbell_lines.follow)."""
-    by = {}
+    """{(branch, family, track): [(rotor_rpm, frequency_Hz, wind_m_s, index,
+    damping_ratio)]}: each mode followed along its branch by its frequency
+    (campbell_lines.follow)."""
+    by, zeta = {}, {}
     for p in points:
         for family in {m["family"] for m in p.modes}:
-            freqs = [m["frequency_Hz"] for m in p.modes if m["family"] == family]
-            by.setdefault((p.branch, family), []).append((p.rotor_rpm, p.wind_m_s, freqs))
-    return {(branch, family, k): track for (branch, family), pts in by.items()
+            mine = [m for m in p.modes if m["family"] == family]
+            by.setdefault((p.branch, family), []).append(
+                (p.rotor_rpm, p.wind_m_s, [m["frequency_Hz"] for m in mine]))
+            zeta[p.branch, family, p.rotor_rpm] = [m["damping_ratio"] for m in mine]
+    return {(branch, family, k): [(*x, zeta[branch, family, x[0]][x[3]]) for x in track]
+            for (branch, family), pts in by.items()
             for k, track in enumerate(campbell_lines.follow(pts))}
 
 

@@ -65,16 +65,16 @@ def line_name(order: int) -> str:
 def crossings(tracks: dict, blades: int) -> list[dict]:
     """Every crossing of a line with a mode.
 
-    ``tracks``: {(branch, family, track): [(rotor_rpm, frequency_Hz, wind_m_s, index),
-    ...]}, one list per mode followed along a branch (:func:`follow`), sorted by rotor
-    speed here.  Returns dicts with family, mode (its 1-based rank in the family at the
+    ``tracks``: {(branch, family, track): [(rotor_rpm, frequency_Hz, wind_m_s, index,
+    ...), ...]}, one list per mode followed along a branch (:func:`follow`; what follows
+    the index is not read), sorted by rotor speed here.  Returns dicts with family, mode (its 1-based rank in the family at the
     lower point), branch, line, frequency_Hz, rotor_rpm, wind_m_s, in increasing rotor
     speed."""
     out = []
     for (branch, family, _), points in tracks.items():
         points = sorted(points)
         for n in orders(blades):
-            for (r0, f0, v0, k0), (r1, f1, v1, _) in zip(points, points[1:]):
+            for (r0, f0, v0, k0, *_), (r1, f1, v1, *_) in zip(points, points[1:]):
                 g0, g1 = f0 - n * r0 * RPM_HZ, f1 - n * r1 * RPM_HZ
                 if g0 == 0.0 or g0 * g1 >= 0.0:
                     if g0 == 0.0:  # on the line at a point
@@ -84,7 +84,7 @@ def crossings(tracks: dict, blades: int) -> list[dict]:
                 out.append(_crossing(family, k0, branch, n, r0 + t * (r1 - r0),
                                      f0 + t * (f1 - f0), v0 + t * (v1 - v0)))
             if points and points[-1][1] - n * points[-1][0] * RPM_HZ == 0.0:
-                r, f, v, k = points[-1]
+                r, f, v, k = points[-1][:4]
                 out.append(_crossing(family, k, branch, n, r, f, v))
     return sorted(out, key=lambda c: (c["rotor_rpm"], c["line"], c["family"]))
 

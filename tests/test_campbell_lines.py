@@ -75,7 +75,8 @@ def test_figure_from_a_summary(tmp_path):
                "points": [{"rotor_rpm": r, "branch": 0, "stable": r < 100}
                           for r in (40.0, 80.0, 120.0)],
                "tracks": [{"branch": 0, "family": "lateral_in_plane",
-                           "points": [[r, 3 + 0.01 * r, 5.0, 0] for r in (40.0, 80.0, 120.0)]}],
+                           "points": [[r, 3 + 0.01 * r, 5.0, 0, 0.05 if r < 100 else -0.01]
+                                      for r in (40.0, 80.0, 120.0)]}],
                "crossings": [{"rotor_rpm": 100.0, "frequency_Hz": 4.0, "line": "3P"}]}
     path = campbell_png(tmp_path / "campbell.png", json.loads(json.dumps(summary)), "t")
     assert path.stat().st_size > 1000

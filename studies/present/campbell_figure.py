@@ -26,25 +26,34 @@ def campbell_png(path: Path, summary: dict, title: str) -> Path:
 
 
 def draw(ax, summary: dict):
-    """Each track of summary["tracks"] ([rotor_rpm, frequency_Hz, wind_m_s, index] along
-    a branch), crosses at its unstable points, the lines, crossings and slack bands."""
+    """Each track of summary["tracks"] ([rotor_rpm, frequency_Hz, wind_m_s, index,
+    damping_ratio] along a branch), crosses on its growing points (damping ratio < 0),
+    a triangle at 0 Hz for an unstable point whose growth is a real root, the lines,
+    crossings and slack bands."""
     points = summary["points"]
     top_rpm = 1.05 * max([p["rotor_rpm"] for p in points] + [1e-9])
-    unstable = {(p["branch"], p["rotor_rpm"]) for p in points if not p["stable"]}
     labelled = set()
+    growing_rpm = set()
     for track in summary.get("tracks", []):
-        family, branch = track["family"], track["branch"]
+        family = track["family"]
         x = np.array([t[0] for t in track["points"]])
         f = np.array([t[1] for t in track["points"]])
+        zeta = np.array([t[4] for t in track["points"]])
         colour = COLOURS.get(family, "k")
         ax.plot(x, f, "-", color=colour, marker="o", ms=3,
                 label=None if family in labelled else FAMILY_LABELS.get(family, family))
         labelled.add(family)
-        bad = np.array([(branch, r) in unstable for r in x], dtype=bool)
+        bad = zeta < 0
         if bad.any():
-            ax.plot(x[bad], f[bad], "x", color=colour, ms=8,
-                    label=None if "unstable" in labelled else "unstable point")
-            labelled.add("unstable")
+            ax.plot(x[bad], f[bad], "x", color=colour, ms=9, mew=2,
+                    label=None if "growing" in labelled else "growing mode")
+            labelled.add("growing")
+            growing_rpm.update((track["branch"], r) for r in x[bad])
+    real = [p["rotor_rpm"] for p in points
+            if not p["stable"] and (p["branch"], p["rotor_rpm"]) not in growing_rpm]
+    if real:
+        ax.plot(real, [0.0] * len(real), "^", color="k", ms=8, clip_on=False,
+                label="unstable: a growing real root")
     orders = [int(name[:-1]) for name in summary.get("lines", [])]
     for n in orders:
         ax.plot([0.0, top_rpm], [0.0, n * top_rpm * LINE_RPM_HZ], "k--", lw=0.8)
