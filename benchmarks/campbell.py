@@ -6,14 +6,11 @@ same points as benchmarks/operate.py), CPU time in this process after a run that
 compiles the forms, against the power curve alone; the ratio is (campbell - operate) /
 operate, the Campbell's own part (a stationary solve and an eigenproblem a point).
 
-    .venv/bin/python benchmarks/campbell.py [--elements 8] [--repeats 3]
-    .venv/bin/python benchmarks/run.py --only campbell      (the same, into results.json)
+    .venv/bin/python benchmarks/run.py --only campbell      (into results.json)
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import time
 
 import numpy as np
@@ -54,11 +51,3 @@ def markdown(c: dict) -> list[str]:
             f"(CPU, median of {c['campbell_cpu_s']['runs']}) | {c['campbell_cpu_s']['median']:.2f} s "
             f"with operate's {c['operate_cpu_s']['median']:.2f} s: the Campbell's own part "
             f"{c['extra_over_operate']:.2f} x the power curve's | <= {c['target']:g} x |"]
-
-
-if __name__ == "__main__":
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--elements", type=int, default=8)
-    ap.add_argument("--repeats", type=int, default=3)
-    a = ap.parse_args()
-    print(json.dumps(bench_campbell(a.elements, a.repeats), indent=2))
