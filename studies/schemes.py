@@ -93,9 +93,9 @@ class FE(FECore, Scheme):
         return params.normalised().tension_N(result.tension[0])
 
     def spectrum(self, params, comm=None, scene="scene", nev=None, shapes=True):
-        from rawehelix.solvers.modal import ModalSolver
+        from rawehelix.solvers.spin_modes import static_modal_solver
         comm = comm or MPI.COMM_WORLD
-        solver = ModalSolver.from_stationary(params, comm, scene=scene)
+        solver = static_modal_solver(params, comm, scene=scene)  # a [rotor]'s J lumped
         if not shapes:  # eigenvalues only
             return Spectrum(solver.solve(keep_vectors=False, require_families=False), {})
         found = solver.solve(nev=nev, require_families=False)

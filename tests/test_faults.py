@@ -77,6 +77,15 @@ FAULTS = [
     (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
     (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
      "rotor: 'operate' needs a [rotor] section"),
+    # the Campbell diagram: its wind list, its envelope folder, a scene with no rotor
+    (["campbell", "rotor_example", "--wind", "6:3:1"], 2, "--wind: 6:3:1: must be LO:HI:STEP"),
+    (["campbell", "rotor_example", "--wind", "3:6:1", "--envelope", "nowhere"], 2,
+     "--envelope: nowhere: must be the output folder of a finished 'rawehelix envelope' run"),
+    (["campbell", "stationary_table2", "--elements", "2", "--wind", "3:6:1"], 2,
+     "stationary_table2: rotor: 'operate' needs a [rotor] section"),
+    (["campbell", "rotor_example", "--elements", "2", "--wind", "3:6:1", "--set",
+      'lifter.top="lifted"', "--set", "lifter.force_N=100"], 2,
+     "rotor_example: lifter: 'campbell' linearises about a fixed top end"),
 ]
 
 
