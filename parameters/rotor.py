@@ -1,0 +1,111 @@
+"""The scene's ``[rotor]`` section: the rotor at the top end, a rigid body with a
+Cp/CT table (operation/rotor.py has its law).  No table: no rotor (the paper's)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+from rawehelix.operation.rotor import AXES, table_fault
+from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
+from rawehelix.parameters.tables import numbers, read_csv
+
+COLUMNS = ("tsr", "cp", "ct")
+
+
+@dataclass(frozen=True)
+class Rotor:
+    """The rotor: R, its inertia, mass and blades, and its table (a CSV file or inline
+    arrays).  Q = 1/2 rho pi R^2 V_n^3 Cp(lambda) / Omega, F = 1/2 rho pi R^2 V_n^2
+    CT(lambda), lambda = Omega R / V_n (operation/rotor.py)."""
+
+    radius_m: float | None = None  # R, the rotor's radius; required with a table [m]
+    spin_inertia_kgm2: float = 0.0  # J, the rotor's moment of inertia about its axis [kg m^2]
+    mass_kg: float = 0.0  # the rotor and hub's mass [kg]
+    blades: int = 3  # the blades: the nP excitation lines of the Campbell diagram
+    # the Cp/CT table: a CSV file with the columns tsr, cp, ct (its path relative to the
+    # scene file; '#' lines are comments); "": none (or give tsr, cp and ct inline)
+    table: str = ""
+    tsr: tuple[float, ...] = ()  # lambda = Omega R / V_n of each row, increasing (inline table) [-]
+    cp: tuple[float, ...] = ()  # Cp at each tsr, 0 <= Cp <= 16/27 (inline table) [-]
+    ct: tuple[float, ...] = ()  # CT at each tsr, >= 0 (inline table) [-]
+    # the rotor's axis: "tangent", the helix's end tangent (V_n = V cos 45 deg at the
+    # paper's elevation); "wind", facing the wind (V_n = V at the hub)
+    axis: str = "tangent"
+
+    def __post_init__(self):
+        for name in COLUMNS:
+            object.__setattr__(self, name, numbers(f"rotor.{name}", getattr(self, name)))
+        if not isinstance(self.table, str):
+            raise ParameterError("rotor.table", self.table, "must be a file name")
+        if self.axis not in AXES:
+            raise ParameterError("rotor.axis", self.axis, f"must be one of {AXES}")
+        if self.table and not self.tsr:  # the API: relative to the working folder
+            for name, col in read_table(self.table, Path(".")).items():
+                object.__setattr__(self, name, col)
+        if not self.active:
+            given = [f.name for f in dataclasses.fields(self) if f.name not in COLUMNS
+                     and getattr(self, f.name) != f.default]
+            given += [name for name in COLUMNS if getattr(self, name)]
+            if given:
+                raise ParameterError("rotor.table", None, f"is required: [rotor] gives "
+                                     f"rotor.{given[0]} but no table (rotor.table = 'FILE.csv' "
+                                     "with the columns tsr, cp, ct, or rotor.tsr, rotor.cp "
+                                     "and rotor.ct inline)")
+            return
+        if self.radius_m is None:
+            raise ParameterError("rotor.radius_m", None, "is required with the rotor's table "
+                                 "(rotor.table or rotor.tsr)")
+        _positive("rotor", self, "radius_m")
+        _non_negative("rotor", self, "spin_inertia_kgm2", "mass_kg")
+        if isinstance(self.blades, bool) or not isinstance(self.blades, int) or self.blades < 1:
+            raise ParameterError("rotor.blades", self.blades, "must be an integer >= 1")
+        fault = table_fault(self.tsr, self.cp, self.ct)
+        if fault:
+            row, column, what = fault
+            key = "rotor.table" if self.table else f"rotor.{column}"
+            raise ParameterError(key, self.table or None, f"{f'row {row}: ' if row else ''}{what}")
+
+    @classmethod
+    def from_scene(cls, values: dict, folder: Path) -> "Rotor":
+        """The section as a scene gives it: ``table`` read relative to the scene's
+        ``folder``, its faults named by the file's line (studies/scene.py)."""
+        table = values.get("table", "")
+        if isinstance(table, str) and table:
+            inline = [f"rotor.{name}" for name in COLUMNS if name in values]
+            if inline:
+                raise ParameterError(inline[0], None, "and rotor.table both give the rotor's "
+                                     "table: keep one")
+            values = {**values, **read_table(table, folder)}
+        return cls(**values)
+
+    @property
+    def active(self) -> bool:
+        """A table is given: the rotor is on."""
+        return bool(self.tsr or self.cp or self.ct)
+
+    def describe(self) -> str:
+        return (f"rotor: R = {self.radius_m:g} m, {len(self.tsr)} rows of Cp/CT, "
+                f"Cp_max = {max(self.cp):.4g}, axis {self.axis}")
+
+
+def read_table(table: str, folder: Path) -> dict:
+    """{tsr, cp, ct} of the CSV ``table`` (relative to ``folder``), its faults named by
+    line: ParameterError("rotor.table", ...)."""
+    columns, lines = read_csv("rotor.table", folder / table, COLUMNS)
+    fault = table_fault(*(columns[c] for c in COLUMNS))
+    if fault:
+        row, _, what = fault
+        where = f"line {lines[row - 1]} (row {row}): " if row else ""
+        raise ParameterError("rotor.table", table, f"{where}{what}")
+    return columns
+
+
+def check(params) -> None:
+    """What the rotor cannot run with (``params`` a whole scene): the torque ramp of
+    Eq. (69), a second torque at the top end."""
+    if params.rotor.active and params.torque.top_Nm != 0:
+        raise ParameterError("torque.top_Nm", params.torque.top_Nm,
+                             "and [rotor] both put a torque on the top end: set "
+                             "torque.top_Nm = 0 with a rotor (its torque is the table's)")
