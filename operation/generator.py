@@ -105,5 +105,5 @@ def from_params(params) -> GeneratorLaw | None:
         return GeneratorLaw("paper", target_rad_s=c.target_rpm * RPM,
                             integral_Nm=c.k1 * torque_scale, damping_Nms=c.k2 * torque_scale * t_scale)
     return GeneratorLaw(g.law, mppt_gain_Nms2=g.mppt_gain_Nms2, torque_Nm=g.torque_Nm,
-                        table_rpm=g.speeds_rpm, table_torque_Nm=g.torques_Nm,
+                        table_rpm=g.speeds_rpm or (), table_torque_Nm=g.torques_Nm or (),
                         rated_power_W=g.rated_power_W)

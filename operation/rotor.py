@@ -60,8 +60,7 @@ def table_fault(tsr, cp, ct) -> tuple[int, str, str] | None:
         if x < 0:
             return i, "tsr", f"tsr = {x!r} is negative"
         if i > 1 and not x > tsr[i - 2]:
-            return i, "tsr", (f"tsr = {x!r} does not increase (the row before has "
-                              f"{tsr[i - 2]!r}): the table must be sorted in tsr, each once")
+            return i, "tsr", f"tsr = {x!r} does not increase: the table must be sorted in tsr"
         if p > BETZ:
             return i, "cp", f"cp = {p!r} is above the Betz limit 16/27 = {BETZ:.6f}"
         if p < 0:

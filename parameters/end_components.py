@@ -57,6 +57,9 @@ class EndComponent:
     off: str  # its null object, as a scene spells it ("" : none, always on)
     active: Callable  # params -> bool: False at its null object
     check: Callable = lambda p: None  # params -> None: ParameterError for what it cannot run with
+    # (values, the scene's folder) -> its section, for a section that reads files beside
+    # the scene (a table); None: SECTION(**values)
+    read: Callable | None = None
 
     def __post_init__(self):
         if self.end not in ENDS or self.load not in LOADS:
@@ -76,10 +79,10 @@ END_COMPONENTS = (
                  "controller off", lambda p: p.controller.active),
     # issue 43: the machine in operation (operation/ has their laws)
     EndComponent("rotor", "rotor", Rotor, "top", "torque", "issue 43: Q = 1/2 rho pi R^2 V^3 Cp / Omega",
-                 "no rotor.table", lambda p: p.rotor.active, rotor.check),
+                 "no rotor.table", lambda p: p.rotor.active, rotor.check, Rotor.from_scene),
     EndComponent("generator", "generator", Generator, "ground", "torque",
                  "issue 43: mppt k Omega^2, a torque table", "generator.law = 'paper'",
-                 lambda p: p.generator.active, generator.check),
+                 lambda p: p.generator.active, generator.check, Generator.from_scene),
     EndComponent("lifter", "lifter", Lifter, "top", "force", "issue 43: the lifted top end",
                  "lifter.top = 'fixed'", lambda p: p.lifter.active, lifter.check),
 )
@@ -106,6 +109,12 @@ def scene_sections() -> dict:
     return {c.KEY: c.SECTION for c in END_COMPONENTS}
 
 
+def scene_readers() -> dict:
+    """``[KEY]`` -> how the scene loader builds a section that reads files beside the
+    scene (studies/scene.py): ``read(values, folder)``."""
+    return {c.KEY: c.read for c in END_COMPONENTS if c.read is not None}
+
+
 def active(params) -> tuple[EndComponent, ...]:
     """The end components ``params`` switches on."""
     return tuple(c for c in END_COMPONENTS if c.active(params))
@@ -122,4 +131,4 @@ def torque_free() -> str:
 
 
 __all__ = ["END_COMPONENTS", "ENDS", "EndComponent", "LOADS", "REGISTRY", "active", "check",
-           "get", "scene_sections", "torque_free", "torques"]
+           "get", "scene_readers", "scene_sections", "torque_free", "torques"]

@@ -23,16 +23,16 @@ READS = {"paper": (), "mppt": ("mppt_gain_Nms2", "rated_power_W"),
 class Generator:
     """The ground end's torque tau(Omega) (operation/generator.py)."""
 
-    # "paper": Eq. (40), the [controller]'s ground torque; "mppt": tau = k Omega^2;
+    # "paper": Eq. (40), the controller section's ground torque; "mppt": tau = k Omega^2;
     # "torque": a constant torque or a table tau(rpm)
     law: str = "paper"
     mppt_gain_Nms2: float = 0.0  # k of law "mppt": tau = k Omega^2 [N m s^2]
     torque_Nm: float = 0.0  # law "torque": its constant torque [N m]
     # law "torque": a CSV file with the columns rpm, torque_Nm (its path relative to the
     # scene file); "": none
-    table: str = ""
-    speeds_rpm: tuple[float, ...] = ()  # law "torque": the table's speeds, from 0, increasing (inline) [rpm]
-    torques_Nm: tuple[float, ...] = ()  # law "torque": the torque at each speed, >= 0 (inline) [N m]
+    table: str | None = None
+    speeds_rpm: tuple[float, ...] | None = None  # law "torque": the table's speeds, from 0, increasing (inline) [rpm]
+    torques_Nm: tuple[float, ...] | None = None  # law "torque": the torque at each speed, >= 0 (inline) [N m]
     # above it the generator holds the power: tau = P_rated / Omega; absent: no cap [W]
     rated_power_W: float | None = None
 
@@ -40,34 +40,40 @@ class Generator:
         if self.law not in LAWS:
             raise ParameterError("generator.law", self.law, f"must be one of {LAWS}")
         for name in ("speeds_rpm", "torques_Nm"):
-            object.__setattr__(self, name, numbers(f"generator.{name}", getattr(self, name)))
-        if not isinstance(self.table, str):
-            raise ParameterError("generator.table", self.table, "must be a file name")
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, numbers(f"generator.{name}", getattr(self, name)))
+        if self.table is not None and not (isinstance(self.table, str)
+                                           and self.table.lower().endswith(".csv")):
+            raise ParameterError("generator.table", self.table, "must be a CSV file's name (*.csv)")
         if self.table and not self.speeds_rpm:  # the API: relative to the working folder
             for name, col in read_table(self.table, Path(".")).items():
                 object.__setattr__(self, name, col)
         for f in dataclasses.fields(self):
             if f.name != "law" and f.name not in READS[self.law] and getattr(self, f.name) != f.default:
+                readers = " or ".join(repr(k) for k, v in READS.items() if f.name in v)
                 raise ParameterError(f"generator.{f.name}", getattr(self, f.name),
-                                     f"is not read by generator.law = {self.law!r}: it is read "
-                                     f"by {[k for k, v in READS.items() if f.name in v]}")
-        _non_negative("generator", self, "mppt_gain_Nms2", "torque_Nm")
+                                     f"is read only with generator.law = {readers}")
+        if self.law == "mppt" and not (self.mppt_gain_Nms2 > 0 and math.isfinite(self.mppt_gain_Nms2)):
+            raise ParameterError("generator.mppt_gain_Nms2", self.mppt_gain_Nms2,
+                                 "must be a finite number > 0 with generator.law = 'mppt' "
+                                 "(tau = k Omega^2)")
+        _non_negative("generator", self, "torque_Nm")
         if self.rated_power_W is not None:
             _positive("generator", self, "rated_power_W")
-        if self.law == "mppt":
-            _positive("generator", self, "mppt_gain_Nms2")
         if self.law == "torque":
             self._check_torque()
 
     def _check_torque(self):
-        tabulated = bool(self.speeds_rpm or self.torques_Nm)
-        if tabulated == (self.torque_Nm > 0):
+        tabulated = self.speeds_rpm is not None or self.torques_Nm is not None
+        if not tabulated and not self.torque_Nm > 0:
             raise ParameterError("generator.torque_Nm", self.torque_Nm,
-                                 "generator.law = 'torque' takes one of generator.torque_Nm > 0 "
-                                 "and a table (generator.table, or generator.speeds_rpm and "
-                                 "generator.torques_Nm)")
+                                 "must be > 0 with generator.law = 'torque', or give its table")
+        if tabulated and self.torque_Nm > 0:
+            raise ParameterError("generator.torque_Nm", self.torque_Nm,
+                                 "and the torque table both give generator.law = 'torque' its "
+                                 "torque: keep one")
         if tabulated:
-            fault = table_fault(self.speeds_rpm, self.torques_Nm)
+            fault = table_fault(self.speeds_rpm or (), self.torques_Nm or ())
             if fault:
                 row, what = fault
                 key = "generator.table" if self.table else "generator.speeds_rpm"
@@ -77,8 +83,8 @@ class Generator:
     def from_scene(cls, values: dict, folder: Path) -> "Generator":
         """The section as a scene gives it: ``table`` read relative to the scene's
         ``folder`` (studies/scene.py)."""
-        table = values.get("table", "")
-        if isinstance(table, str) and table:
+        table = values.get("table")
+        if isinstance(table, str) and table.lower().endswith(".csv"):
             inline = [f"generator.{n}" for n in ("speeds_rpm", "torques_Nm") if n in values]
             if inline:
                 raise ParameterError(inline[0], None, "and generator.table both give the "
@@ -117,7 +123,7 @@ def table_fault(rpm, torque) -> tuple[int, str] | None:
 
 def read_table(table: str, folder: Path) -> dict:
     """{speeds_rpm, torques_Nm} of the CSV ``table`` (relative to ``folder``)."""
-    columns, lines = read_csv("generator.table", folder / table, COLUMNS)
+    columns, lines = read_csv("generator.table", folder, table, COLUMNS)
     fault = table_fault(columns["rpm"], columns["torque_Nm"])
     if fault:
         row, what = fault

@@ -8,7 +8,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from rawehelix.parameters.checks import ParameterError, _positive
+from rawehelix.parameters.checks import ParameterError
 
 #: "fixed": [ends]' position (the paper's); "lifted": a point mass (rotor and hub)
 #: under its weight, the rotor's thrust, the lifter's force and the helix's end force;
@@ -21,10 +21,12 @@ LIFTED_KEYS = ("force_N", "elevation_deg", "azimuth_deg")  # read by top = "lift
 class Lifter:
     """The top end's support (module docstring)."""
 
-    top: str = "fixed"  # "fixed" (the paper's, [ends]), "lifted" (the lifter's force) or "circle" (Eq. 70)
+    top: str = "fixed"  # "fixed" (the paper's: the ends section's), "lifted" (the lifter's force) or "circle" (Eq. 70)
     force_N: float = 0.0  # top = "lifted": the lifter's pull on the top end [N]
     elevation_deg: float = 90.0  # top = "lifted": its direction's angle above the horizontal [deg]
-    azimuth_deg: float = 0.0  # top = "lifted": its direction's angle from i_E about k_E [deg]
+    # top = "lifted": its direction's horizontal angle from downwind (-i_E, the way the
+    # chord leans) toward j_E [deg]
+    azimuth_deg: float = 0.0
 
     def __post_init__(self):
         if self.top not in TOPS:
@@ -35,16 +37,17 @@ class Lifter:
                 raise ParameterError(f"lifter.{f.name}", value, "must be a finite number")
             if self.top != "lifted" and f.name in LIFTED_KEYS and value != f.default:
                 raise ParameterError(f"lifter.{f.name}", value,
-                                     f"is read by lifter.top = 'lifted' only (the top is "
-                                     f"{self.top!r})")
+                                     "is read only with lifter.top = 'lifted'")
         if self.top == "lifted":
-            _positive("lifter", self, "force_N")
             if not 0 < self.elevation_deg <= 90:
                 raise ParameterError("lifter.elevation_deg", self.elevation_deg,
                                      "must lie in (0, 90]: the lifter holds the top end up")
             if not -360 <= self.azimuth_deg <= 360:
                 raise ParameterError("lifter.azimuth_deg", self.azimuth_deg,
                                      "must lie in [-360, 360]")
+            if not self.force_N > 0:
+                raise ParameterError("lifter.force_N", self.force_N,
+                                     "must be > 0 with lifter.top = 'lifted' (the lifter's pull)")
 
     @property
     def active(self) -> bool:
@@ -52,9 +55,11 @@ class Lifter:
         return self.top == "lifted"
 
     def direction(self) -> tuple[float, float, float]:
-        """The unit vector of the lifter's force in (i_E, j_E, k_E)."""
+        """The unit vector of the lifter's force in the paper's (i_E, j_E, k_E), whose
+        k_E points down (gravity is +k_E) and whose wind blows along -i_E:
+        cos(e) (cos(a) (-i_E) + sin(a) j_E) - sin(e) k_E."""
         e, a = math.radians(self.elevation_deg), math.radians(self.azimuth_deg)
-        return (math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e))
+        return (-math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), -math.sin(e))
 
     def describe(self) -> str:
         if not self.active:

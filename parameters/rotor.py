@@ -25,38 +25,44 @@ class Rotor:
     mass_kg: float = 0.0  # the rotor and hub's mass [kg]
     blades: int = 3  # the blades: the nP excitation lines of the Campbell diagram
     # the Cp/CT table: a CSV file with the columns tsr, cp, ct (its path relative to the
-    # scene file; '#' lines are comments); "": none (or give tsr, cp and ct inline)
-    table: str = ""
-    tsr: tuple[float, ...] = ()  # lambda = Omega R / V_n of each row, increasing (inline table) [-]
-    cp: tuple[float, ...] = ()  # Cp at each tsr, 0 <= Cp <= 16/27 (inline table) [-]
-    ct: tuple[float, ...] = ()  # CT at each tsr, >= 0 (inline table) [-]
+    # scene file; '#' lines are comments); absent: none (or give tsr, cp and ct inline)
+    table: str | None = None
+    tsr: tuple[float, ...] | None = None  # lambda = Omega R / V_n of each row, increasing (inline table) [-]
+    cp: tuple[float, ...] | None = None  # Cp at each tsr, 0 <= Cp <= 16/27 (inline table) [-]
+    ct: tuple[float, ...] | None = None  # CT at each tsr, >= 0 (inline table) [-]
     # the rotor's axis: "tangent", the helix's end tangent (V_n = V cos 45 deg at the
     # paper's elevation); "wind", facing the wind (V_n = V at the hub)
     axis: str = "tangent"
 
     def __post_init__(self):
         for name in COLUMNS:
-            object.__setattr__(self, name, numbers(f"rotor.{name}", getattr(self, name)))
-        if not isinstance(self.table, str):
-            raise ParameterError("rotor.table", self.table, "must be a file name")
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, numbers(f"rotor.{name}", getattr(self, name)))
+        if self.table is not None and not (isinstance(self.table, str)
+                                           and self.table.lower().endswith(".csv")):
+            raise ParameterError("rotor.table", self.table, "must be a CSV file's name (*.csv)")
         if self.axis not in AXES:
             raise ParameterError("rotor.axis", self.axis, f"must be one of {AXES}")
         if self.table and not self.tsr:  # the API: relative to the working folder
             for name, col in read_table(self.table, Path(".")).items():
                 object.__setattr__(self, name, col)
         if not self.active:
-            given = [f.name for f in dataclasses.fields(self) if f.name not in COLUMNS
-                     and getattr(self, f.name) != f.default]
-            given += [name for name in COLUMNS if getattr(self, name)]
+            given = [f.name for f in dataclasses.fields(self) if getattr(self, f.name) != f.default]
             if given:
                 raise ParameterError("rotor.table", None, f"is required: [rotor] gives "
                                      f"rotor.{given[0]} but no table (rotor.table = 'FILE.csv' "
                                      "with the columns tsr, cp, ct, or rotor.tsr, rotor.cp "
                                      "and rotor.ct inline)")
             return
+        missing = [name for name in COLUMNS if getattr(self, name) is None]
+        if missing:
+            given = next(name for name in COLUMNS if name not in missing)
+            raise ParameterError(f"rotor.{missing[0]}", None,
+                                 f"is required with rotor.{given} (the inline table: rotor.tsr, "
+                                 "rotor.cp and rotor.ct), or give rotor.table")
         if self.radius_m is None:
             raise ParameterError("rotor.radius_m", None, "is required with the rotor's table "
-                                 "(rotor.table or rotor.tsr)")
+                                 f"(rotor.{'table' if self.table else 'tsr, cp, ct'})")
         _positive("rotor", self, "radius_m")
         _non_negative("rotor", self, "spin_inertia_kgm2", "mass_kg")
         if isinstance(self.blades, bool) or not isinstance(self.blades, int) or self.blades < 1:
@@ -71,8 +77,8 @@ class Rotor:
     def from_scene(cls, values: dict, folder: Path) -> "Rotor":
         """The section as a scene gives it: ``table`` read relative to the scene's
         ``folder``, its faults named by the file's line (studies/scene.py)."""
-        table = values.get("table", "")
-        if isinstance(table, str) and table:
+        table = values.get("table")
+        if isinstance(table, str) and table.lower().endswith(".csv"):
             inline = [f"rotor.{name}" for name in COLUMNS if name in values]
             if inline:
                 raise ParameterError(inline[0], None, "and rotor.table both give the rotor's "
@@ -80,12 +86,21 @@ class Rotor:
             values = {**values, **read_table(table, folder)}
         return cls(**values)
 
+    @classmethod
+    def reference_example(cls) -> "Rotor":
+        """A rotor that is on, for the scene-key reference's probes
+        (docs/_ext/rawehelix_reference.py): its ranges are met only when a table is given."""
+        return cls(radius_m=2.0, tsr=(1.0, 3.0, 5.0, 7.0), cp=(0.1, 0.3, 0.4, 0.2),
+                   ct=(0.2, 0.5, 0.7, 0.8))
+
     @property
     def active(self) -> bool:
         """A table is given: the rotor is on."""
-        return bool(self.tsr or self.cp or self.ct)
+        return any(getattr(self, name) is not None for name in COLUMNS)
 
     def describe(self) -> str:
+        if not self.active:
+            return "rotor: none"
         return (f"rotor: R = {self.radius_m:g} m, {len(self.tsr)} rows of Cp/CT, "
                 f"Cp_max = {max(self.cp):.4g}, axis {self.axis}")
 
@@ -93,7 +108,7 @@ class Rotor:
 def read_table(table: str, folder: Path) -> dict:
     """{tsr, cp, ct} of the CSV ``table`` (relative to ``folder``), its faults named by
     line: ParameterError("rotor.table", ...)."""
-    columns, lines = read_csv("rotor.table", folder / table, COLUMNS)
+    columns, lines = read_csv("rotor.table", folder, table, COLUMNS)
     fault = table_fault(*(columns[c] for c in COLUMNS))
     if fault:
         row, _, what = fault

@@ -65,11 +65,12 @@ class Parameters:
         and not 0 where the values they scale are not (:data:`GROUP_KEYS`)."""
         q = Normalised.from_parameters(self)
         for group, (formula, equation, numerators, others) in GROUP_KEYS.items():
-            scaled = [self.value(k) for k in numerators]
+            # an absent key (None: an absent EI law, [wind]'s density) scales nothing
+            scaled = [self.value(k) for k in numerators if self.value(k) is not None]
             value = getattr(q, group)
-            if None in scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
+            if not scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
                 continue
-            keys = [*numerators, *others]
+            keys = [k for k in (*numerators, *others) if self.value(k) is not None]
             # named: the key of the most extreme size, the likeliest culprit
             culprit = max(keys, key=lambda k: abs(math.log10(abs(self.value(k)) or 1.0)))
             raise ParameterError(

@@ -25,43 +25,45 @@ def numbers(key: str, values) -> tuple[float, ...]:
     return tuple(out)
 
 
-def read_csv(key: str, path: Path, columns: tuple[str, ...]) -> tuple[dict, list[int]]:
-    """``columns`` of a CSV file (a header line naming them, any order, other columns
+def read_csv(key: str, folder: Path, name: str, columns: tuple[str, ...]) -> tuple[dict, list[int]]:
+    """``columns`` of the CSV file ``name`` in ``folder`` (the scene's; an absolute name
+    is itself), with a header line naming them (any order, other columns
     ignored; lines starting with '#' and blank lines skipped) as {column: tuple of
     floats}, and each row's line number.  ParameterError naming ``key``, the file and
     the line otherwise."""
+    path = folder / name
     try:
         text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ParameterError(key, str(path), "no such file (a CSV path is relative to the "
-                             "scene file's folder)") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise ParameterError(key, str(path), f"cannot be read as UTF-8 text ({err})") from None
+    except (FileNotFoundError, NotADirectoryError, IsADirectoryError):
+        raise ParameterError(key, name, f"no such file in {folder.resolve()} (a table's path "
+                             "is relative to the scene file's folder)") from None
+    except (OSError, UnicodeDecodeError, ValueError) as err:
+        raise ParameterError(key, name, f"cannot be read as UTF-8 text ({err})") from None
     lines = [(n, line) for n, line in enumerate(text.splitlines(), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
-        raise ParameterError(key, str(path), f"has no header line: it must name the columns "
+        raise ParameterError(key, name, f"has no header line: it must name the columns "
                              f"{', '.join(columns)}")
     rows = list(csv.reader([line for _, line in lines]))
     header = [h.strip() for h in rows[0]]
     missing = [c for c in columns if c not in header]
     if missing:
-        raise ParameterError(key, str(path), f"line {lines[0][0]}: the header {header} lacks "
+        raise ParameterError(key, name, f"line {lines[0][0]}: the header {header} lacks "
                              f"the column {missing[0]!r} (it must name {', '.join(columns)})")
     where = {c: header.index(c) for c in columns}
     out = {c: [] for c in columns}
     for (n, _), row in zip(lines[1:], rows[1:]):
         if len(row) != len(header):
-            raise ParameterError(key, str(path), f"line {n} has {len(row)} cells, the header "
+            raise ParameterError(key, name, f"line {n} has {len(row)} cells, the header "
                                  f"{len(header)}")
         for c in columns:
             try:
                 value = float(row[where[c]])
             except ValueError:
-                raise ParameterError(key, str(path), f"line {n}: {c} = {row[where[c]].strip()!r} "
+                raise ParameterError(key, name, f"line {n}: {c} = {row[where[c]].strip()!r} "
                                      "is not a number") from None
             if not math.isfinite(value):
-                raise ParameterError(key, str(path), f"line {n}: {c} = {value!r} is not a "
+                raise ParameterError(key, name, f"line {n}: {c} = {value!r} is not a "
                                      "finite number")
             out[c].append(value)
     return {c: tuple(v) for c, v in out.items()}, [n for n, _ in lines[1:]]

@@ -97,17 +97,36 @@ class Wind:
         w_m_s: numpy arrays} (read and checked once, at construction)."""
         return self._series
 
+    @classmethod
+    def reference_example(cls) -> "Wind":
+        """A wind that is on, for the scene-key reference's probes
+        (docs/_ext/rawehelix_reference.py): its ranges are met only with a speed."""
+        return cls(speed_m_s=10.0, profile="power")
+
     @property
     def active(self) -> bool:
         return self.speed_m_s is not None
 
+    @property
+    def uniform(self) -> bool:
+        """The same speed at every height (the paper's wind, or [wind]'s uniform one)."""
+        return not self.active or self.profile == "uniform"
+
     def describe(self) -> str:
+        if not self.active:
+            return "wind: environment.wind_speed_m_s, uniform (Eq. 14)"
         return f"wind: {self.profile}, {self.speed_m_s:g} m/s at {self.reference_height_m:g} m"
 
 
 _L0 = ("helix.length_m",)
-#: its normalised groups (parameters/scene.py::GROUP_KEYS): heights / L0
+#: its normalised groups (parameters/scene.py::GROUP_KEYS): heights / L0; and the
+#: groups its speed and density scale beside [environment]'s (replacing those entries)
 GROUP_KEYS = {
+    "nu": ("rho0 l_a L0^2 C_D/(2 M)", "Eq. 26",
+           ("environment.air_density_kg_m3", "wind.air_density_kg_m3", "helix.drag_length_m",
+            "helix.drag_coefficient"), ("helix.length_m", "helix.mass_kg")),
+    "v_w0": ("v_w0/sqrt(g L0)", "Eq. 27", ("environment.wind_speed_m_s", "wind.speed_m_s"),
+             ("helix.length_m", "environment.g_m_s2")),
     "wind_reference": ("z_ref/L0", "Eq. 14", ("wind.reference_height_m",), _L0),
     "wind_roughness": ("z0/L0", "Eq. 14", ("wind.roughness_m",), _L0),
 }
@@ -126,7 +145,7 @@ def normalise(p, scales: dict) -> dict:
     """Normalised's wind fields: the heights over L0 (their values when off for the
     uniform wind)."""
     w = p.wind
-    if not w.active or w.profile == "uniform":
+    if w.uniform:
         return {**NORMALISED}
     L0 = scales["L0"]
     return {"wind_profile": w.profile, "wind_exponent": w.shear_exponent,

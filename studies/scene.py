@@ -36,6 +36,7 @@ SECTIONS = {
     **end_components.scene_sections(),  # and [rotor], [generator], [lifter]
 }
 NESTED = components.scene_holders()  # sections held by another section's dataclass
+READERS = end_components.scene_readers()  # sections that read a file beside the scene
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"
@@ -47,11 +48,12 @@ _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "boo
 
 
 def value_type(type_name: str) -> str:
-    """The type a scene value of a field of this annotation has: an optional number
-    (``float | None``, ``int | None``: absent is None, as TOML has no null) is a number
-    when a scene sets it.  The one place that reads an optional key's annotation."""
+    """The type a scene value of a field of this annotation has: an optional number,
+    string or array (``float | None``, ``str | None``: absent is None, as TOML has no
+    null) is one when a scene sets it.  The one place that reads an optional key's annotation."""
     base, _, none = type_name.partition(" | ")
-    return base if none == "None" and base in ("float", "int") else type_name
+    return base if none == "None" and base in ("float", "int", "str", "tuple[float, ...]") \
+        else type_name
 
 
 def key_type(key: str) -> str:
@@ -119,9 +121,8 @@ def _section(path, name: str, table) -> object:
                          f"gives {given}")
     try:
         # a section with files beside the scene (the rotor's table) reads them itself
-        if hasattr(cls, "from_scene"):
-            return cls.from_scene(values, Path(str(path)).parent)
-        return cls(**values)
+        read = READERS.get(name)
+        return cls(**values) if read is None else read(values, Path(str(path)).parent)
     except ParameterError as err:
         raise _scene_error(path, err) from None
 
