@@ -57,7 +57,7 @@ class Wind:
     time_step_s: float = 0.05  # "turbulent": its step (Nyquist 1 / (2 dt)) [s]
     # "file": a CSV of the hub's wind (its path relative to the scene file): the columns
     # time_s (uniform step) and speed_m_s, or u_m_s, v_m_s, w_m_s (along -x, lateral, up)
-    file: str = ""
+    file: str | None = None
 
     def __post_init__(self):
         if self.profile not in PROFILES:
@@ -85,7 +85,7 @@ class Wind:
     @classmethod
     def from_scene(cls, values: dict, folder: Path) -> "Wind":
         """The section as a scene gives it: ``file`` relative to the scene's ``folder``
-        (studies/scene.py)."""
+        (studies/scene.py), kept as its absolute path."""
         name = values.get("file")
         if isinstance(name, str) and name and not Path(name).is_absolute():
             values = {**values, "file": str((folder / name).resolve())}
@@ -117,6 +117,9 @@ class Wind:
             return "wind: environment.wind_speed_m_s, uniform (Eq. 14)"
         return f"wind: {self.profile}, {self.speed_m_s:g} m/s at {self.reference_height_m:g} m"
 
+
+#: how the scene loader builds the section (studies/scene.py): a file beside the scene
+read = Wind.from_scene
 
 _L0 = ("helix.length_m",)
 #: its normalised groups (parameters/scene.py::GROUP_KEYS): heights / L0; and the

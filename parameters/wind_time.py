@@ -40,13 +40,14 @@ def check_section(w) -> None:
         kinds = KIND_KEYS.get(f.name)
         if kinds and w.kind not in kinds and getattr(w, f.name) != f.default:
             raise ParameterError(f"wind.{f.name}", getattr(w, f.name),
-                                 f"is for wind.kind = {' or '.join(map(repr, kinds))}; "
-                                 f"this scene's is {w.kind!r} (remove the key)")
+                                 f"is for wind.kind = {' or '.join(map(repr, kinds))} only "
+                                 "(remove the key, or set that wind.kind)")
     if w.kind == "step":
+        _non_negative("wind", w, "step_time_s", "rise_time_s")
         if w.step_to_m_s is None:
             raise ParameterError("wind.step_to_m_s", None, "is required with wind.kind = 'step' "
                                  "(the reference speed after the step) [m/s]")
-        _non_negative("wind", w, "step_to_m_s", "step_time_s", "rise_time_s")
+        _non_negative("wind", w, "step_to_m_s")
     if w.kind in ("gust", "turbulent"):
         if w.turbulence_class not in TURBULENCE_CLASSES:
             raise ParameterError("wind.turbulence_class", w.turbulence_class,
@@ -61,9 +62,11 @@ def check_section(w) -> None:
     if w.kind == "turbulent":
         _check_turbulent(w)
     if w.kind == "file":
-        if not w.file:
-            raise ParameterError("wind.file", "", "is required with wind.kind = 'file' (a CSV "
+        if w.file is None:
+            raise ParameterError("wind.file", None, "is required with wind.kind = 'file' (a CSV "
                                  "with time_s and speed_m_s, or u_m_s, v_m_s, w_m_s)")
+        if not (isinstance(w.file, str) and w.file.lower().endswith(".csv")):
+            raise ParameterError("wind.file", w.file, "must be a CSV file's name (*.csv)")
         object.__setattr__(w, "_series", read_file(w.file))
 
 
@@ -80,16 +83,15 @@ def _check_turbulent(w) -> None:
     if not MIN_SAMPLES <= samples <= MAX_SAMPLES:
         raise ParameterError("wind.time_step_s", w.time_step_s,
                              f"must give {MIN_SAMPLES} to {MAX_SAMPLES} samples over "
-                             f"wind.duration_s = {w.duration_s!r} (it gives {samples:.4g})")
+                             "wind.duration_s (duration_s / time_step_s)")
 
 
 def read_file(name: str) -> dict:
     """A wind file's columns as numpy arrays, checked (operation/wind_series.series_fault):
     ParameterError("wind.file", ...) naming the line."""
-    path = Path(name)
-    header = _header(path)
+    header = _header(Path(name))
     columns = next((c for c in FILE_COLUMNS if all(x in header for x in c)), FILE_COLUMNS[0])
-    values, lines = read_csv("wind.file", path, ("time_s",) + columns)
+    values, lines = read_csv("wind.file", Path("."), name, ("time_s",) + columns)
     data = {k: np.asarray(v, float) for k, v in values.items()}
     fault = series_fault(data["time_s"], {c: data[c] for c in columns}, FILE_STEP_TOLERANCE)
     if fault:
