@@ -95,3 +95,23 @@ def fluctuations(heights_m, hub_height_m: float, v_hub: float, sigma_u: float,
             out[:n, p, k] = turb[f"{c}_p{p}"].to_numpy()
     out[n] = out[0]
     return np.arange(n + 1) * (duration_s / n), out
+
+
+def welch(u, time_step_s: float, segment_samples: int = 1024):
+    """(f [Hz], S [m^2/s^2 / Hz]): the Welch estimate of u's one-sided spectrum, Hann
+    segments of ``segment_samples``, no overlap (each bin chi^2 with 2 K dof of K
+    segments for a Gaussian series), of u less its record's mean (the mean would leak
+    into the first bin through the window)."""
+    from scipy import signal
+    u = np.asarray(u, float)
+    return signal.welch(u - u.mean(), fs=1.0 / time_step_s, window="hann",
+                        nperseg=min(segment_samples, len(u)), noverlap=0, detrend=False)
+
+
+def target(f_Hz, sigma: float, length_m: float, v_hub: float, duration_s: float,
+           time_step_s: float):
+    """The spectrum a series of length T and step dt is generated to: Kaimal's S over
+    :func:`resolved_fraction` (its variance sigma^2 between 1/T and the Nyquist
+    frequency) [m^2/s^2 / Hz]."""
+    return kaimal(f_Hz, sigma, length_m, v_hub) / resolved_fraction(length_m, v_hub, duration_s,
+                                                                    time_step_s)

@@ -253,8 +253,7 @@ def from_params(params) -> WindHistory:
                                 WIND_CLASSES[w.wind_class], diameter, z_hub)
         return extreme_operating_gust(profile, v_gust, w.gust_start_s)
     if kind == "turbulent":
-        sigma = (w.turbulence_intensity * v_hub if w.turbulence_intensity is not None
-                 else sigma_1(TURBULENCE_CLASSES[w.turbulence_class], v_hub))
+        sigma = turbulence_sigma(params, v_hub)
         heights = z_hub * np.asarray(TURBULENCE_POINTS)
         t, fl = turbulence.fluctuations(heights, z_hub, v_hub, sigma, length_scale_m(z_hub),
                                         w.duration_s, w.time_step_s, w.seed)
@@ -265,3 +264,24 @@ def from_params(params) -> WindHistory:
             return from_file(profile, s["time_s"], s["speed_m_s"])
         return from_file(profile, s["time_s"], s["u_m_s"], s["v_m_s"], s["w_m_s"])
     return steady(profile)
+
+
+def turbulence_sigma(params, v_hub: float) -> float:
+    """sigma_u [m/s]: wind.turbulence_intensity V_hub, else IEC's NTM sigma_1 of the class."""
+    w = params.wind
+    if w.turbulence_intensity is not None:
+        return w.turbulence_intensity * v_hub
+    return sigma_1(TURBULENCE_CLASSES[w.turbulence_class], v_hub)
+
+
+def hub_spectrum(params, history: WindHistory):
+    """(f, Welch estimate, target) of u at the hub of a turbulent history (the figure's
+    data; operation/turbulence.py's :func:`~turbulence.welch` and
+    :func:`~turbulence.target`)."""
+    w = params.wind
+    z_hub, v_hub = history.profile.hub_height_m, history.profile.hub_speed
+    u = history.fluctuation_m_s[:-1, -1, 0] + v_hub
+    f, estimate = turbulence.welch(u, w.time_step_s)
+    length = turbulence.LENGTH_RATIOS[0] * length_scale_m(z_hub)
+    return f, estimate, turbulence.target(f, turbulence_sigma(params, v_hub), length, v_hub,
+                                          w.duration_s, w.time_step_s)

@@ -198,23 +198,29 @@ def test_the_turbulence_is_the_kaimal_target_over_six_seeds():
         _, h, u = hub_series(seed)
         means.append(u.mean())
         variances.append(u.var(ddof=1))
-        f, s = signal.welch(u, fs=10.0, window="hann", nperseg=nperseg, noverlap=0, detrend=False)
+        f, s = signal.welch(u - u.mean(), fs=10.0, window="hann", nperseg=nperseg, noverlap=0,
+                            detrend=False)
         spectra.append(s)
     assert abs(np.mean(means) - RATED) < z * sigma * math.sqrt(2 * tau / T) / math.sqrt(n)
     assert abs(np.mean(variances) / sigma**2 - 1) < z * math.sqrt(8 * tau / (7 * T)) / math.sqrt(n)
     K = len(u) // nperseg
     target = turbulence.kaimal(f, sigma, L, RATED) / turbulence.resolved_fraction(L, RATED, T, 0.1)
     estimate = np.mean(spectra, axis=0)
-    edges = np.unique(np.round(np.geomspace(3, len(f) - 1, 13)).astype(int))
+    edges = np.unique(np.round(np.geomspace(1, len(f) - 1, 14)).astype(int))
     ratios, dofs = [], []
     for a, b in zip(edges[:-1], edges[1:]):
         m = b - a
         ratios.append(estimate[a:b].mean() / target[a:b].mean())
         dofs.append(2 * K * n * max(1.0, m / (1 + 2 * (4 / 9 + 1 / 36))))
     alpha = 1e-3 / len(ratios)
+    dofs, ratios = np.array(dofs), np.array(ratios)
     lo = stats.chi2.ppf(alpha / 2, dofs) / dofs
     hi = stats.chi2.ppf(1 - alpha / 2, dofs) / dofs
-    assert np.all((lo < ratios) & (np.array(ratios) < hi)), (np.round(ratios, 3), lo, hi)
+    assert np.all((lo < ratios) & (ratios < hi)), (np.round(ratios, 3), lo, hi)
+    # the band tells 8 % apart: against the continuous Kaimal S (not rescaled to the
+    # record's variance, 0.917 of it) the high-frequency bins fall outside
+    fraction = turbulence.resolved_fraction(L, RATED, T, 0.1)
+    assert not np.all((lo < ratios * fraction) & (ratios * fraction < hi))
     # the unnormalised Kaimal lies below by the unresolved variance: by hand, tau = 9.833 s,
     # (1 + 6 tau / 600)^(-2/3) - (1 + 6 tau * 5)^(-2/3) = 0.9394 - 0.0225
     assert turbulence.resolved_fraction(L, RATED, T, 0.1) == pytest.approx(0.9169, abs=2e-4)
@@ -241,3 +247,18 @@ def test_the_same_seed_on_one_and_two_ranks(tmp_path_factory):
     if comm.rank == 0:
         serial = hub_series(4, dt=0.5)[1].fluctuation_m_s.tobytes()
         assert all(b == serial for b in every)
+
+
+def test_the_wind_figure_shows_the_hub_and_its_spectrum(tmp_path):
+    """wind_png from turbulent_rated's data: a PNG; the target it plots holds sigma_1^2
+    between 1/T and the Nyquist frequency (a fine trapezoid rule)."""
+    from rawehelix.studies.present import wind_figure
+    p, h, u = hub_series(5, dt=0.2)
+    f, estimate, target = wind_series.hub_spectrum(p, h)
+    assert f[1] == pytest.approx(1 / (1024 * 0.2)) and len(estimate) == len(target) == len(f)
+    L, sigma = 8.1 * 0.7 * HUB, 0.14 * (0.75 * RATED + 5.6)
+    fine = np.geomspace(1 / 600.0, 0.5 / 0.2, 200001)
+    held = np.trapz(turbulence.target(fine, sigma, L, RATED, 600.0, 0.2), fine)
+    assert held == pytest.approx(sigma**2, rel=1e-6)
+    png = wind_figure.wind_png(tmp_path / "wind.png", h.times_s[:-1], u, f, estimate, target)
+    assert png.stat().st_size > 10_000
