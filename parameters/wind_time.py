@@ -134,18 +134,28 @@ def check(params) -> None:
                                  f"gives V_hub = {v_hub:g} m/s, not below V_e1 = {v_e1:g} m/s "
                                  f"of wind.wind_class = {w.wind_class!r} (IEC's gust needs "
                                  "V_hub < V_e1: a stronger class, I or II)")
-    until = params.time.until_s
-    if w.kind == "turbulent" and w.duration_s < until:
-        raise ParameterError("wind.duration_s", w.duration_s,
-                             f"is shorter than the run, time.until_s = {until!r} (or --until): "
-                             "give a longer series")
+    fault = too_short(params, params.time.until_s, "time.until_s")
+    if fault:
+        raise ParameterError(*fault)
     if w.kind == "file":
-        t = w.series["time_s"]
-        if t[0] > 0 or t[-1] < until:
-            raise ParameterError("wind.file", w.file,
-                                 f"covers {t[0]:g} to {t[-1]:g} s; the run needs 0 to "
-                                 f"time.until_s = {until!r} s (or a shorter --until)")
         if not hub.factor(hub.hub_height_m) > 0:
             raise ParameterError("wind.profile", w.profile,
                                  f"is 0 at the hub ({hub.hub_height_m:g} m): it cannot spread "
                                  "the file's hub speed in height")
+
+
+def too_short(params, until_s: float, key: str):
+    """(key, value, what) when the wind's series ends before a run to ``until_s``
+    (``key``: time.until_s, or the command's --until), else None."""
+    w = params.wind
+    if not w.active:
+        return None
+    if w.kind == "turbulent" and w.duration_s < until_s:
+        return ("wind.duration_s", w.duration_s, f"is shorter than the run, {key} = "
+                f"{until_s!r}: give a longer series (or a shorter run)")
+    if w.kind == "file":
+        t = w.series["time_s"]
+        if t[0] > 0 or t[-1] < until_s:
+            return ("wind.file", w.file, f"covers {t[0]:g} to {t[-1]:g} s; the run needs 0 "
+                    f"to {key} = {until_s!r} s (a longer file, or a shorter run)")
+    return None
