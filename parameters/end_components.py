@@ -78,13 +78,15 @@ END_COMPONENTS = (
     EndComponent("controller", "controller", Controller, "ground", "torque", "Eq. (40)",
                  "controller off", lambda p: p.controller.active),
     # issue 43: the machine in operation (operation/ has their laws)
-    EndComponent("rotor", "rotor", Rotor, "top", "torque", "issue 43: Q = 1/2 rho pi R^2 V^3 Cp / Omega",
-                 "no rotor.table", lambda p: p.rotor.active, rotor.check, Rotor.from_scene),
+    EndComponent("rotor", "rotor", Rotor, "top", "torque",
+                 "Q = 1/2 rho pi R^2 V_n^3 Cp / Omega (its table)", "no rotor.table",
+                 lambda p: p.rotor.active, rotor.check, Rotor.from_scene),
     EndComponent("generator", "generator", Generator, "ground", "torque",
-                 "issue 43: mppt k Omega^2, a torque table", "generator.law = 'paper'",
+                 "mppt k Omega^2, a torque table, or Eq. (40)", "generator.law = 'paper'",
                  lambda p: p.generator.active, generator.check, Generator.from_scene),
-    EndComponent("lifter", "lifter", Lifter, "top", "force", "issue 43: the lifted top end",
-                 "lifter.top = 'fixed'", lambda p: p.lifter.active, lifter.check),
+    EndComponent("lifter", "lifter", Lifter, "top", "force",
+                 "the lifted top end's balance of forces", "lifter.top = 'fixed'",
+                 lambda p: p.lifter.active, lifter.check),
 )
 #: every end component by name
 REGISTRY = {c.name: c for c in END_COMPONENTS}

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from rawehelix.operation.generator import LAWS
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
-from rawehelix.parameters.tables import numbers, read_csv
+from rawehelix.parameters.tables import numbers, read_beside, read_csv
 
 COLUMNS = ("rpm", "torque_Nm")  # the torque table's CSV columns
 #: the keys each law reads (any other given is refused)
@@ -83,14 +83,8 @@ class Generator:
     def from_scene(cls, values: dict, folder: Path) -> "Generator":
         """The section as a scene gives it: ``table`` read relative to the scene's
         ``folder`` (studies/scene.py)."""
-        table = values.get("table")
-        if isinstance(table, str) and table.lower().endswith(".csv"):
-            inline = [f"generator.{n}" for n in ("speeds_rpm", "torques_Nm") if n in values]
-            if inline:
-                raise ParameterError(inline[0], None, "and generator.table both give the "
-                                     "torque table: keep one")
-            values = {**values, **read_table(table, folder)}
-        return cls(**values)
+        return cls(**read_beside("generator", values, folder, ("speeds_rpm", "torques_Nm"),
+                                 read_table))
 
     @property
     def active(self) -> bool:

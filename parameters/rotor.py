@@ -9,7 +9,7 @@ from pathlib import Path
 
 from rawehelix.operation.rotor import AXES, table_fault
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
-from rawehelix.parameters.tables import numbers, read_csv
+from rawehelix.parameters.tables import numbers, read_beside, read_csv
 
 COLUMNS = ("tsr", "cp", "ct")
 
@@ -77,14 +77,7 @@ class Rotor:
     def from_scene(cls, values: dict, folder: Path) -> "Rotor":
         """The section as a scene gives it: ``table`` read relative to the scene's
         ``folder``, its faults named by the file's line (studies/scene.py)."""
-        table = values.get("table")
-        if isinstance(table, str) and table.lower().endswith(".csv"):
-            inline = [f"rotor.{name}" for name in COLUMNS if name in values]
-            if inline:
-                raise ParameterError(inline[0], None, "and rotor.table both give the rotor's "
-                                     "table: keep one")
-            values = {**values, **read_table(table, folder)}
-        return cls(**values)
+        return cls(**read_beside("rotor", values, folder, COLUMNS, read_table))
 
     @classmethod
     def reference_example(cls) -> "Rotor":

@@ -67,3 +67,16 @@ def read_csv(key: str, folder: Path, name: str, columns: tuple[str, ...]) -> tup
                                      "finite number")
             out[c].append(value)
     return {c: tuple(v) for c, v in out.items()}, [n for n, _ in lines[1:]]
+
+
+def read_beside(section: str, values: dict, folder: Path, inline: tuple[str, ...], read) -> dict:
+    """A section's ``values`` as a scene gives them, with the CSV its ``table`` names read
+    relative to the scene's ``folder`` by ``read(table, folder)`` into the ``inline``
+    keys; a scene that gives both the file and an inline column is refused."""
+    table = values.get("table")
+    if not (isinstance(table, str) and table.lower().endswith(".csv")):
+        return values  # no file: the dataclass checks the name and the inline columns
+    given = [f"{section}.{name}" for name in inline if name in values]
+    if given:
+        raise ParameterError(given[0], None, f"and {section}.table both give the table: keep one")
+    return {**values, **read(table, folder)}
