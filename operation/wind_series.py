@@ -43,7 +43,6 @@ from rawehelix.operation import turbulence
 from rawehelix.operation import wind as profile_law
 from rawehelix.operation.wind import WindProfile
 
-KINDS = ("steady", "step", "gust", "turbulent", "file")
 #: I_ref of IEC 61400-1's turbulence classes (ed. 3 Table 1; A+ ed. 4) [-]
 TURBULENCE_CLASSES = {"A+": 0.18, "A": 0.16, "B": 0.14, "C": 0.12}
 #: V_ref of its wind turbine classes (ed. 3 Table 1) [m/s]
@@ -236,34 +235,58 @@ def series_fault(times_s, values: dict, tolerance: float = 1e-6):
     return None
 
 
+def _steady_of(params, profile: WindProfile) -> WindHistory:
+    return steady(profile)
+
+
+def _step_of(params, profile: WindProfile) -> WindHistory:
+    w = params.wind
+    return step(profile, w.step_to_m_s, w.step_time_s, w.rise_time_s)
+
+
+def _gust_of(params, profile: WindProfile) -> WindHistory:
+    w = params.wind
+    diameter = 2 * params.rotor.radius_m if params.rotor.active else 0.0  # D [m]
+    v_gust = gust_amplitude(profile.hub_speed, TURBULENCE_CLASSES[w.turbulence_class],
+                            WIND_CLASSES[w.wind_class], diameter, profile.hub_height_m)
+    return extreme_operating_gust(profile, v_gust, w.gust_start_s)
+
+
+def _turbulent_of(params, profile: WindProfile) -> WindHistory:
+    w = params.wind
+    z_hub, v_hub = profile.hub_height_m, profile.hub_speed
+    heights = z_hub * np.asarray(TURBULENCE_POINTS)
+    t, fl = turbulence.fluctuations(heights, z_hub, v_hub, turbulence_sigma(params, v_hub),
+                                    length_scale_m(z_hub), w.duration_s, w.time_step_s, w.seed)
+    return sampled(profile, t, heights_m=heights, fluctuation_m_s=fl)
+
+
+def _file_of(params, profile: WindProfile) -> WindHistory:
+    s = params.wind.series
+    return from_file(profile, s["time_s"], s.get("speed_m_s", s.get("u_m_s")),
+                     s.get("v_m_s"), s.get("w_m_s"))
+
+
+#: each ``[wind] kind`` and how a scene's history of it is built
+HISTORIES = {"steady": _steady_of, "step": _step_of, "gust": _gust_of,
+             "turbulent": _turbulent_of, "file": _file_of}
+
+
 def from_params(params) -> WindHistory:
-    """The scene's wind history (``params.wind.kind``); the hub at wind.hub_height_m or
-    the top end's height, D = 2 R of ``[rotor]`` (0 without a rotor)."""
+    """The scene's wind history (``params.wind.kind``, :data:`HISTORIES`); the hub at
+    wind.hub_height_m or the top end's height, D = 2 R of ``[rotor]`` (0 without a
+    rotor).  The wind off: the paper's uniform wind, steady."""
     w = params.wind
     profile = profile_law.from_params(params)
-    if w.active and w.hub_height_m is not None:
+    if not w.active:
+        return steady(profile)
+    if w.hub_height_m is not None:
         profile = dataclasses.replace(profile, hub_height_m=w.hub_height_m)
-    kind = w.kind if w.active else "steady"
-    z_hub, v_hub = profile.hub_height_m, profile.hub_speed
-    if kind == "step":
-        return step(profile, w.step_to_m_s, w.step_time_s, w.rise_time_s)
-    if kind == "gust":
-        diameter = 2 * params.rotor.radius_m if params.rotor.active else 0.0
-        v_gust = gust_amplitude(v_hub, TURBULENCE_CLASSES[w.turbulence_class],
-                                WIND_CLASSES[w.wind_class], diameter, z_hub)
-        return extreme_operating_gust(profile, v_gust, w.gust_start_s)
-    if kind == "turbulent":
-        sigma = turbulence_sigma(params, v_hub)
-        heights = z_hub * np.asarray(TURBULENCE_POINTS)
-        t, fl = turbulence.fluctuations(heights, z_hub, v_hub, sigma, length_scale_m(z_hub),
-                                        w.duration_s, w.time_step_s, w.seed)
-        return sampled(profile, t, heights_m=heights, fluctuation_m_s=fl)
-    if kind == "file":
-        s = w.series
-        if "speed_m_s" in s:
-            return from_file(profile, s["time_s"], s["speed_m_s"])
-        return from_file(profile, s["time_s"], s["u_m_s"], s["v_m_s"], s["w_m_s"])
-    return steady(profile)
+    return HISTORIES[w.kind](params, profile)
+
+
+#: the kinds, in the order a scene's reference lists them
+KINDS = tuple(HISTORIES)
 
 
 def turbulence_sigma(params, v_hub: float) -> float:

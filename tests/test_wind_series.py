@@ -39,6 +39,9 @@ def test_steady_is_the_profile_bit_for_bit():
         assert np.array_equal(h.along(t, z), np.full(z.shape, RATED))
         assert np.array_equal(hp.along(t, z), profile.speed_at(z))
         assert np.array_equal(h.speed(t, z)[..., 1:], np.zeros(z.shape + (2,)))
+    # the paper's scenes ([wind] off): environment.wind_speed_m_s, uniform
+    paper = wind_series.from_params(scene.load("stationary_table2"))
+    assert np.array_equal(paper.along(3.0, z), np.full(z.shape, 10.0))
 
 
 def test_the_gust_is_iecs_eog_by_hand():
