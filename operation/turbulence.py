@@ -44,6 +44,12 @@ COHERENCE_RATIO = 8.1  # L_c / Lambda_1 (Eq. C.3)
 MAX_SAMPLES = 2_000_000  # the longest series generated (time samples; memory) [-]
 
 
+def available() -> bool:
+    """Is pyconturb installed (scripts/install.sh installs it)?"""
+    import importlib.util
+    return importlib.util.find_spec("pyconturb") is not None
+
+
 def kaimal(f_Hz, sigma: float, length_m: float, v_hub: float):
     """S(f) of IEC's Kaimal spectrum, one-sided, its integral over f > 0 sigma^2
     [m^2/s^2 / Hz] (Eq. C.2)."""

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rawehelix.operation import turbulence
 from rawehelix.operation.turbulence import MAX_SAMPLES
 from rawehelix.operation import wind as profile_law
 from rawehelix.operation.wind import top_height_m
@@ -71,6 +72,9 @@ def check_section(w) -> None:
 
 
 def _check_turbulent(w) -> None:
+    if not turbulence.available():
+        raise ParameterError("wind.kind", w.kind, "needs the package pyconturb: run 'make "
+                             "install' (or pip install --no-deps pyconturb==2.7.4)")
     if isinstance(w.seed, bool) or not isinstance(w.seed, int) or not 0 <= w.seed <= MAX_SEED:
         raise ParameterError("wind.seed", w.seed, f"must be an integer from 0 to {MAX_SEED}")
     if w.turbulence_intensity is not None:

@@ -265,3 +265,12 @@ def test_the_wind_figure_shows_the_hub_and_its_spectrum(tmp_path):
     assert held == pytest.approx(sigma**2, rel=1e-6)
     png = wind_figure.wind_png(tmp_path / "wind.png", h.times_s[:-1], u, f, estimate, target)
     assert png.stat().st_size > 10_000
+
+
+def test_without_pyconturb_a_turbulent_scene_says_how_to_install(monkeypatch):
+    """No pyconturb: the turbulent scene is refused at load, naming the way in."""
+    from rawehelix.errors import SceneError
+    monkeypatch.setattr(turbulence, "available", lambda: False)
+    with pytest.raises(SceneError, match="needs the package pyconturb: run 'make install'"):
+        scene.load("turbulent_rated")
+    scene.load("gust_rated")  # the other kinds need nothing
