@@ -48,6 +48,9 @@ TURBULENCE_CLASSES = {"A+": 0.18, "A": 0.16, "B": 0.14, "C": 0.12}
 #: V_ref of its wind turbine classes (ed. 3 Table 1) [m/s]
 WIND_CLASSES = {"I": 50.0, "II": 42.5, "III": 37.5}
 EOG_PERIOD_S = 10.5  # T, the extreme operating gust's duration (ed. 3 Eq. 17) [s]
+#: (u, v, w) -> (x, y, z) of the ground frame E: downwind -i_E, lateral +j_E, up -k_E
+FRAME_E = np.array([-1.0, 1.0, -1.0])
+
 #: the heights of the turbulent points, as fractions of the hub's: along the helix's
 #: chord to the top end, whose last point is the hub the rotor takes its wind at
 TURBULENCE_POINTS = (0.25, 0.5, 0.75, 1.0)
@@ -150,6 +153,12 @@ class WindHistory:
             else:
                 out[..., k] += np.interp(z, self.heights_m, fluct[:, k])
         return out
+
+    def velocity_E(self, t: float, z_m):
+        """The wind's velocity in the ground frame E (x, y, z; z down, Eq. 14's wind
+        -v_w0 i_E): u along -i_E, v along +j_E, w up, along -k_E (u, v, w right-handed,
+        pyconturb's) [m/s]; shape z.shape + (3,)."""
+        return self.speed(t, z_m) * FRAME_E
 
     def along(self, t: float, z_m):
         """u(z, t), the component along -i_E [m/s]."""

@@ -39,6 +39,10 @@ def test_steady_is_the_profile_bit_for_bit():
         assert np.array_equal(h.along(t, z), np.full(z.shape, RATED))
         assert np.array_equal(hp.along(t, z), profile.speed_at(z))
         assert np.array_equal(h.speed(t, z)[..., 1:], np.zeros(z.shape + (2,)))
+    # Eq. 14's wind -v_w0 i_E in the ground frame; (u, v, w) right-handed there
+    assert np.array_equal(h.velocity_E(1.0, 3.0), [-RATED, 0.0, 0.0])
+    e = wind_series.FRAME_E
+    assert np.array_equal(np.cross(e * [1, 0, 0], e * [0, 1, 0]), e * [0, 0, 1])
     # the paper's scenes ([wind] off): environment.wind_speed_m_s, uniform
     paper = wind_series.from_params(scene.load("stationary_table2"))
     assert np.array_equal(paper.along(3.0, z), np.full(z.shape, 10.0))
