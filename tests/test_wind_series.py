@@ -233,6 +233,44 @@ def test_the_turbulence_is_the_kaimal_target_over_six_seeds():
     assert turbulence.resolved_fraction(L, RATED, T, 0.1) == pytest.approx(0.9169, abs=2e-4)
 
 
+def test_the_coherence_is_iecs_over_six_seeds():
+    """u at the hub and at 0.75 z_hub (r = 2.87 m apart), 6 seeds: the coherence
+    |S_xy| / sqrt(S_xx S_yy) of the seed- and bin-averaged Welch (cross-)spectra
+    against IEC's exp(-12 sqrt((f r / V_hub)^2 + (0.12 r / L_c)^2)), L_c = 8.1
+    Lambda_1 (ed. 3 Eq. C.3), where it exceeds 0.3: within 4 standard errors,
+    (1 - gamma^2) / sqrt(2 n_d) (Bendat and Piersol), n_d = K m_eff 6 averages."""
+    r, L_c = 0.25 * HUB, 8.1 * 0.7 * HUB
+    sxy = sxx = syy = 0
+    for seed in SEEDS:
+        fl = hub_series(seed)[1].fluctuation_m_s[:-1, :, 0]
+        x, y = fl[:, -1], fl[:, -2]
+        welch = dict(fs=10.0, window="hann", nperseg=1024, noverlap=0, detrend=False)
+        f, a = signal.csd(x, y, **welch)
+        sxy = sxy + a
+        sxx = sxx + signal.welch(x, **welch)[1]
+        syy = syy + signal.welch(y, **welch)[1]
+    K = 6000 // 1024
+    edges = np.unique(np.round(np.geomspace(1, 120, 10)).astype(int))
+
+    def misses(distance):  # the bins outside 4 standard errors of IEC's at ``distance``
+        iec = np.exp(-12 * np.sqrt((f * distance / RATED) ** 2 + (0.12 * distance / L_c) ** 2))
+        out, checked = [], 0
+        for a, b in zip(edges[:-1], edges[1:]):
+            gamma = iec[a:b].mean()
+            if gamma < 0.3:
+                continue
+            est = abs(sxy[a:b].sum()) / math.sqrt(sxx[a:b].sum() * syy[a:b].sum())
+            n_d = K * len(SEEDS) * max(1.0, (b - a) / (1 + 2 * (4 / 9 + 1 / 36)))
+            checked += 1
+            if abs(est - gamma) >= 4 * (1 - gamma**2) / math.sqrt(2 * n_d):
+                out.append((round(f[a], 3), round(est, 3), round(gamma, 3)))
+        return out, checked
+
+    missed, checked = misses(r)
+    assert not missed and checked >= 5, missed
+    assert misses(2 * r)[0]  # the bound tells the points' distance from twice it
+
+
 def test_the_same_seed_gives_the_same_bytes():
     """Same seed: the same series bit for bit; another seed another; numpy's global
     generator untouched (pyconturb seeds it; turbulence.py restores it)."""
