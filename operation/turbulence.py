@@ -41,7 +41,8 @@ SIGMA_RATIOS = (1.0, 0.8, 0.5)
 #: integral length scales L_k over Lambda_1 (Table C.1)
 LENGTH_RATIOS = (8.1, 2.7, 0.66)
 COHERENCE_RATIO = 8.1  # L_c / Lambda_1 (Eq. C.3)
-MAX_SAMPLES = 2_000_000  # the longest series generated (time samples; memory) [-]
+MAX_SAMPLES = 1_000_000  # the longest series (time samples): about 0.5 GB and 40 s [-]
+CHUNK = 4096  # frequencies whose coherence pyconturb holds at once (memory: 4096 x 12^2 x 8 B)
 
 
 def available() -> bool:
@@ -92,7 +93,7 @@ def fluctuations(heights_m, hub_height_m: float, v_hub: float, sigma_u: float,
     try:
         turb = pyconturb.gen_turb(spat, T=duration_s, nt=n, coh_model="iec", seed=seed,
                                   wsp_func=zero_mean, sig_func=sig, spec_func=spectrum, u_ref=v_hub, z_ref=hub_height_m,
-                                  l_c=COHERENCE_RATIO * length_scale_m, nf_chunk=n // 2 + 1)
+                                  l_c=COHERENCE_RATIO * length_scale_m, nf_chunk=min(n // 2 + 1, CHUNK))
     finally:
         np.random.set_state(state)
     out = np.empty((n + 1, len(z), 3))
