@@ -23,9 +23,10 @@ from rawehelix.operation.interpolation import Pchip
 BETZ = 16.0 / 27.0  # the largest Cp of an ideal rotor (Betz)
 MIN_ROWS = 3  # the interpolant's end slopes take three rows
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
-#: the rotor's axis: "tangent", the helix's end tangent (V_n = V |t . i_E|: about
-#: V cos 45 deg at the paper's elevation); "wind", facing the wind (V_n = V)
-AXES = ("tangent", "wind")
+#: the rotor's axis -> V_n / V: "tangent", the helix's end tangent t (V_n = V |t . i_E|:
+#: about V cos 45 deg at the paper's elevation); "wind", facing the wind (V_n = V)
+NORMAL = {"tangent": lambda t: abs(float(t[0])), "wind": lambda t: 1.0}
+AXES = tuple(NORMAL)
 
 
 class OutOfTable(ValueError):
@@ -168,9 +169,7 @@ class RotorLaw:
     def normal_speed(self, v_hub, tangent=None):
         """V_n [m/s]: the wind's component along the rotor's axis, the wind V_hub along
         -i_E; ``tangent`` the helix's unit end tangent (x, y, z) for axis "tangent"."""
-        if self.axis == "wind":
-            return np.asarray(v_hub, float)
-        return np.asarray(v_hub, float) * abs(float(tangent[0]))
+        return np.asarray(v_hub, float) * NORMAL[self.axis](tangent)
 
     def dtorque_domega(self, omega, v_n, rho):
         """dQ/dOmega at fixed V_n [N m s]: the rotor's aerodynamic damping is its

@@ -17,8 +17,27 @@ from dataclasses import dataclass
 
 import numpy as np
 
-PROFILES = ("uniform", "power", "log")
 FLOOR_M = 1.0e-2  # [m] the power law's lowest height: V(z < 1 cm) = V(1 cm)
+
+
+def _uniform(z, w):
+    return np.ones_like(z)
+
+
+def _power(z, w):
+    """(z / z_ref)^a, z at least :data:`FLOOR_M`."""
+    return (np.maximum(z, FLOOR_M) / w.reference_height_m) ** w.shear_exponent
+
+
+def _log(z, w):
+    """ln(z / z0) / ln(z_ref / z0), z at least z0."""
+    z0 = w.roughness_m
+    return np.log(np.maximum(z, z0) / z0) / math.log(w.reference_height_m / z0)
+
+
+#: the profiles' factors V(z) / V_ref by name (forms/wind.py has the same in UFL)
+FACTORS = {"uniform": _uniform, "power": _power, "log": _log}
+PROFILES = tuple(FACTORS)
 
 
 @dataclass(frozen=True)
@@ -38,13 +57,7 @@ class WindProfile:
 
     def factor(self, z_m):
         """V(z) / V_ref [-]."""
-        z = np.asarray(z_m, float)
-        if self.profile == "power":
-            return (np.maximum(z, FLOOR_M) / self.reference_height_m) ** self.shear_exponent
-        if self.profile == "log":
-            z0 = self.roughness_m
-            return np.log(np.maximum(z, z0) / z0) / math.log(self.reference_height_m / z0)
-        return np.ones_like(z)
+        return FACTORS[self.profile](np.asarray(z_m, float), self)
 
     def speed_at(self, z_m):
         """V(z) [m/s]."""

@@ -45,7 +45,12 @@ def test_the_interpolant_is_scipys_pchip():
     tables = [(tsr, cp, ct),
               (np.array([0.5, 1.0, 2.5, 2.7, 4.0, 6.5, 7.0]),
                np.array([0.02, 0.1, 0.3, 0.3, 0.45, 0.2, 0.21]),
-               np.array([0.1, 0.2, 0.4, 0.45, 0.6, 0.8, 0.79]))]
+               np.array([0.1, 0.2, 0.4, 0.45, 0.6, 0.8, 0.79])),
+              # the end slopes' two limiters: the three-point slope against the first
+              # secant's sign (set to 0), and past 3 times it where the data turns
+              (np.array([0.5, 1.5, 1.6, 3.0, 3.5, 4.0]),
+               np.array([0.0, 0.1, 0.0, 0.05, 0.45, 0.46]),
+               np.array([0.1, 0.2, 0.3, 0.5, 0.6, 0.7]))]
     for x, c, t in tables:
         law = RotorLaw(x, c, t, radius_m=R)
         lam = np.concatenate([x, rng.uniform(x[0], x[-1], 200)])
@@ -141,7 +146,8 @@ def test_rated_power_caps_the_generator():
 
 
 def test_a_torque_table_and_a_constant_torque():
-    g = gen_law.GeneratorLaw("torque", table_rpm=[0.0, 60.0, 120.0], table_torque_Nm=[0.0, 10.0, 25.0])
+    g = gen_law.GeneratorLaw("torque", table_rpm=[0.0, 60.0, 120.0],
+                             table_torque_Nm=[0.0, 10.0, 25.0])
     assert g.torque(90 * RPM) == pytest.approx(17.5, rel=1e-14)
     assert g.torque(200 * RPM) == 25.0  # its last row beyond the table
     assert g.dtorque_domega(90 * RPM) == pytest.approx(15.0 / (60 * RPM))
@@ -165,8 +171,10 @@ def test_the_paper_law_holds_its_target_spin():
     stall = 2.0 * v / R
     dQ = law.dtorque_domega(stall, v, RHO)
     assert dQ > 0
-    g = gen_law.GeneratorLaw("paper", target_rad_s=stall, integral_Nm=2.0, damping_Nms=0.5 * dQ)
-    assert not rigid_shaft.operating_points(law, g, v, RHO)[0].stable
+    for K2 in (0.5 * dQ, dQ - 1e-3):  # net slope dQ - K2 > 0, however small: unstable
+        g = gen_law.GeneratorLaw("paper", target_rad_s=stall, integral_Nm=2.0, damping_Nms=K2)
+        (p,) = rigid_shaft.operating_points(law, g, v, RHO)
+        assert p.slope_Nms == pytest.approx(dQ - K2, rel=1e-9) and not p.stable
     with pytest.raises(ValueError, match="holds the rotor at its target spin"):
         g.torque(stall)
 

@@ -296,7 +296,19 @@ def _cross_section_rules() -> list[tuple[str, str]]:
               {"damping": {"axial_s": 1e-3}, **ip_only},
               {"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 1.0}, **ip_only},
               {"helix": {"stiffness": "from_section"}},
-              {"helix": {"stiffness": "from_section"}, "section": {"tether_EA_N": 6e3}}]
+              {"helix": {"stiffness": "from_section"}, "section": {"tether_EA_N": 6e3}},
+              # the machine's sections against the paper's ends, wind and scheme
+              {"generator": {"law": "mppt", "mppt_gain_Nms2": 0.1}},
+              {"rotor": {"radius_m": 2.0, "tsr": (1.0, 3.0, 5.0), "cp": (0.1, 0.3, 0.4),
+                         "ct": (0.2, 0.5, 0.7)}},
+              {"wind": {"speed_m_s": 5.0}},
+              {"wind": {"speed_m_s": 10.0, "air_density_kg_m3": 1.2},
+               "environment": {"air_density_kg_m3": 1.1}},
+              {"wind": {"speed_m_s": 10.0, "profile": "power"}, "environment": {"wind_speed_m_s": 0.0},
+               "discretisation": {"scheme": "spline"}},
+              {"lifter": {"top": "circle"}},
+              {"lifter": {"top": "lifted", "force_N": 300.0},
+               "ends": {"circle_radius_m": 0.1, "circle_frequency_Hz": 1.0}}]
     found = []
     for trial in trials:
         try:
