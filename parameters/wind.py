@@ -94,8 +94,9 @@ class Wind:
     @property
     def series(self) -> dict:
         """kind "file": the file's columns, {time_s, and speed_m_s or u_m_s, v_m_s,
-        w_m_s: numpy arrays} (read and checked once, at construction)."""
-        return self._series
+        w_m_s: numpy arrays} (read and checked once, at construction); None for the
+        other kinds."""
+        return getattr(self, "_series", None)
 
     @classmethod
     def reference_example(cls) -> "Wind":
