@@ -86,6 +86,13 @@ FAULTS = [
     (["campbell", "rotor_example", "--elements", "2", "--wind", "3:6:1", "--set",
       'lifter.top="lifted"', "--set", "lifter.force_N=100"], 2,
      "rotor_example: lifter: 'campbell' linearises about a fixed top end"),
+    # issue 44: the wind in time (tests/test_wind_series.py has every key and file fault)
+    (["stationary", "gust_rated", "--set", "wind.speed_m_s=45"], 2,
+     "not below V_e1 = 42 m/s of wind.wind_class = 'III'"),
+    (["stationary", "gust_rated", "--set", 'wind.turbulence_class="D"'], 2,
+     'wind.turbulence_class: "D" must be one of'),
+    (["simulate", "turbulent_rated", "--until", "700"], 2,
+     "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
 ]
 
 
