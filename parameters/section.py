@@ -53,6 +53,16 @@ class Section:
     slack_width: float = 1.0e-5  # w, the strain over which a tether goes slack (regularisation) [-]
     torsion: str = "helix"  # the twist's moment: "helix" (GJ_Nm2) or "members" (their torque)
     ring: str = "worst"  # the ring's phase: "worst" (a member on the bending plane) or "turning" (with alpha)
+    # the mass of one ring of the network reference (--scheme network) [kg]; None: the
+    # helix's mass lumped at the rings, helix.mass_kg / (rings - 1) each (the end rings,
+    # fixed, half that); the network's tethers are massless
+    ring_mass_kg: float | None = None
+    # a ring's moment of inertia about its own axis (network reference) [kg m^2]; None:
+    # a hoop's, ring mass x R^2 (its mass at the tethers' radius)
+    ring_polar_inertia_kgm2: float | None = None
+    # a ring's moment of inertia about a diameter (network reference) [kg m^2]; None: a
+    # hoop's, ring mass x R^2 / 2
+    ring_diametral_inertia_kgm2: float | None = None
 
     def __post_init__(self):
         if section_laws.refusal(self.law):
@@ -77,7 +87,8 @@ class Section:
                                  "must lie in [0, 60) degrees")
         _non_negative("section", self, "self_stress_N", "bar_EA_N")
         _positive("section", self, "slack_width")
-        for name in ("radius_m", "tether_EA_N", "breaking_force_N", "ring_spacing_m"):
+        for name in ("radius_m", "tether_EA_N", "breaking_force_N", "ring_spacing_m",
+                     "ring_mass_kg", "ring_polar_inertia_kgm2", "ring_diametral_inertia_kgm2"):
             if getattr(self, name) is not None:
                 _positive("section", self, name)
         if self.rings is not None:
