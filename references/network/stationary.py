@@ -11,6 +11,7 @@ did not converge and what to try.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -104,9 +105,10 @@ def _descent_step(H: sp.csr_matrix, r: np.ndarray) -> np.ndarray:
     D = sp.diags(np.abs(H.diagonal()) + 1e-300)
     for shift in [0.0] + [10.0 ** e for e in range(-8, 3)]:
         try:
-            with np.errstate(all="raise"):
+            with np.errstate(all="raise"), warnings.catch_warnings():
+                warnings.simplefilter("error", spla.MatrixRankWarning)  # singular: next shift
                 step = -spla.spsolve((H + shift * D).tocsc(), r)
-        except (RuntimeError, FloatingPointError, ValueError):
+        except (RuntimeError, FloatingPointError, ValueError, spla.MatrixRankWarning):
             continue
         if np.all(np.isfinite(step)) and step @ r < 0:
             return step

@@ -1,0 +1,178 @@
+"""The network reference (references/network) against closed forms of the network
+alone, each written out here from the chord geometry, independently of the module:
+a single bay's axial, bending and torsional stiffness, Tulloch's collapse angle of one
+bay, a weighted taut string of rings' sag and a taut string's frequencies.  All numpy,
+under 3 s together."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq, minimize_scalar
+
+from rawehelix import members
+from rawehelix.references.network import Network, Ring, solve
+from rawehelix.references.network import energy as en
+from rawehelix.references.network.modes import modes
+from rawehelix.studies import scene
+
+N_TETHERS, RADIUS, K, HEIGHT = 6, 0.19, 6000.0, 1.0  # [-], [m], [N], [m]
+
+
+def bay(lay_rad=0.0, rest_m=0.99, k=K, height=HEIGHT, twist=0.0, torque=None):
+    """One bay (two rings, tethers of rest length rest_m) standing on e3 = -k_E."""
+    ring = Ring(1.0, 1.0, 1.0)
+    return Network(n=N_TETHERS, radius_m=RADIUS, k_N=k, l0_m=rest_m,
+                   chord_m=np.array([0.0, 0.0, -height]), lay_rad=lay_rad, rings=(ring, ring),
+                   loads_N=np.zeros((2, 3)), end_twist_rad=twist, end_torque_Nm=torque)
+
+
+def hand_energy(lay, rest, dz=0.0, bend=0.0, twist=0.0, k=K):
+    """The bay's tether energy [J], written from its chord geometry: ground point m at
+    R (cos phi, sin phi, 0), top point m at the top ring's centre (0, 0, HEIGHT + dz)
+    plus R (cos(phi + lay + twist), sin(phi + lay + twist), 0) tilted by ``bend`` about
+    the first axis; force k (L - rest) / rest when taut."""
+    phi = 2 * np.pi * np.arange(N_TETHERS) / N_TETHERS
+    lo = RADIUS * np.column_stack([np.cos(phi), np.sin(phi), 0 * phi])
+    a = phi + lay + twist
+    up = RADIUS * np.column_stack([np.cos(a), np.sin(a) * np.cos(bend), np.sin(a) * np.sin(bend)])
+    up[:, 2] += HEIGHT + dz
+    L = np.linalg.norm(up - lo, axis=1)
+    return float(np.sum(k / (2 * rest) * np.maximum(L - rest, 0.0) ** 2))
+
+
+def top_block(net):
+    """The top ring's 6x6 stiffness in the chord frame (e1, e2, e3), ground held."""
+    H = en.gradient_hessian(net, en.State(*net.reference()))[1].toarray()[6:, 6:]
+    E = net.frame
+    T = np.block([[E, np.zeros((3, 3))], [np.zeros((3, 3)), E]])
+    return T.T @ H @ T
+
+
+def second_difference(f, h=1e-4):  # truncation ~1e-8, round-off ~2e-7 relative
+    return (f(h) - 2 * f(0.0) + f(-h)) / (h * h)
+
+
+def test_bay_stiffness_at_zero_lay_is_the_closed_form():
+    """beta = 0, chords of length h = 1 m at the force f = k (h - l0) / l0: axial n k / l0,
+    bending (about a diameter) n k R^2 / (2 l0) (the tension adds nothing: the tilted
+    chords' length is stationary to second order), torsion n f R^2 / h (Tulloch's
+    geometric torsional stiffness, GJ = N R^2)."""
+    rest = 0.99
+    f = K * (HEIGHT - rest) / rest
+    S = top_block(bay(rest_m=rest))
+    # the chord frame's e3 is the chord (0, 0, -1): e3's translation and turn are the bay's
+    assert S[2, 2] == pytest.approx(N_TETHERS * K / rest, rel=1e-12)
+    assert S[3, 3] == pytest.approx(N_TETHERS * K * RADIUS**2 / (2 * rest), rel=1e-12)
+    assert S[4, 4] == pytest.approx(N_TETHERS * K * RADIUS**2 / (2 * rest), rel=1e-12)
+    assert S[5, 5] == pytest.approx(N_TETHERS * f * RADIUS**2 / HEIGHT, rel=1e-12)
+
+
+@pytest.mark.parametrize("lay_deg", [10.0, 25.0])
+def test_laid_bay_stiffness_against_its_chord_geometry(lay_deg):
+    """A laid bay (the top ring turned by delta_0): its axial, bending and torsional
+    stiffness against the second differences of the energy of the chords written
+    out by hand (relative 1e-6: the differences' truncation)."""
+    lay = math.radians(lay_deg)
+    rest = 0.995 * math.hypot(HEIGHT, 2 * RADIUS * math.sin(lay / 2))
+    S = top_block(bay(lay_rad=lay, rest_m=rest))
+    # the network's e3 points up (0, 0, -1 in k_E): a rise dz is a move along e3
+    axial = second_difference(lambda h: hand_energy(lay, rest, dz=h))
+    bending = second_difference(lambda h: hand_energy(lay, rest, bend=h))
+    torsion = second_difference(lambda h: hand_energy(lay, rest, twist=h))
+    assert S[2, 2] == pytest.approx(axial, rel=1e-6)
+    assert max(S[3, 3], S[4, 4]) == pytest.approx(bending, rel=1e-6)
+    assert min(S[3, 3], S[4, 4]) == pytest.approx(bending, rel=1e-6)  # n = 6: isotropic
+    assert S[5, 5] == pytest.approx(torsion, rel=1e-6)
+
+
+def tulloch_angle(R, l_t):
+    """Derived here: a bay of inextensible tethers l_t under the axial force F has the
+    height h(d) = sqrt(l_t^2 - 2 R^2 (1 - cos d)) at the twist d, each tether's
+    tangential share (R sin d) / l_t of its force and axial share h / l_t, so the torque
+    is Q = F R^2 sin d / h(d); dQ/dd = 0 at cos d h^2 + R^2 sin^2 d = 0, i.e.
+    R^2 (1 - c)^2 + l_t^2 c = 0, c = cos d, the root in [-1, 0]."""
+    return math.acos(brentq(lambda c: R * R * (1 - c) ** 2 + l_t * l_t * c, -1.0, 0.0))
+
+
+def test_one_bays_torque_peaks_at_tullochs_collapse_angle():
+    """One bay of nearly inextensible tethers (k = 1e6 N, F = 100 N) held at the axial force F by
+    its height: the network's torque reaction peaks at the twist the closed form gives
+    (and members.critical_twist, the limits' criterion, agrees)."""
+    l_t, F = 1.0, 100.0  # [m], [N]
+    stiff = 1e6  # stretch ~1e-5: the argmax moves by ~1e-5, and the torque keeps 1e-11 digits
+
+    def reactions(twist, height):
+        net = bay(rest_m=l_t, k=stiff, height=height, twist=twist)
+        g = en.gradient_hessian(net, en.State(*net.reference()))[0]
+        e3 = net.frame[:, 2]
+        return g[6:9] @ e3, g[9:12] @ e3  # the force and torque holding the top ring
+
+    def torque(twist):
+        hi = math.sqrt(max(l_t**2 - 2 * RADIUS**2 * (1 - math.cos(twist)), 1e-12))
+        h = brentq(lambda z: reactions(twist, z)[0] - F, 0.5 * hi, hi * 1.001, xtol=1e-14)
+        return reactions(twist, h)[1]
+
+    peak = minimize_scalar(lambda d: -torque(d), bounds=(1.2, 2.5), method="bounded",
+                           options={"xatol": 1e-7}).x
+    expected = tulloch_angle(RADIUS, l_t)
+    assert expected == pytest.approx(members.critical_twist(RADIUS, l_t), abs=1e-12)
+    assert peak == pytest.approx(expected, abs=1e-4)  # 2e-5 observed
+    assert torque(expected) == pytest.approx(F * RADIUS**2 * math.sin(expected) / math.sqrt(
+        l_t**2 - 2 * RADIUS**2 * (1 - math.cos(expected))), rel=1e-4)  # the stretch f / k ~ 2e-5
+
+
+def string_scene(rings, elevation_deg=45.0, gravity=False):
+    """Table 2's helix as a bending-free (R = 1 mm), unlaid, weightless-or-not string of
+    rings without drag."""
+    return scene.load("stationary_table2").replace(
+        section={"rings": rings, "radius_m": 1e-3}, model={"gravity": gravity, "drag": False},
+        ends={"elevation_deg": elevation_deg})
+
+
+def test_taut_string_of_rings_frequencies():
+    """Weightless, bending-free: the lateral frequencies are the beaded string's,
+    f_k = (1 / pi) sqrt(T / (m l)) sin(k pi / (2 (rings - 1))), and tend to the
+    string's k / (2 L) sqrt(T / mu) (within the beads' (k pi / (2 (rings - 1)))^2 / 6);
+    T = n k eps0, m = M / (rings - 1), l = (1 + eps0) L0 / (rings - 1)."""
+    rings = 17
+    p = string_scene(rings)
+    h = p.helix
+    eps0, bays = p.ends.elongation, rings - 1
+    T = h.EA_N * eps0  # the tethers' k = EA / n (members.py) at the strain eps0
+    m, l, L = h.mass_kg / bays, (1 + eps0) * h.length_m / bays, (1 + eps0) * h.length_m
+    result = solve(Network.from_parameters(p))
+    assert result.tension_N() == pytest.approx(T, rel=1e-9)
+    found = modes(result)
+    for family in ("lateral_in_plane", "lateral_out_of_plane"):
+        f = np.array([x.frequency_Hz for x in found if x.family == family][:4])
+        k = np.arange(1, 5)
+        beads = np.sqrt(T / (m * l)) / np.pi * np.sin(k * np.pi / (2 * bays))
+        assert f == pytest.approx(beads, rel=2e-5)  # the rings' R = 1 mm bending: ~1e-6
+        string = k / (2 * L) * math.sqrt(T / (h.mass_kg / L))
+        assert np.all(np.abs(f / string - 1) < (k * np.pi / (2 * bays)) ** 2 / 6 * 1.01 + 1e-5)
+
+
+def test_string_of_rings_sags_as_the_weighted_string():
+    """A horizontal chord under the rings' weight: the beads' polygon has the string's
+    parabola at its rings, y(x) = w x (L - x) / (2 H), H the chord-wise tension (the
+    same in every bay), w = M g / L per unit chord L (each ring M / (rings - 1) every
+    L / (rings - 1)): the sag at the middle ring is M g L / (8 H), within the string's
+    small-sag error (sag / L)^2."""
+    p = string_scene(9, elevation_deg=0.0, gravity=True)
+    h, eps0 = p.helix, p.ends.elongation
+    result = solve(Network.from_parameters(p))
+    L = (1 + eps0) * h.length_m
+    H = float(result.bay_forces_N()[0] @ (result.network.chord_m / L))  # chord-wise, constant
+    sag = h.mass_kg * p.environment.g_m_s2 * L / (8 * H)
+    assert result.sag_m() == pytest.approx(sag, rel=1e-3)
+    assert abs(result.sag_m() / L) ** 2 < 1e-3
+
+
+def test_stationary_solve_refuses_a_collapsed_bay():
+    """A torque far past what one bay can carry: no stationary state; the error names
+    the torque key to lower."""
+    from rawehelix.references.network import NetworkError
+    net = bay(rest_m=0.99, torque=1e4)
+    with pytest.raises(NetworkError, match="torque.top_Nm"):
+        solve(net, max_iterations=30)
