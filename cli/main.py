@@ -159,6 +159,10 @@ def main(argv: list[str] | None = None) -> int:
             params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                    scheme=args.scheme,
                                    overrides=overrides(args, command.f1_grid))
+            from rawehelix.parameters import schemes as scheme_cores
+            refusal = scheme_cores.of(params).command_refusal(args.command)
+            if refusal:  # before any work or folder
+                raise SceneError("--scheme", params.discretisation.scheme, refusal)
             from rawehelix.solvers import tension_target
             params = tension_target.resolve(params, comm)  # ends.tension_N -> its elongation
             outdir = args.output or Path("results") / params.name / args.command

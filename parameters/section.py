@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from rawehelix import section_laws
 from rawehelix.members import Members
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
+from rawehelix.parameters.numerics import BESIDE_CONTINUUM
 
 #: the section laws' names, the registry's (section_laws.py): "saturating" is the fallback
 #: law of issue 29 (members.py::ConeSection), the solid's EA and EI inside the cone
@@ -137,6 +138,18 @@ class Section:
             return helix.length_m / (self.rings - 1)
         return self.ring_spacing_m
 
+    def ring_count(self, length_m: float) -> int:
+        """The rings along a helix of length L0 [m], both ends included: ``rings``, or
+        L0 / ring_spacing_m + 1 rounded (at least 2); ParameterError when neither is
+        given (the network reference, --scheme network, needs them)."""
+        if self.rings is not None:
+            return self.rings
+        if self.ring_spacing_m is not None:
+            return max(2, round(length_m / self.ring_spacing_m) + 1)
+        raise ParameterError("section.rings", None,
+                             "--scheme network needs the rings: set section.rings (>= 2, both "
+                             "end rings included) or section.ring_spacing_m")
+
     def describe(self) -> str:
         return (f"section: {self.law}, torsion by the {self.torsion}, {self.tethers} tethers, "
                 f"lay {self.lay_angle_deg:g} deg, ring {self.ring}, "
@@ -220,8 +233,10 @@ def check(params) -> None:
     are the variation of the members' energy, so it needs the extensible kinematics
     (model.kinematics = "extensible") of the FE scheme with the IP bending form."""
     section, disc = params.model.section, params.discretisation
+    if disc.scheme in BESIDE_CONTINUUM:  # the network's rings, before any work
+        section.ring_count(params.helix.length_m)
     if section.active and (params.model.kinematics not in ("extensible", "shearable")
-                           or disc.scheme != "fe" or disc.bending != "ip"):
+                           or disc.continuum_scheme != "fe" or disc.bending != "ip"):
         raise ParameterError("section.law", section.law,
                              f"'{section.law}' needs model.kinematics = 'extensible' (or "
                              "'shearable') on the FE scheme with discretisation.bending = 'ip' "

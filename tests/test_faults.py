@@ -57,6 +57,11 @@ FAULTS = [
     (["stationary", "nominal_operation", "--elements", "2"], 2,
      "controller.target_rpm: 120 rpm with controller.k1 = 0.5 > 0"),
     (["converge", "stationary_table2", "--quantity", "nothing"], 2, "--quantity: nothing"),
+    # the network reference (references/network): its rings, and the commands it runs
+    (["modes", "stationary_table2", "--scheme", "network"], 2,
+     "section.rings: --scheme network needs the rings"),
+    (["sweep", "mobile_end", "--scheme", "network", "--set", "section.rings=5"], 2,
+     "'network' runs 'stationary', 'modes', 'section' only, not 'sweep'"),
     (["extremes", "nosuchcase"], 2, "unknown case(s)"),
     (["study", "stationary_table2", "--vary", "helix.EI_Nm2=1:2:3", "--quantity", "tension"], 2,
      "--quantity: tension: unknown quantity"),

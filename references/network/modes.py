@@ -24,6 +24,9 @@ from rawehelix.references.network import energy as en
 
 #: the kinetic-energy groups and their families (module docstring)
 GROUPS = ("longitudinal", "lateral_in_plane", "lateral_out_of_plane", "torsional", ROTATION)
+#: each group's dofs, in the chord's frame (a mode's dominant components)
+DOFS_OF = {"longitudinal": "x_3", "lateral_in_plane": "x_1", "lateral_out_of_plane": "x_2",
+           "torsional": "w_3", ROTATION: "w_1, w_2"}
 
 
 @dataclass(frozen=True)

@@ -155,7 +155,7 @@ class Network:
         the scene's torque.top_Nm when nonzero, unless ``end_torque_Nm`` is given."""
         h, sec, env, ends, model = (params.helix, params.model.section, params.environment,
                                     params.ends, params.model)
-        N = rings if rings is not None else ring_count(sec, h.length_m)
+        N = rings if rings is not None else sec.ring_count(h.length_m)
         if ends.elongation is None:
             raise ParameterError("ends.tension_N", ends.tension_N,
                                  "--scheme network needs ends.elongation (the chord's stretch)")
@@ -186,14 +186,3 @@ class Network:
                    rings=ring_list, loads_N=loads, bar_EA_N=bar_EA, bar_l0_m=bar_l0,
                    end_twist_rad=end_twist_rad, end_torque_Nm=end_torque_Nm, spacing_m=l)
 
-
-def ring_count(section, length_m: float) -> int:
-    """The rings along the helix, both ends included: section.rings, or L0 /
-    section.ring_spacing_m + 1 rounded; ParameterError when neither is given."""
-    if section.rings is not None:
-        return section.rings
-    if section.ring_spacing_m is not None:
-        return max(2, round(length_m / section.ring_spacing_m) + 1)
-    raise ParameterError("section.rings", None,
-                         "--scheme network needs the rings: set section.rings (>= 3, both end "
-                         "rings included) or section.ring_spacing_m")
