@@ -212,3 +212,26 @@ def test_stationary_prints_the_network_beside_the_continuum():
     assert s["beside"]["rings"] == 9
     assert s["beside"]["tension_s0_N"] == pytest.approx(s["tension_N"]["s0"], rel=1e-2)
     assert "network beside it (9 rings" in stationary.report(result)
+
+
+def test_a_self_stressed_bays_shear_stiffness_is_its_net_tensions():
+    """An unlaid bay with the self-stress P0 balanced by its bar (on the axis, between the
+    ring centres): the top ring moved sideways by u, not turned, tilts every tether and
+    the bar by u / h, so its stiffness is (n f - C) / h with f the tethers' force and C
+    the bar's compression, i.e. the bay's net axial force T / h: the self-stress drops
+    out (members.py::Members.shear_stiffness counts n f, its bars adding nothing)."""
+    n, P0, EA_b, stretch = N_TETHERS, 600.0, 2e4, 1.001  # [-], [N], [N], the bay's stretch
+    rest = HEIGHT / (1 + P0 / K)
+    ring = Ring(1.0, 1.0, 1.0)
+    bar_l0 = HEIGHT / (1 - n * P0 / EA_b)
+    h = stretch * HEIGHT
+    net = Network(n=n, radius_m=RADIUS, k_N=K, l0_m=rest, chord_m=np.array([0.0, 0.0, -h]),
+                  lay_rad=0.0, rings=(ring, ring), loads_N=np.zeros((2, 3)), bar_EA_N=EA_b,
+                  bar_l0_m=bar_l0)
+    f = K * (h - rest) / rest
+    compression = -EA_b * (h - bar_l0) / bar_l0
+    S = top_block(net)
+    assert S[0, 0] == pytest.approx((n * f - compression) / h, rel=1e-12)
+    assert n * f - compression < 0.05 * n * P0  # the net tension, not the self-stress
+    assert members.Members(n=n, R=RADIUS, beta=0.0, k=K, P0=P0, EA_b=EA_b).shear_stiffness(f) \
+        == pytest.approx(n * f)
