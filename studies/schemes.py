@@ -251,6 +251,8 @@ class Network(NetworkCore, Scheme):
                 # the bay's middle along the unstretched helix
                 "smallest_at_s_m": (bay + 0.5) * net.spacing_m,
                 "slack_tethers": len(result.slack), "newton_iterations": result.iterations,
+                # the top ring's turn about the chord beyond the lay (a torque end's twist)
+                "twist_end_to_end_rad": result.state.theta + net.end_twist_rad,
                 "wall_s": time.perf_counter() - start}
 
     def size_label(self, info):

@@ -140,9 +140,9 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
         raise SceneError(params.name, "discretisation.scheme",
                          "'stationary' runs the FE scheme; the spline reference's stationary "
                          "state is part of 'modes'")
+    top_torque = static_torque(params)  # refuses an unbalanced scene before any work
     beside = scheme.stationary_beside(params)  # a model of its own, beside the FE's
     params = params.replace(discretisation={"scheme": params.discretisation.continuum_scheme})
-    top_torque = static_torque(params)  # refuses an unbalanced scene before any work
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
@@ -265,10 +265,14 @@ def _beside_line(b: dict, s: dict) -> str:
     tether = (f"smallest tether force {b['smallest_tether_force_N']:.2f} N at s = "
               f"{b['smallest_at_s_m']:.2f} m"
               + (f" (continuum {f_fe:.2f} N)" if f_fe is not None else ""))
+    torque = s.get("torque")
+    twist = (f", twist {b['twist_end_to_end_rad']:.6g} rad "
+             f"({gap(b['twist_end_to_end_rad'], torque['twist_end_to_end_rad'])})"
+             if torque else "")
     return (f"  {b['scheme']} beside it ({b['rings']} rings, l = {b['spacing_m']:.4g} m, "
             f"{b['newton_iterations']} Newton iterations, {b['wall_s']:.2f} s): sag "
             f"{b['sag_m']:.5f} m ({gap(b['sag_m'], s['sag_m'])}), T(0) = "
-            f"{b['tension_s0_N']:.3f} N ({gap(b['tension_s0_N'], s['tension_N']['s0'])}), "
+            f"{b['tension_s0_N']:.3f} N ({gap(b['tension_s0_N'], s['tension_N']['s0'])}){twist}, "
             f"{tether}, {b['slack_tethers']} slack")
 
 
