@@ -131,7 +131,8 @@ def string_scene(rings, elevation_deg=45.0, gravity=False):
 
 
 def test_taut_string_of_rings_frequencies():
-    """Weightless, bending-free: the lateral frequencies are the beaded string's,
+    """Weightless, bending-free: the lateral (and, with the hoop's inertia, the
+    torsional) frequencies are the beaded string's,
     f_k = (1 / pi) sqrt(T / (m l)) sin(k pi / (2 (rings - 1))), and tend to the
     string's k / (2 L) sqrt(T / mu) (within the beads' (k pi / (2 (rings - 1)))^2 / 6);
     T = n k eps0, m = M / (rings - 1), l = (1 + eps0) L0 / (rings - 1)."""
@@ -151,6 +152,14 @@ def test_taut_string_of_rings_frequencies():
         assert f == pytest.approx(beads, rel=2e-5)  # the rings' R = 1 mm bending: ~1e-6
         string = k / (2 * L) * math.sqrt(T / (h.mass_kg / L))
         assert np.all(np.abs(f / string - 1) < (k * np.pi / (2 * bays)) ** 2 / 6 * 1.01 + 1e-5)
+    # the rings' turns: each bay's torsional stiffness n f R^2 / l (Tulloch's), each
+    # ring's polar inertia the hoop's m R^2: the beaded string's frequencies again
+    R = p.helix.radius_m if p.model.section.radius_m is None else p.model.section.radius_m
+    f = np.array([x.frequency_Hz for x in found if x.family == "torsional"][:4])
+    k = np.arange(1, 5)
+    GJ_per_l = T * R * R / l  # n f = T, unlaid
+    assert f == pytest.approx(np.sqrt(GJ_per_l / (m * R * R)) / np.pi
+                              * np.sin(k * np.pi / (2 * bays)), rel=1e-9)
 
 
 def test_string_of_rings_sags_as_the_weighted_string():
@@ -241,3 +250,34 @@ def test_a_self_stressed_bays_shear_stiffness_is_its_net_tensions():
     assert n * f - compression < 0.05 * n * P0  # the net tension, not the self-stress
     assert members.Members(n=n, R=RADIUS, beta=0.0, k=K, P0=P0, EA_b=EA_b).shear_stiffness(f) \
         == pytest.approx(n * f)
+
+
+def test_the_hessian_is_the_energys_second_derivative():
+    """At a state off equilibrium (rings moved and turned at random, some tethers slack,
+    bars, a torque end), the analytic gradient and Hessian against central differences
+    of the energy in the exponential chart (1e-6 and 1e-4 relative: the differences)."""
+    from rawehelix.references.network import energy as en
+    p = scene.load("stationary_table2").replace(
+        section={"rings": 4, "lay_angle_deg": 20.0, "self_stress_N": 50.0, "bar_EA_N": 1e4})
+    net = Network.from_parameters(p, end_torque_Nm=3.0)
+    rng = np.random.default_rng(1)
+    X, R = net.reference()
+    s = en.moved(net, en.State(X + 0.01 * rng.standard_normal(X.shape), R),
+                 0.05 * rng.standard_normal(6 * net.count))
+    assert 0 < np.sum(en.tether_forces(net, s) == 0) < net.n * (net.count - 1)  # some slack
+    g, H = en.gradient_hessian(net, s)
+    P = en.free_basis(net)
+    g, H = P.T @ g, (P.T @ H @ P).toarray()
+    free = P.shape[1]
+
+    def E(v):
+        return en.energy(net, en.moved(net, s, P @ v))
+
+    h, I = 1e-4, np.eye(free)
+    fd_g = np.array([(E(h * I[i]) - E(-h * I[i])) / (2 * h) for i in range(free)])
+    fd_H = np.array([[(E(h * (I[i] + I[j])) - E(h * (I[i] - I[j])) - E(h * (I[j] - I[i]))
+                       + E(-h * (I[i] + I[j]))) / (4 * h * h) for j in range(free)]
+                     for i in range(free)])
+    assert np.abs(fd_g - g).max() < 1e-6 * np.abs(g).max()
+    assert np.abs(fd_H - H).max() < 1e-4 * np.abs(H).max()
+    assert np.abs(H - H.T).max() < 1e-12 * np.abs(H).max()
