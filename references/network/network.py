@@ -38,8 +38,9 @@ each ring carries l of it (the end rings l / 2).  Both follow the model's
 gravity and drag switches.
 
 **Ends** (Eq. 66): the ground ring at 0 in its reference frame; the top ring at the
-elongated chord (1 + eps0) L0 (cos Gamma0 (-i_E) + sin Gamma0 (-k_E)), turned by an
-optional end twist about e3; or, with an end torque (torque.top_Nm, the stationary
+elongated chord (1 + eps0) L0 (cos Gamma0 (-i_E) + sin Gamma0 (-k_E)) (on the circle of
+Eq. (70) at t = 0 when it has one, where every run starts), turned by an optional end
+twist about e3; or, with an end torque (torque.top_Nm, the stationary
 value of Eq. 69), the top ring's rotation about e3 free and loaded by that torque.
 """
 
@@ -168,8 +169,8 @@ class Network:
         bar_EA, bar_l0 = members.EA_b, l
         if bar_EA > 0:
             bar_l0 = l / (1 - n * P0 * (l / l_t) / bar_EA)  # balances the self-stress
-        a, G = (1 + ends.elongation) * L0, math.radians(ends.elevation_deg)
-        chord = -a * np.array([math.cos(G), 0.0, math.sin(G)])  # Eq. (66): z down
+        # Eq. (66), z down, on the circle of Eq. (70) at t = 0 as every run starts
+        chord = L0 * np.asarray(params.normalised().top_position(0.0), dtype=float)
         share = np.full(N, l)  # each ring's length of helix [m]
         share[[0, -1]] = l / 2
         M_ring = sec.ring_mass_kg
