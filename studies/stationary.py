@@ -269,11 +269,17 @@ def _beside_line(b: dict, s: dict) -> str:
     twist = (f", twist {b['twist_end_to_end_rad']:.6g} rad "
              f"({gap(b['twist_end_to_end_rad'], torque['twist_end_to_end_rad'])})"
              if torque else "")
+    from rawehelix import section_laws
+    law = (s.get("limits") or {}).get("law")
+    other = ("; the continuum's section is not the members' (section.law = "
+             f"{law!r}): --set section.law=tensegrity --set model.kinematics=extensible "
+             "compares the same members"
+             if law is not None and not section_laws.get(law).members else "")
     return (f"  {b['scheme']} beside it ({b['rings']} rings, l = {b['spacing_m']:.4g} m, "
             f"{b['newton_iterations']} Newton iterations, {b['wall_s']:.2f} s): sag "
             f"{b['sag_m']:.5f} m ({gap(b['sag_m'], s['sag_m'])}), T(0) = "
             f"{b['tension_s0_N']:.3f} N ({gap(b['tension_s0_N'], s['tension_N']['s0'])}){twist}, "
-            f"{tether}, {b['slack_tethers']} slack")
+            f"{tether}, {b['slack_tethers']} slack{other}")
 
 
 def _status(status: str) -> str:

@@ -281,3 +281,21 @@ def test_the_hessian_is_the_energys_second_derivative():
     assert np.abs(fd_g - g).max() < 1e-6 * np.abs(g).max()
     assert np.abs(fd_H - H).max() < 1e-4 * np.abs(H).max()
     assert np.abs(H - H.T).max() < 1e-12 * np.abs(H).max()
+
+
+@pytest.mark.parametrize("law,advised", [("solid", True), ("saturating", True),
+                                         ("tensegrity", False)])
+def test_the_beside_line_says_when_the_continuum_has_other_members(law, advised):
+    """The network is the members' helix: beside a continuum whose section is not the
+    members' (the solid's EI is 20x theirs: sag +228 % at 9 rings) the line says how to
+    compare the same members."""
+    from rawehelix.studies import stationary
+    beside = {"scheme": "network", "rings": 9, "spacing_m": 2.015, "newton_iterations": 4,
+              "wall_s": 0.1, "sag_m": 0.1176, "tension_s0_N": 207.4,
+              "smallest_tether_force_N": 33.9, "smallest_at_s_m": 15.1, "slack_tethers": 0,
+              "twist_end_to_end_rad": 0.0}
+    s = {"sag_m": 0.0359, "tension_N": {"s0": 202.9}, "torque": None,
+         "limits": {"law": law, "min_member_force_N": {"value": 3.66}}}
+    line = stationary._beside_line(beside, s)
+    assert "sag 0.11760 m (+227.58 %)" in line
+    assert ("--set section.law=tensegrity --set model.kinematics=extensible" in line) == advised
