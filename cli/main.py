@@ -1,7 +1,7 @@
 """The rawehelix command line: a thin layer over the Python API (:mod:`rawehelix.api`).
 
-    rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
-    rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
+    rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [--scheme fe|network] [PETSc options]
+    rawehelix modes SCENE [--scheme fe|spline|network] [--elements N] [--degree p] [--count k] [-o DIR]
     rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
     rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
