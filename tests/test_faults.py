@@ -60,6 +60,10 @@ FAULTS = [
     # the network reference (references/network): its rings, and the commands it runs
     (["modes", "stationary_table2", "--scheme", "network"], 2,
      "section.rings: --scheme network needs the rings"),
+    (["stationary", "stationary_table2", "--scheme", "network", "--set", "section.rings=2"], 2,
+     "section.rings: 2 --scheme network needs 3 to 1000 rings"),
+    (["modes", "stationary_table2", "--scheme", "network", "--set", "section.rings=5", "--set",
+      "section.lay_angle_deg=16.8"], 2, "past Tulloch's collapse angle"),
     (["sweep", "mobile_end", "--scheme", "network", "--set", "section.rings=5"], 2,
      "'network' runs 'stationary', 'modes', 'section' only, not 'sweep'"),
     (["extremes", "nosuchcase"], 2, "unknown case(s)"),

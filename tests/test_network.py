@@ -187,6 +187,20 @@ def test_stationary_solve_refuses_a_collapsed_bay():
         solve(net, max_iterations=30)
 
 
+def test_a_torque_that_unwinds_the_lay_collapses_the_helix():
+    """Table 2 laid at 16.8 deg, its top ring free under a torque: with the lay's hand
+    (+20 N m) it holds (every tether taut); against it (-5 N m, below the lay's own
+    unwinding torque T R tan(beta) ~ 12 N m) the tethers straighten, shorten past their
+    4.5 % lay and go slack: no state near the straight chord, and the error says why."""
+    from rawehelix.references.network import NetworkError
+    p = scene.load("stationary_table2").replace(
+        section={"rings": 65, "lay_angle_deg": 16.8, "tether_EA_N": 6910.2})  # delta_0 0.4 rad
+    held = solve(Network.from_parameters(p.replace(torque={"top_Nm": 20.0})))
+    assert held.slack == [] and held.state.theta > 0
+    with pytest.raises(NetworkError, match="unwinds the lay"):
+        solve(Network.from_parameters(p.replace(torque={"top_Nm": -5.0})))
+
+
 def test_modes_through_the_scheme_registry_are_the_networks_in_hertz():
     """`rawehelix modes SCENE --scheme network`'s path (studies/modes.py through the
     registry): the lowest lateral frequency is the beaded string's (Table 2's rings of
@@ -258,7 +272,7 @@ def test_the_hessian_is_the_energys_second_derivative():
     of the energy in the exponential chart (1e-6 and 1e-4 relative: the differences)."""
     from rawehelix.references.network import energy as en
     p = scene.load("stationary_table2").replace(
-        section={"rings": 4, "lay_angle_deg": 20.0, "self_stress_N": 50.0, "bar_EA_N": 1e4})
+        section={"rings": 4, "lay_angle_deg": 2.0, "self_stress_N": 50.0, "bar_EA_N": 1e4})
     net = Network.from_parameters(p, end_torque_Nm=3.0)
     rng = np.random.default_rng(1)
     X, R = net.reference()

@@ -53,6 +53,7 @@ import numpy as np
 
 from rawehelix.errors import SolverError
 from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.section import check_network_rings
 
 
 class NetworkError(SolverError):
@@ -157,6 +158,7 @@ class Network:
         h, sec, env, ends, model = (params.helix, params.model.section, params.environment,
                                     params.ends, params.model)
         N = rings if rings is not None else sec.ring_count(h.length_m)
+        check_network_rings(sec, h, N)  # the lay alone would collapse its bays
         if ends.elongation is None:
             raise ParameterError("ends.tension_N", ends.tension_N,
                                  "--scheme network needs ends.elongation (the chord's stretch)")

@@ -110,8 +110,9 @@ def _descent_step(H: sp.csr_matrix, r: np.ndarray) -> np.ndarray:
                 step = -spla.spsolve((H + shift * D).tocsc(), r)
         except (RuntimeError, FloatingPointError, ValueError, spla.MatrixRankWarning):
             continue
-        if np.all(np.isfinite(step)) and step @ r < 0:
-            return step
+        with np.errstate(all="ignore"):  # a near-singular shift's step may overflow
+            if np.all(np.isfinite(step)) and np.isfinite(step @ r) and step @ r < 0:
+                return step
     return None
 
 
@@ -141,18 +142,22 @@ def solve(net: Network, state: en.State | None = None, max_iterations: int = 100
         slope, alpha = float(step @ r), 1.0
         noise = ENERGY_NOISE * (abs(E) + float(np.abs(net.loads_N * s.X).sum()))  # round-off [J]
         for _ in range(HALVINGS):
-            trial = en.moved(net, s, P @ (alpha * step))
-            E_trial = en.energy(net, trial)
-            if E_trial <= E + ARMIJO * alpha * slope + noise:
+            with np.errstate(all="ignore"):  # a long step's energy may overflow: halve it
+                trial = en.moved(net, s, P @ (alpha * step))
+                E_trial = en.energy(net, trial)
+            if E_trial <= E + ARMIJO * alpha * slope + noise:  # False for nan
                 break
             alpha /= 2
         else:
             raise NetworkError(
                 f"the network's line search found no decrease of the energy at iteration {it} "
-                f"(largest force {res:.3g} N): the tethers' slack switches too close to the "
-                "state; fewer rings (section.rings) or a smaller load (wind, torque) converge")
+                f"(largest force {res:.3g} N): its tethers go slack along the step, the load "
+                "past what they carry near the straight chord (a top torque that unwinds the "
+                "lay collapses it); lower torque.top_Nm or the wind, or give the tethers a "
+                "self-stress (section.self_stress_N with section.bar_EA_N)")
         s, E = trial, E_trial
     raise NetworkError(
         f"the network's Newton did not converge in {max_iterations} iterations (largest force "
-        f"{res:.3g} N against {tol:.3g} N): the end torque or twist may be past the bays' "
-        "collapse (rawehelix limits SCENE names it); lower torque.top_Nm")
+        f"{res:.3g} N against {tol:.3g} N): the end torque, or the lay's turn per bay "
+        "(l tan(beta) / R against Tulloch's collapse angle), may be near the bays' collapse; "
+        "lower torque.top_Nm or give more rings (section.rings)")
