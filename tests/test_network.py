@@ -122,11 +122,11 @@ def test_one_bays_torque_peaks_at_tullochs_collapse_angle():
         l_t**2 - 2 * RADIUS**2 * (1 - math.cos(expected))), rel=1e-4)  # the stretch f / k ~ 2e-5
 
 
-def string_scene(rings, elevation_deg=45.0, gravity=False):
+def string_scene(rings, elevation_deg=45.0, gravity=False, drag=False):
     """Table 2's helix as a bending-free (R = 1 mm), unlaid, weightless-or-not string of
-    rings without drag."""
+    rings, without drag unless asked."""
     return scene.load("stationary_table2").replace(
-        section={"rings": rings, "radius_m": 1e-3}, model={"gravity": gravity, "drag": False},
+        section={"rings": rings, "radius_m": 1e-3}, model={"gravity": gravity, "drag": drag},
         ends={"elevation_deg": elevation_deg})
 
 
@@ -176,6 +176,22 @@ def test_string_of_rings_sags_as_the_weighted_string():
     sag = h.mass_kg * p.environment.g_m_s2 * L / (8 * H)
     assert result.sag_m() == pytest.approx(sag, rel=1e-3)
     assert abs(result.sag_m() / L) ** 2 < 1e-3
+
+
+def test_string_of_rings_sags_downwind_as_eq_14s_drag_says():
+    """A vertical chord, weightless, in the wind of Table 2 (10 m/s along -i_E): Eq. (14)'s
+    drag at rest, q = rho_0 l_a C_D v_w0^2 / 2 per unit unstretched length, pushes the
+    middle ring downwind (-x) by q L0 L / (8 H) (the weighted string's parabola, the load
+    per unit chord q L0 / L), within the small-sag error."""
+    p = string_scene(9, elevation_deg=90.0, drag=True)
+    h, env, eps0 = p.helix, p.environment, p.ends.elongation
+    result = solve(Network.from_parameters(p))
+    L = (1 + eps0) * h.length_m
+    H = float(result.bay_forces_N()[0] @ (result.network.chord_m / L))
+    q = env.air_density_kg_m3 * h.drag_length_m * h.drag_coefficient * env.wind_speed_m_s**2 / 2
+    middle = result.positions_m[4]
+    assert middle[0] == pytest.approx(-q * h.length_m * L / (8 * H), rel=1e-3)
+    assert abs(middle[1]) < 1e-12
 
 
 def test_stationary_solve_refuses_a_collapsed_bay():
