@@ -43,8 +43,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 from rawehelix.parameters import Normalised
+from rawehelix.references.drag import drag_factor
 from rawehelix.references.budget import OverBudget, budget, watched
-from rawehelix.references.wind_load import drag_factor
 
 __all__ = ["OverBudget", "budget", "MAX_SEGMENTS", "ShootingSolution", "solve", "rhs", "load_vector", "default_segments",
            "ExtensibleSolution", "solve_extensible", "bending_law"]

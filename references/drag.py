@@ -1,6 +1,6 @@
-"""The wind profile's load on the references' planar rod: the drag -nu v(z)^2 i_E at
-each point's height (Eq. 14 with [wind]'s profile), and which references model only a
-uniform load."""
+"""The drag along the rod as the references take it (references/shooting.py): the wind
+profile's factor on the uniform wind's drag of Eq. (28), and which references take a
+uniform load only.  numpy and the parameters only, as every reference."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from rawehelix.parameters import Normalised
 def drag_factor(normalised: Normalised):
     """The wind profile's (V(z)/V_ref)^2 as a function of the state's z (the height above
     the ground end is -z L0: k_E points down), which scales the drag of
-    :func:`load_vector` along the rod; None for the uniform wind (the paper's: the
+    shooting.load_vector along the rod; None for the uniform wind (the paper's: the
     drag is the same everywhere).  The profile is operation/wind.py's numpy law, the
     FE path's is forms/wind.py's UFL."""
     q = normalised
