@@ -120,7 +120,7 @@ def test_the_orbit_problems_interface_carries_no_methods_knob():
 
     from rawehelix.periodic_orbits.floquet import PeriodMap
     from rawehelix.periodic_orbits.problem import PeriodicOrbitProblem
-    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
 
     def knobs(cls):
         return set(inspect.signature(cls.orbit).parameters)
