@@ -11,7 +11,9 @@ name once, with the list.
 
 from __future__ import annotations
 
-from rawehelix.parameters.numerics import SCHEMES, check_scheme
+from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.numerics import SCHEMES
+from rawehelix.registry import Registry
 
 
 class SchemeCore:
@@ -91,14 +93,11 @@ class SplineCore(SchemeCore):
 
 
 #: every scheme's core by name
-CORES: dict[str, SchemeCore] = {s.name: s for s in (FECore(), SplineCore())}
-assert tuple(CORES) == SCHEMES, "the cores name the schemes of SCHEMES"
-
-
-def get(name: str) -> SchemeCore:
-    """The scheme core of a name; any other name is refused as a scene's is."""
-    check_scheme(name)
-    return CORES[name]
+CORES: Registry[SchemeCore] = Registry("discretisation.scheme", (FECore(), SplineCore()),
+                                       error=ParameterError)
+assert CORES.names() == SCHEMES, "the cores name the schemes of SCHEMES"
+#: the scheme core of a name; any other name is refused as a scene's is
+get = CORES.get
 
 
 def of(params) -> SchemeCore:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
+from rawehelix.registry import Registry
 from rawehelix.solvers.harmonic_balance import scope
 
 
@@ -122,19 +123,16 @@ class Auto(OrbitMethod):
 
 SHOOTING, HB, AUTO = Shooting(), HarmonicBalanceMethod(), Auto()
 #: every method by its name, in the order ``--method`` lists them
-ORBIT_METHODS: dict[str, OrbitMethod] = {m.name: m for m in (SHOOTING, HB, AUTO)}
-METHODS = tuple(ORBIT_METHODS)
+ORBIT_METHODS: Registry[OrbitMethod] = Registry("--method", (SHOOTING, HB, AUTO),
+                                                error=SceneError)
+METHODS = ORBIT_METHODS.names()
 #: each command's default method: orbits shoots (its reference results), envelope's
 #: many branches take harmonic balance
 DEFAULTS = {"orbits": SHOOTING.name, "envelope": HB.name}
 
 
-def get(name: str) -> OrbitMethod:
-    """The method of ``name``; SceneError (bad input) naming the allowed names."""
-    try:
-        return ORBIT_METHODS[name]
-    except (KeyError, TypeError):
-        raise SceneError("--method", name, f"must be one of {METHODS}") from None
+#: the method of a name; SceneError (bad input) naming the allowed names
+get = ORBIT_METHODS.get
 
 
 def default_for(command: str) -> str:
