@@ -7,7 +7,7 @@ import logging
 
 from rawehelix.cli.commands.base import (Command, check_branch_output, method_argument,
                                           overrides, say)
-from rawehelix.studies import quantities
+from rawehelix.studies import needs, quantities
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -137,11 +137,12 @@ def _envelope(rh, params, args, outdir, comm) -> int:
 
 COMMANDS = [
     Command("converge", "refinement study and work-precision figure", _converge_arguments,
-            _converge, kept="runs/*.json"),
+            _converge, needs.get("converge"), kept="runs/*.json"),
     Command("study", "named quantities over a design of scene keys, on MPI ranks",
-            _study_arguments, _study, kept="points/*.json"),
+            _study_arguments, _study, needs.get("study"), kept="points/*.json"),
     Command("envelope", "design map in (f1, a scene key): folds, PD / NS, first limits",
-            _envelope_arguments, _envelope, kept="tick*/window*/p*.json"),
+            _envelope_arguments, _envelope, needs.get("envelope"),
+            kept="tick*/window*/p*.json"),
     Command("calibrate", "fit scene keys to target quantities (least squares)",
-            _calibrate_arguments, _calibrate, kept="points/*.json"),
+            _calibrate_arguments, _calibrate, needs.get("calibrate"), kept="points/*.json"),
 ]

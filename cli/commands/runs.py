@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 from rawehelix.cli.commands.base import Command, check_branch_output, method_argument, say
+from rawehelix.studies import needs
 from rawehelix.studies.scene import SceneError
 
 
@@ -53,7 +54,7 @@ def _simulate(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import resources, simulate
     resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
     resources.check_simulate(params, args.until)  # its outputs, frames and steps
-    outdir_check.check(outdir, "simulate",
+    outdir_check.check(outdir, needs.get("simulate"),
                        extra_bytes=resources.simulate_output_bytes(params, args.until))
 
     def checkpoint(partial):  # the last good state and the series so far, every minute
@@ -87,7 +88,7 @@ def _sweep(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies.store.sweep_store import SweepError
     count = resources.frequency_count(params)
     resources.check_run(params, "sweep")  # before the disk's estimate counts its points
-    outdir_check.check(outdir, "sweep", points=count,
+    outdir_check.check(outdir, needs.get("sweep"), points=count,
                        extra_bytes=resources.sweep_output_bytes(params, count))
     try:
         result = rh.sweep(params, comm=comm, checkpoint=outdir)
@@ -164,17 +165,17 @@ def _none(p):
 
 COMMANDS = [
     Command("stationary", "stationary state with fixed ends (Sec. 5.1), under the ends' balanced "
-            "torque (a twisted state)", _none, _stationary),
+            "torque (a twisted state)", _none, _stationary, needs.get("stationary")),
     Command("modes", "natural modes about the stationary state (Table 3)", _modes_arguments,
-            _modes),
+            _modes, needs.get("modes")),
     Command("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)",
-            _simulate_arguments, _simulate),
+            _simulate_arguments, _simulate, needs.get("simulate")),
     Command("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)", _sweep_arguments,
-            _sweep, kept="points/f1_*.json", f1_grid=True),
+            _sweep, needs.get("sweep"), kept="points/f1_*.json", f1_grid=True),
     Command("response", "linear frequency response to the upper end's circle",
-            _f1_grid_arguments, _response, f1_grid=True),
+            _f1_grid_arguments, _response, needs.get("response"), f1_grid=True),
     Command("orbits", "periodic orbits over f1 with Floquet stability, through folds",
-            _orbits_arguments, _orbits, kept="window*/p*.json"),
+            _orbits_arguments, _orbits, needs.get("orbits"), kept="window*/p*.json"),
     Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
-            _none, _section),
+            _none, _section, needs.get("section")),
 ]
