@@ -271,6 +271,7 @@ class _Backend:
         return state, 1.0 + a * np.sin(self.omega * t)
 
     pack = unpack = staticmethod(lambda s: s)
+    parts = staticmethod(lambda s: None)  # no parts (solvers/periodic.py's Backend)
 
 
 def _sweep_params(max_periods):

@@ -23,7 +23,7 @@ def _converge(rh, params, args, outdir, comm) -> int:
     if args.quantity not in quantities.refined():
         raise SceneError("--quantity", args.quantity,
                          f"is not one of {', '.join(quantities.refined())}")
-    converge.run(params, args.quantity, outdir, name=params.name,
+    converge.run(params, quantities.refined()[args.quantity], outdir, name=params.name,
                  log=lambda m: say(comm, m), comm=comm)
     return 0
 

@@ -1,12 +1,12 @@
 """Where harmonic balance can run, where it is the wrong tool, and the size of its
 unknown: decisions from the scene's parameters alone, which the orbit-method registry
 (studies/orbit_method.py) asks without loading the FE rod
-(docs/explanation/harmonic_balance.md, "Where HB is the wrong tool")."""
+(docs/explanation/harmonic_balance.md, "Where HB is the wrong tool"); it loads
+neither scipy nor MPI, so that ``import rawehelix`` stays light (tests/test_api.py)."""
 
 from __future__ import annotations
 
 from rawehelix.parameters import Parameters, schemes
-from rawehelix.periodic_orbits.problem import FREE_ROTATION
 
 H_START, H_MAX = 3, 40  # harmonics: the first tried, the most allowed
 
@@ -18,6 +18,7 @@ def cannot(params: Parameters) -> str | None:
     if refusal:
         return refusal
     if params.normalised().steady_torque().k1 == 0.0:
+        from rawehelix.periodic_orbits.problem import FREE_ROTATION  # (scipy: late)
         return FREE_ROTATION
     if params.model.torsion_hysteresis.active:
         return ("the hysteretic torsion's internal twist is non-smooth and hardly moves over "
