@@ -100,14 +100,16 @@ def say(comm, text: str):
         print(printable(text), flush=True)
 
 
-def check_branch_output(params, command, outdir, branches, lo, hi, method, max_points=None):
+def check_branch_output(params, command, outdir, branches, lo, hi, method, key: str,
+                        max_points=None):
     """The disk of the branches' stored points (orbits, envelope): their memory first
-    (studies/resources.py), then the folder's room (studies/store/outdir.py)."""
+    (studies/resources.py), then the folder's room (studies/store/outdir.py); ``key``:
+    the option that sets their count (--f1, --vary)."""
     from rawehelix.studies import needs, resources
     from rawehelix.studies.store import outdir as outdir_check
     resources.check(params, command)  # the discretisation's own check comes first
     points = resources.check_branches(params, branches, lo, hi, method,
-                                      key="--vary" if command == "envelope" else "--f1",
+                                      key=key,
                                       max_points=max_points or resources.MAX_BRANCH_POINTS)
     outdir_check.check(outdir, needs.get(command),
                        extra_bytes=points * resources.store_bytes_per_point(params, method))

@@ -121,7 +121,7 @@ def _envelope(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies.sampling import parse_vary
     vary = parse_vary(args.vary[0])
     check_branch_output(params, "envelope", outdir, vary.count or envelope.DEFAULT_VALUES,
-                       lo, hi, args.method)
+                        lo, hi, args.method, key="--vary")
     try:
         result = rh.envelope(params, args.vary[0], lo, hi, comm=comm, outdir=outdir,
                              method=args.method,

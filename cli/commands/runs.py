@@ -141,7 +141,7 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     if args.sweep is not None:
         orbits.check_sweep_dir(args.sweep)
     check_branch_output(params, "orbits", outdir, comm.size, start, stop, args.method,
-                       args.max_points)
+                        key="--f1", max_points=args.max_points)
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
