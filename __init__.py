@@ -1,8 +1,9 @@
 """rawehelix: dynamics of the tensegrity helix of a rotary airborne wind energy machine.
 
-The helix is an unshearable Cosserat rod (Sanchez-Arriaga et al., Eqs. 30-40):
-centre line r(s, t) and twist angle alpha(s, t).  The public API
-(:mod:`rawehelix.api`)::
+The helix is a Cosserat rod (Sanchez-Arriaga et al., Eqs. 30-40): centre line r(s, t)
+and twist angle alpha(s, t), either the paper's unshearable rod or the shearable
+Simo-Reissner rod (``model.kinematics``), with the section's law of its members
+(``section.law``).  The public API (:mod:`rawehelix.api`)::
 
     import rawehelix as rh
     scene = rh.load_scene("stationary_table2", elements=16)
@@ -12,13 +13,26 @@ centre line r(s, t) and twist angle alpha(s, t).  The public API
     ts = rh.simulate(rh.load_scene("nominal_operation"), until_s=10.0)
     sw = rh.sweep(rh.load_scene("mobile_end", elements=8), f1_Hz=[9.0, 10.0])
 
-Subpackages:
+Subpackages and top-level modules, from the top of the imports down (.importlinter;
+docs/explanation/architecture.md):
 
-- ``rawehelix.parameters``: the scene parameters (SI) and their normalisation (numpy only)
-- ``rawehelix.forms``: the weak forms (UFL)
+- ``rawehelix.cli``: the ``rawehelix`` command line, its command registry and the demo
+- ``rawehelix.api``: the public functions, one per command
+- ``rawehelix.studies``: the command drivers and registries (schemes, orbit methods,
+  quantities, needs), over ``present/`` (figures, reports), ``analysis/`` (post-processing)
+  and ``store/`` (outputs, stores, locks); ``converge/`` and ``extremes/`` are two drivers
+- ``rawehelix.solvers``: SNES, TS and SLEPc on the FE rod, and ``harmonic_balance/``
+- ``rawehelix.references``: the paper's shooting and spline-Galerkin schemes (no FE code)
+- ``rawehelix.models``: the rod models (unshearable, shearable) and the kinematics registry
+- ``rawehelix.periodic_orbits``: the periodic-orbit problem, Floquet, continuation (numpy)
 - ``rawehelix.meshes``: uniform and graded interval meshes
-- ``rawehelix.solvers``: SNES, TS, SLEPc, and the independent references
-- ``rawehelix.studies``: scenes, drivers, writers and the command line
+- ``rawehelix.forms``: the weak forms (UFL), one physics component a module
+- ``rawehelix.parameters``: the scene parameters (SI), their checks and normalisation
+- ``rawehelix.section_laws``: the section-law registry (UFL and numpy from one definition)
+- ``rawehelix.members``, ``fits``, ``families``, ``compat``, ``errors``: the members'
+  numpy laws and limits, when a fit's data determine it, the mode families, the calls
+  that differ between DOLFINx versions, the errors
+- ``rawehelix.section_math``, ``registry``: the section laws' algebra, the one registry class
 """
 
 __version__ = "0.2.0"

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
+from rawehelix.studies.orbit_method import default_for
 
 __all__ = ["load_scene", "section", "stationary", "modes", "response", "simulate", "sweep", "orbits",
            "envelope", "operate", "campbell",
@@ -242,7 +243,7 @@ def sweep(scene: Parameters, f1_Hz=None, comm=None, checkpoint=None):
 
 def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, progress=None,
            outdir=None, tension_step=None, max_points: int = 400, superharmonics=None,
-           method: str = "shooting"):
+           method: str = default_for("orbits")):
     """The branch of periodic orbits of Sec. 5.3 from f1_start towards f1_stop [Hz]:
     shooting on the period map of the generalised-alpha integrator, Floquet
     multipliers from its tangent, pseudo-arclength continuation through folds,
@@ -283,7 +284,8 @@ def orbits(scene: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=None, 
 
 
 def envelope(scene: Parameters, vary, f1_lo_Hz: float, f1_hi_Hz: float, comm=None,
-             outdir=None, method: str = "hb", progress=None, f1_step_Hz: float | None = None):
+             outdir=None, method: str = default_for("envelope"), progress=None,
+             f1_step_Hz: float | None = None):
     """The operating envelope of Sec. 5.3's forced helix in (f1, KEY): ``vary`` is
     "KEY=LO:HI[:COUNT]" (a dotted scene key, COUNT values, default 5); at each value the
     branch over [f1_lo, f1_hi] (``method``: "hb", "shooting" or "auto"), the f1 where the

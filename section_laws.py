@@ -22,6 +22,7 @@ with :func:`refusal`'s one message.
 from __future__ import annotations
 
 from rawehelix.members import ConeSection, Members
+from rawehelix.registry import Registry
 from rawehelix.section_math import NUMPY, Cone, TetherRing
 
 
@@ -104,24 +105,14 @@ class Saturating(SectionLaw):
 
 
 #: every section law by name (the first is the default, the null object)
-SECTION_LAWS: dict[str, SectionLaw] = {x.name: x for x in (SectionLaw(), Tensegrity(), Saturating())}
+SECTION_LAWS: Registry[SectionLaw] = Registry("section.law", (SectionLaw(), Tensegrity(),
+                                                               Saturating()), listed=list)
 #: the names, in the registry's order (the scene's section.law is one of them)
-NAMES = tuple(SECTION_LAWS)
-
-
-def refusal(name) -> str | None:
-    """Why ``name`` is no section law (the list of names), None: it is one."""
-    if name in SECTION_LAWS:
-        return None
-    return f"must be one of {list(NAMES)}"
-
-
-def get(name: str) -> SectionLaw:
-    """The section law of a name; any other name is refused with :func:`refusal`'s message."""
-    why = refusal(name)
-    if why:
-        raise ValueError(f"section.law = {name!r}: {why}")
-    return SECTION_LAWS[name]
+NAMES = SECTION_LAWS.names()
+#: why a name is no section law (the list of names), None: it is one
+refusal = SECTION_LAWS.refusal
+#: the section law of a name; any other name is refused (ValueError) with the list
+get = SECTION_LAWS.get
 
 
 __all__ = ["NAMES", "SECTION_LAWS", "Saturating", "SectionLaw", "Tensegrity", "get", "refusal"]

@@ -70,8 +70,8 @@ def fold_curve(stats) -> dict:
 def parts(stats, elements=(8, 32), f1: float = 10.0, repeats: int = 3) -> dict:
     """CPU time of a point's parts at 10 Hz."""
     import rawehelix as rh
-    from rawehelix.solvers.harmonic_balance import HarmonicBalance
-    from rawehelix.solvers.sparse_lu import LU
+    from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
+    from rawehelix.solvers.harmonic_balance.sparse_lu import LU
     out = {}
     for N in elements:
         m = HarmonicBalance(rh.load_scene("mobile_end", elements=N, degree=3))

@@ -664,6 +664,15 @@ def markdown(r: dict) -> str:
         lines += operate_bench.markdown(r["operate"])
     if r.get("campbell"):
         lines += campbell_bench.markdown(r["campbell"])
+    for row in r.get("refactor_42") or []:  # measured by hand: the rows' own commands
+        w, c = row["ratio_wall"], row["ratio_cpu"]
+        lines.append(
+            f"| 15. `{row['command']}`, whole command, issue 42's branch against {row['before']} "
+            f"(paired runs, one warm-up pair) | before {_spread(row['before_wall_s'], '.1f')}, "
+            f"after {_spread(row['after_wall_s'], '.1f')} wall; after/before wall "
+            f"{w['median']:.3f} ({w['min']:.3f}-{w['max']:.3f}), CPU {c['median']:.3f} "
+            f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
+            f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
     return "\n".join(lines) + "\n"
 
 

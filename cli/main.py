@@ -166,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
             from rawehelix.solvers import tension_target
             params = tension_target.resolve(params, comm)  # ends.tension_N -> its elongation
             outdir = args.output or Path("results") / params.name / args.command
-            outdir_check.check(outdir, args.command)
+            outdir_check.check(outdir, command.needs)
             # one writer per output folder, one command's output in it: exit 2 otherwise
             with outdir_lock.hold(outdir, comm, args.command):
                 status = command.run(rh, params, args, outdir, comm)

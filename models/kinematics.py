@@ -30,7 +30,8 @@ from typing import Callable
 import numpy as np
 
 from rawehelix.parameters import KINEMATICS, Parameters
-from rawehelix.parameters.sections import check_kinematics_name
+from rawehelix.parameters.checks import ParameterError
+from rawehelix.registry import Registry
 
 
 def paper_axial_strain(tension, EA):
@@ -120,16 +121,12 @@ class Shearable(Kinematics):
 
 
 #: every kinematics by name
-KINEMATICS_REGISTRY: dict[str, Kinematics] = {k.name: k for k in (Paper(), Extensible(),
-                                                                  Shearable())}
-assert tuple(KINEMATICS_REGISTRY) == KINEMATICS, \
+KINEMATICS_REGISTRY: Registry[Kinematics] = Registry(
+    "model.kinematics", (Paper(), Extensible(), Shearable()), error=ParameterError)
+assert KINEMATICS_REGISTRY.names() == KINEMATICS, \
     "the registry names the kinematics of parameters.KINEMATICS"
-
-
-def get(name: str) -> Kinematics:
-    """The kinematics of a name; any other name is refused as a scene's is."""
-    check_kinematics_name(name)
-    return KINEMATICS_REGISTRY[name]
+#: the kinematics of a name; any other name is refused as a scene's is
+get = KINEMATICS_REGISTRY.get
 
 
 def of(params: Parameters) -> Kinematics:

@@ -39,6 +39,7 @@ from rawehelix.parameters.generator import Generator
 from rawehelix.parameters.lifter import Lifter
 from rawehelix.parameters.rotor import Rotor
 from rawehelix.parameters.sections import Controller, Ends, Torque
+from rawehelix.registry import Registry
 
 ENDS = ("ground", "top", "both")  # s = 0, s = L0, both
 LOADS = ("position", "torque", "force")  # what a component prescribes at its end
@@ -89,15 +90,10 @@ END_COMPONENTS = (
                  lambda p: p.lifter.active, lifter.check),
 )
 #: every end component by name
-REGISTRY = {c.name: c for c in END_COMPONENTS}
-
-
-def get(name: str) -> EndComponent:
-    """The end component of a name; any other name is refused once, with the list."""
-    try:
-        return REGISTRY[name]
-    except KeyError:
-        raise ParameterError("end component", name, f"must be one of {tuple(REGISTRY)}") from None
+REGISTRY: Registry[EndComponent] = Registry("end component", END_COMPONENTS,
+                                            error=ParameterError)
+#: the end component of a name; any other name is refused once, with the list
+get = REGISTRY.get
 
 
 def check(params) -> None:

@@ -11,7 +11,9 @@ name once, with the list.
 
 from __future__ import annotations
 
-from rawehelix.parameters.numerics import BESIDE_CONTINUUM, SCHEMES, check_scheme
+from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.numerics import BESIDE_CONTINUUM, SCHEMES
+from rawehelix.registry import Registry
 
 
 class SchemeCore:
@@ -128,15 +130,13 @@ class NetworkCore(SchemeCore):
 
 
 #: every scheme's core by name
-CORES: dict[str, SchemeCore] = {s.name: s for s in (FECore(), SplineCore(), NetworkCore())}
-assert tuple(CORES) == SCHEMES, "the cores name the schemes of SCHEMES"
+CORES: Registry[SchemeCore] = Registry("discretisation.scheme",
+                                       (FECore(), SplineCore(), NetworkCore()),
+                                       error=ParameterError)
+assert CORES.names() == SCHEMES, "the cores name the schemes of SCHEMES"
 assert tuple(c.name for c in CORES.values() if c.beside_continuum) == BESIDE_CONTINUUM
-
-
-def get(name: str) -> SchemeCore:
-    """The scheme core of a name; any other name is refused as a scene's is."""
-    check_scheme(name)
-    return CORES[name]
+#: the scheme core of a name; any other name is refused as a scene's is
+get = CORES.get
 
 
 def of(params) -> SchemeCore:

@@ -18,20 +18,9 @@ controller (40) see one clock), and the circle restarts at phase 0 at every
 new frequency; since every point ends after whole periods, the upper end
 never jumps: continuation as in the paper.
 
-A *backend* integrates the rod; it works in normalised units and provides
-
-    backend.stationary()                     -> state at t = 0 (stationary, top at phase 0)
-    backend.set_frequency(f1_Hz, t_start)    the circle at f1, phase 0 at t_start
-                                             (``Normalised.at_frequency``)
-    backend.advance(state, t0, t1, t_out)    -> (state at t1, tension at s = 0 at t_out)
-    backend.pack(state) -> dict of arrays;  backend.unpack(dict) -> state
-    backend.section_sampler                  None, or solvers/section_samples.py's
-                                             SectionSampler: the section along s over
-                                             the recorded periods (PointResult.sections)
-    backend.track_sections()                 set section_sampler (a no-op without
-                                             fields along s)
-
-Backends read and write no files: ``pack`` and ``unpack`` convert a state to
+A *backend* integrates the rod, in normalised units: :class:`Backend` declares what
+is asked of it (the FE's solvers/forced.py, the spline reference's
+references/spline_galerkin/forced.py).  Backends read and write no files: ``pack`` and ``unpack`` convert a state to
 and from plain arrays, which the caller may keep where it likes.
 """
 
@@ -40,10 +29,41 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
 from rawehelix.parameters import Normalised, Sweep
+
+
+class Backend(Protocol):
+    """What :func:`periodic_response` asks of the scheme that integrates the rod."""
+
+    #: None, or solvers/section_samples.py's SectionSampler: the section along s over
+    #: the recorded periods (PointResult.sections)
+    section_sampler: object | None
+
+    def stationary(self):
+        """The state at t = 0 (stationary, the top at phase 0)."""
+
+    def set_frequency(self, f1_Hz: float, t_start: float) -> None:
+        """The circle at f1, phase 0 at t_start (``Normalised.at_frequency``)."""
+
+    def advance(self, state, t0: float, t1: float, t_out):
+        """(the state at t1, the tension at s = 0 at the times t_out)."""
+
+    def pack(self, state) -> dict:
+        """The state as plain arrays (:meth:`unpack` reads them back)."""
+
+    def unpack(self, data: dict):
+        """The state of :meth:`pack`'s arrays."""
+
+    def track_sections(self) -> None:
+        """Set ``section_sampler`` (a no-op without fields along s)."""
+
+    def parts(self, state) -> dict | None:
+        """The state's parts (name -> array) whose change over a period says what still
+        moves (:func:`unsettled`); None: no parts to name (the tension alone is judged)."""
 
 
 @dataclass
@@ -166,8 +186,8 @@ def moving_parts(before: dict, after: dict) -> list[tuple[str, float]]:
     return sorted(changes, key=lambda c: -c[1])
 
 
-def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start: float,
-                      sweep: Sweep, lead_in: bool, progress=None):
+def periodic_response(backend: Backend, q_base: Normalised, f1_Hz: float, state,
+                      t_start: float, sweep: Sweep, lead_in: bool, progress=None):
     """Integrate at f1 from ``state`` at normalised time ``t_start``; ``progress(k,
     measure)`` after each judged period k (``measure``: :func:`transient`'s, or None).
 
@@ -186,12 +206,11 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
             t += period
     maxima, minima, means, history = [], [], [], []
     sampler = backend.section_sampler
-    parts = getattr(backend, "parts", None)  # the state's parts, to say what still moves
     periodic = slack = False
     measure = before = None
     for k in range(1, sweep.max_periods + 1):
-        if parts and k == sweep.max_periods:  # the last period's start, if it is not periodic
-            before = parts(state)
+        if k == sweep.max_periods:  # the last period's start, if it is not periodic
+            before = backend.parts(state)  # the parts, to say what still moves
         t_out = t + period * np.arange(1, n + 1) / n
         state, tension = backend.advance(state, t, t + period, t_out)
         if not np.all(np.isfinite(tension)):
@@ -223,7 +242,7 @@ def periodic_response(backend, q_base: Normalised, f1_Hz: float, state, t_start:
         sections=None if sampler is None else sampler.sections(
             [kept for h in history for kept in h[2]]))
     if not periodic:
-        ends = (before, parts(state)) if before is not None else None
+        ends = (before, backend.parts(state)) if before is not None else None
         result.unsettled = unsettled(q, measure, ends, sweep, result.periods)
     return result, state, t
 

@@ -218,7 +218,8 @@ def _crossing(m, limits, a, b, ka, kb, value) -> dict:
 
 
 def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
-            comm=MPI.COMM_WORLD, outdir=None, method: str = "hb", progress=None,
+            comm=MPI.COMM_WORLD, outdir=None, method: str = orbit_method.default_for("envelope"),
+            progress=None,
             substeps: int = envelope_curves.SUBSTEPS,
             f1_step_Hz: float | None = None) -> EnvelopeResult:
     """The envelope (module docstring); ``progress(value, orbit)`` at every branch point;

@@ -2,8 +2,8 @@
 the command line, the studies and the resources ask instead of testing the name.
 
 * ``shooting``: Newton on the scheme's period map (studies/schemes.py);
-* ``hb``: harmonic balance (solvers/harmonic_balance.py), H chosen by accuracy,
-  Hill's method for the multipliers;
+* ``hb``: harmonic balance (solvers/harmonic_balance/, one room: its scope, problem,
+  Newton and Hill's method), H chosen by accuracy, Hill's method for the multipliers;
 * ``auto``: the rule of :meth:`Auto.choose`, stated once here and reported with every
   result (docs/explanation/harmonic_balance.md, "Where HB is the wrong tool").
 
@@ -17,29 +17,8 @@ from __future__ import annotations
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-
-
-def cannot(params: Parameters) -> str | None:
-    """Why harmonic balance cannot trace ``params``'s orbits (None: it can): an
-    internal variable or a free rotation breaks its unknowns."""
-    from rawehelix.studies import schemes
-    refusal = schemes.of(params).harmonic_balance_refusal
-    if refusal:
-        return refusal
-    from rawehelix.solvers import harmonic_balance
-    return harmonic_balance.cannot(params)
-
-
-def wrong_tool(params: Parameters) -> str | None:
-    """Why harmonic balance may be the wrong tool for ``params`` (None: it is not): what
-    :func:`cannot` says, or a non-smooth law that needs many harmonics (then ``hb``
-    runs, its H raised by the tail test, with this warning; where its first orbit needs
-    more, it says to shoot)."""
-    if params.model.section.active:
-        return ("the members' slack is a non-smooth law: past the first slack member the "
-                "orbits need many harmonics (where its first orbit is not found, HB says so: "
-                "then try --method shooting)")
-    return cannot(params)
+from rawehelix.registry import Registry
+from rawehelix.solvers.harmonic_balance import scope
 
 
 class OrbitMethod:
@@ -99,23 +78,18 @@ class HarmonicBalanceMethod(OrbitMethod):
     reported = True
 
     def choose(self, params: Parameters) -> tuple[str, str]:
-        if cannot(params):
+        if scope.cannot(params):
             raise SceneError("--method", self.name, f"harmonic balance is the wrong tool "
-                             f"here: {cannot(params)}")
-        why = wrong_tool(params)
+                             f"here: {scope.cannot(params)}")
+        why = scope.wrong_tool(params)
         return self.name, f"as asked; warning: {why}" if why else "as asked"
 
     def problem(self, params: Parameters):
-        from rawehelix.solvers.harmonic_balance import HarmonicBalance
+        from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
         return HarmonicBalance(params)
 
     def state_size(self, params: Parameters) -> int:
-        from rawehelix.studies import schemes
-        scheme = schemes.of(params)
-        if scheme.harmonic_balance_refusal:  # its period map's state
-            return scheme.period_state_size(params)
-        from rawehelix.solvers.harmonic_balance import H_START
-        return (2 * H_START + 1) * scheme.unknowns(params)
+        return scope.state_size(params)
 
     def discretisation(self, elements: int, degree: int, dt_s: float, branch: list) -> str:
         Hs = [p["accuracy"]["H"] for p in branch if "accuracy" in p] or [0]
@@ -123,9 +97,9 @@ class HarmonicBalanceMethod(OrbitMethod):
 
 
 class Auto(OrbitMethod):
-    """Harmonic balance wherever it can run (:func:`cannot`), with :func:`wrong_tool`'s
-    warning for a non-smooth law: on the tensegrity section (mobile_end, N = 4, 10 to
-    9 Hz) HB traced 5 points in 23 s where shooting failed at the first in 100 s (at
+    """Harmonic balance wherever it can run (solvers/harmonic_balance/scope.py's
+    ``cannot``), with its ``wrong_tool`` warning for a non-smooth law: on the tensegrity
+    section (mobile_end, N = 4, 10 to 9 Hz) HB traced 5 points in 23 s where shooting failed at the first in 100 s (at
     16 Hz both fail: HB in 52 s, shooting in 8 s).  Its results carry the method that
     ran, never ``auto``."""
 
@@ -133,9 +107,9 @@ class Auto(OrbitMethod):
     help = "'auto' (hb where every law is smooth; the choice and its reason are in summary.json)"
 
     def choose(self, params: Parameters) -> tuple[str, str]:
-        if cannot(params):
-            return SHOOTING.name, f"auto: shooting, as {cannot(params)}"
-        why = wrong_tool(params)
+        if scope.cannot(params):
+            return SHOOTING.name, f"auto: shooting, as {scope.cannot(params)}"
+        why = scope.wrong_tool(params)
         if why:
             return HB.name, f"auto: harmonic balance, which runs here; warning: {why}"
         return HB.name, "auto: harmonic balance, as every law of the scene is smooth"
@@ -149,19 +123,16 @@ class Auto(OrbitMethod):
 
 SHOOTING, HB, AUTO = Shooting(), HarmonicBalanceMethod(), Auto()
 #: every method by its name, in the order ``--method`` lists them
-ORBIT_METHODS: dict[str, OrbitMethod] = {m.name: m for m in (SHOOTING, HB, AUTO)}
-METHODS = tuple(ORBIT_METHODS)
+ORBIT_METHODS: Registry[OrbitMethod] = Registry("--method", (SHOOTING, HB, AUTO),
+                                                error=SceneError)
+METHODS = ORBIT_METHODS.names()
 #: each command's default method: orbits shoots (its reference results), envelope's
 #: many branches take harmonic balance
 DEFAULTS = {"orbits": SHOOTING.name, "envelope": HB.name}
 
 
-def get(name: str) -> OrbitMethod:
-    """The method of ``name``; SceneError (bad input) naming the allowed names."""
-    try:
-        return ORBIT_METHODS[name]
-    except (KeyError, TypeError):
-        raise SceneError("--method", name, f"must be one of {METHODS}") from None
+#: the method of a name; SceneError (bad input) naming the allowed names
+get = ORBIT_METHODS.get
 
 
 def default_for(command: str) -> str:

@@ -76,7 +76,7 @@ class OrbitsResult:
     tension_step: float = 0.0
     scheme: str = "fe"  # "fe" (generalised-alpha, dt_s) or "spline" (Radau, adaptive)
     superharmonics: tuple = ()  # the orders k of the sites the step closed in on
-    method: str = "shooting"  # the method that ran (studies/orbit_method.py's names)
+    method: str = orbit_method.SHOOTING.name  # the method that ran (a store without one: shot)
     method_reason: str = ""  # why (studies/orbit_method.py::choose)
     orbits: list = field(default_factory=list, repr=False)  # the Orbits, in branch order
 
@@ -179,7 +179,7 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
     return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
 
 
-def problem(params: Parameters, method: str = "shooting"):
+def problem(params: Parameters, method: str = orbit_method.default_for("orbits")):
     """The scene's periodic-orbit problem of ``method`` on this rank, from the methods'
     registry (studies/orbit_method.py: shooting on its scheme's period map, the FE
     generalised-alpha map or the paper's spline-Galerkin flow, or harmonic balance);
@@ -232,7 +232,7 @@ def branch(m, tension_step: float | None = None, sites=(), f1_step_Hz=None, **op
 
 
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
-                  superharmonics=(), method="shooting", f1_step_Hz=None):
+                  superharmonics=(), method=orbit_method.default_for("orbits"), f1_step_Hz=None):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
     from rawehelix.periodic_orbits.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
@@ -280,7 +280,8 @@ def _trace_window(params, window, tension_step, max_points, store, progress, sto
 
 def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.COMM_WORLD,
             progress=None, outdir=None, tension_step: float | None = None,
-            max_points: int = 400, superharmonics=None, method: str = "shooting",
+            max_points: int = 400, superharmonics=None,
+            method: str = orbit_method.default_for("orbits"),
             f1_step_Hz: float | None = None) -> OrbitsResult:
     """The branch from f1_start to f1_stop (either order), one window per rank
     of ``comm``; with ``outdir``, stored point by point and resumed from it.

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 from typing import Callable
 
 from rawehelix.errors import SceneError, SolverError
@@ -40,24 +39,10 @@ from rawehelix.families import VIBRATIONS
 from rawehelix.parameters import ParameterError, Parameters
 from rawehelix.studies.converge import methods as ladders
 from rawehelix.studies.converge.methods import Refinement
+from rawehelix.studies.converge.quantity import Quantity
 
 AT = "@"  # tension_max_N@F1: the quantity at one forcing frequency
 LATERAL = ("lateral_in_plane", "lateral_out_of_plane")
-
-
-@dataclass(frozen=True)
-class Quantity:
-    name: str
-    unit: str
-    stage: str | None  # at a point: a key of STAGES, or "sweep@F1"; None: refined only
-    pick: Callable | None  # stage result -> float (raises QuantityError if the result has none)
-    doc: str
-    refinement: Refinement | None = None  # refined (converge); None: at a point only
-
-    def __post_init__(self):
-        if (self.stage is None) != (self.pick is None) or (self.stage is None
-                                                          and self.refinement is None):
-            raise ValueError(f"quantity {self.name}: a stage with its pick, or a refinement")
 
 
 class QuantityError(ValueError):

@@ -55,23 +55,15 @@ import os
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters, schemes, wind_time
 from rawehelix.parameters.schemes import FECore
+from rawehelix.studies import needs
 
 BASE_BYTES = 0.25e9  # Python, DOLFINx, PETSc, matplotlib: the smallest run's peak RSS
 #: bytes per FE unknown of each command's heaviest step (module docstring; the scheme's
 #: memory_bytes, parameters/schemes.py, counts a run's working memory)
 BYTES_PER_DOF = FECore.BYTES_PER_UNKNOWN
-#: the step that sets each command's (and each study stage's) memory
-HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dynamics",
-            "spin_up": "dynamics", "sweep": "dynamics", "converge": "modes",
-            "modes": "modes", "response": "modes", "orbits": "modes",
-            "section": "stationary",  # closed forms, no FE (the smallest estimate)
-            "operate": "stationary",  # one stationary solver at a time, a point after another
-            "envelope": "modes",  # its branches are orbits' (and their linearisations)
-            # a design's points: the stage its quantities need (check_quantities); the
-            # worst (modes) for the command as a whole
-            "study": "modes", "calibrate": "modes",
-            "extremes": "modes",  # its cases' eigenproblems
-            "campbell": "modes"}  # an eigenproblem at each operating point
+#: the step that sets the memory of a study's stage that is no command (a command's:
+#: its entry in studies/needs.py)
+STAGE_STEPS = {"spin_up": "dynamics"}
 BYTES_PER_POINT = 2e3  # a sweep's, response's or study's record of one point
 SECONDS_PER_POINT = 0.01  # the least a point costs (a stationary solve at N = 2)
 WALL_LIMIT_S = 30 * 86400.0  # a count longer than this at the least cost is refused
@@ -98,13 +90,12 @@ unknowns = FECore().unknowns
 
 
 def heaviest(command: str) -> str:
-    """The step that sets ``command``'s memory (:data:`HEAVIEST`); an internal error
-    for a command registered without one (tests/test_resource_keys.py)."""
-    try:
-        return HEAVIEST[command]
-    except KeyError:
-        raise KeyError(f"internal: command {command!r} has no memory step in "
-                       f"studies/resources.py HEAVIEST (registered: {sorted(HEAVIEST)})") from None
+    """The step that sets ``command``'s memory (studies/needs.py; a study's stage:
+    :data:`STAGE_STEPS`); an internal error for a command registered without one
+    (tests/test_resource_keys.py)."""
+    if command in STAGE_STEPS:
+        return STAGE_STEPS[command]
+    return needs.get(command).memory_step
 
 
 def estimate_bytes(params: Parameters, command: str) -> float:

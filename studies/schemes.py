@@ -29,8 +29,9 @@ from mpi4py import MPI
 
 from rawehelix.families import LATERAL
 from rawehelix.parameters import SCHEMES, Parameters
-from rawehelix.parameters.schemes import (CORES, FECore, NetworkCore, SchemeCore, SplineCore,
-                                          check_scheme)
+from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.schemes import CORES, FECore, NetworkCore, SchemeCore, SplineCore
+from rawehelix.registry import Registry
 
 
 @dataclass
@@ -295,15 +296,13 @@ class NetworkMode:
 
 
 #: every scheme by name
-SCHEME_REGISTRY: dict[str, Scheme] = {s.name: s for s in (FE(), Spline(), Network())}
-assert tuple(SCHEME_REGISTRY) == SCHEMES == tuple(CORES), \
+SCHEME_REGISTRY: Registry[Scheme] = Registry("discretisation.scheme",
+                                             (FE(), Spline(), Network()),
+                                             error=ParameterError)
+assert SCHEME_REGISTRY.names() == SCHEMES == CORES.names(), \
     "the registry names the schemes of parameters.SCHEMES, each with its core"
-
-
-def get(name: str) -> Scheme:
-    """The scheme of a name; any other name is refused as a scene's is."""
-    check_scheme(name)
-    return SCHEME_REGISTRY[name]
+#: the scheme of a name; any other name is refused as a scene's is
+get = SCHEME_REGISTRY.get
 
 
 def of(params: Parameters) -> Scheme:

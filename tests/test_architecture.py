@@ -85,6 +85,36 @@ def test_no_import_cycles():
     assert _cycles(edges) == []
 
 
+#: the subfolders of studies/ (the .importlinter contract places the flat ones: present,
+#: analysis, store), and the driver-level modules one of them may still import, each
+#: with its reason; any other arrow from a subfolder up to a driver is refused
+STUDIES_SUBFOLDERS = ("converge", "extremes", "present", "analysis", "store")
+UP_ARROWS = {
+    ("rawehelix.studies.converge.methods", "rawehelix.studies.schemes"):
+        "the scheme registry gives each method its scheme's runs",
+    ("rawehelix.studies.converge.methods", "rawehelix.studies.reference_check"):
+        "the independent shooting reference of the tension at s = 0",
+}
+
+
+def test_no_studies_subfolder_imports_a_driver_but_the_named_ones():
+    """A module inside a subfolder of studies/ imports no driver-level module of
+    studies/ (the quantities' registry gives converge its quantity), but UP_ARROWS."""
+    graph = grimp.build_graph("rawehelix", include_external_packages=False)
+    found = set()
+    for m in graph.modules:
+        parts = m.split(".")
+        if len(parts) < 4 or parts[1] != "studies" or parts[2] not in STUDIES_SUBFOLDERS:
+            continue
+        for t in graph.find_modules_directly_imported_by(m):
+            tp = t.split(".")
+            if tp[:2] == ["rawehelix", "studies"] and len(tp) == 3 \
+                    and tp[2] not in STUDIES_SUBFOLDERS:
+                found.add((m, t))
+    assert found - set(UP_ARROWS) == set()
+    assert ("rawehelix.studies.converge.study", "rawehelix.studies.quantities") not in found
+
+
 def _product_modules():
     skip = {"tests", "docs", "benchmarks", "scripts", ".venv", "build"}
     for path in sorted(ROOT.rglob("*.py")):
@@ -99,3 +129,14 @@ def test_long_modules_each_do_one_named_job():
     unnamed = {name: n for name, n in long.items() if name not in LONG}
     assert not unnamed, f"over {MAX_LINES} lines: split them or name their one job in LONG"
     assert not set(LONG) - set(long), "LONG names a module that is short now: drop it"
+
+
+def test_the_package_docstring_names_every_room():
+    """rawehelix/__init__.py's docstring names each subpackage and top-level module."""
+    import rawehelix
+    rooms = {p.name for p in ROOT.iterdir() if (p / "__init__.py").exists()
+             and p.name not in ("tests", "docs", "benchmarks", "scripts")}
+    rooms |= {p.stem for p in ROOT.glob("*.py") if p.stem not in ("__init__", "setup")}
+    missing = [r for r in sorted(rooms) if f"``{r}``" not in rawehelix.__doc__
+               and f"``rawehelix.{r}``" not in rawehelix.__doc__]
+    assert missing == []

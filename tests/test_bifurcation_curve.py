@@ -1,7 +1,7 @@
 """Period-doubling and Neimark-Sacker curves in two parameters
 (rawehelix.periodic_orbits.bifurcation_curve), without scenes: the trivial orbit of a
 parametrically excited linear system, whose multipliers come from Hill's method
-(periodic_orbits/hill.py), in (f1, eps).
+(solvers/harmonic_balance/hill.py), in (f1, eps).
 
 - PD: a damped Mathieu oscillator (5 Hz) excited near twice its frequency: the first
   tongue's boundaries, where a real multiplier passes -1;
@@ -21,7 +21,7 @@ from scipy.optimize import brentq
 from rawehelix.errors import SolverError
 from rawehelix.periodic_orbits import bifurcation_curve as bc
 from rawehelix.periodic_orbits.bifurcations import critical
-from rawehelix.periodic_orbits.hill import hill_exponents
+from rawehelix.solvers.harmonic_balance.hill import hill_exponents
 
 SAMPLES = 48  # per period (>= 4H + 1)
 H = 8

@@ -17,8 +17,8 @@ from rawehelix.studies.converge import study as converge
 
 def study(tmp_path, quantity, scene_name, methods):
     lines = []
-    summary = converge.run(scene.load(scene_name), quantity, tmp_path, name=scene_name,
-                           comm=MPI.COMM_SELF, log=lines.append, methods=methods)
+    summary = converge.run(scene.load(scene_name), quantities.refined()[quantity], tmp_path,
+                           name=scene_name, comm=MPI.COMM_SELF, log=lines.append, methods=methods)
     return summary, lines
 
 

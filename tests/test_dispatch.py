@@ -120,7 +120,7 @@ def test_the_orbit_problems_interface_carries_no_methods_knob():
 
     from rawehelix.periodic_orbits.floquet import PeriodMap
     from rawehelix.periodic_orbits.problem import PeriodicOrbitProblem
-    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
 
     def knobs(cls):
         return set(inspect.signature(cls.orbit).parameters)
@@ -133,3 +133,16 @@ def test_the_orbit_problems_interface_carries_no_methods_knob():
         assert getattr(PeriodMap, name) is not getattr(PeriodicOrbitProblem, name)
     for name in ("X_stationary", "q_base", "q"):  # declared, with their words
         assert name in PeriodicOrbitProblem.__annotations__
+
+
+def test_the_forced_backends_declare_the_interface():
+    """solvers/periodic.py asks a backend for its parts through its declared interface
+    (no getattr probe): both schemes' backends have every method of it."""
+    from rawehelix.references.spline_galerkin.forced import SplineBackend
+    from rawehelix.solvers.forced import FEBackend
+    from rawehelix.solvers.periodic import Backend
+    methods = [n for n, v in vars(Backend).items() if callable(v) and not n.startswith("_")]
+    assert "parts" in methods
+    for cls in (FEBackend, SplineBackend):
+        assert [n for n in methods if not callable(getattr(cls, n, None))] == [], cls
+    assert SplineBackend.parts(None) is None

@@ -134,7 +134,7 @@ def test_the_tensegritys_unstable_band_is_the_shootings():
     curve's ends and middle the shooting (generalised-alpha, dt = 0.1 ms; the monodromy's
     multipliers) changes stability within 2e-3 Hz of it at that elongation."""
     from rawehelix.periodic_orbits.bifurcations import critical
-    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
     from rawehelix.solvers.orbits import AlphaMap
 
     sets = {"model.kinematics": "extensible", "section.law": "tensegrity",

@@ -7,8 +7,8 @@ import pytest
 
 import rawehelix as rh
 from rawehelix.errors import SceneError
-from rawehelix.periodic_orbits import harmonics
-from rawehelix.solvers.harmonic_balance import HarmonicBalance
+from rawehelix.solvers.harmonic_balance import harmonics
+from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
 from rawehelix.solvers.orbits import AlphaMap
 
 

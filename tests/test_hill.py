@@ -1,4 +1,4 @@
-"""Hill's method for Floquet exponents (rawehelix.periodic_orbits.hill), without scenes:
+"""Hill's method for Floquet exponents (rawehelix.solvers.harmonic_balance.hill), without scenes:
 the Mathieu equation's Ince-Strutt transition curves against their classical expansions and
 against a monodromy integrated by solve_ivp, the damped Mathieu equation's multipliers
 (period doubling included), convergence in H, a 2-dof system given as sparse samples with a
@@ -10,7 +10,7 @@ import scipy.sparse as sp
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from rawehelix.periodic_orbits.hill import (fourier_coefficients, hill_exponents,
+from rawehelix.solvers.harmonic_balance.hill import (fourier_coefficients, hill_exponents,
                                             hill_matrix)
 
 N = 64  # samples per period (>= 4H + 1 for every H used here)

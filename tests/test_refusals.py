@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from rawehelix.errors import SceneError
+from rawehelix.studies import needs
 from rawehelix.studies.store import outdir
 from rawehelix.studies import resources
 
@@ -168,9 +169,9 @@ def test_a_full_filesystem_is_refused(tmp_path, monkeypatch):
     usage = shutil.disk_usage(tmp_path)
     monkeypatch.setattr(shutil, "disk_usage", lambda p: usage._replace(free=10**6))
     with pytest.raises(SceneError, match="1 MB free, less than the about 200 MB"):
-        outdir.check(tmp_path / "o", "simulate")
+        outdir.check(tmp_path / "o", needs.get("simulate"))
     monkeypatch.setattr(shutil, "disk_usage", lambda p: usage._replace(free=10**9))
-    outdir.check(tmp_path / "o", "simulate")  # 1 GB is room enough
+    outdir.check(tmp_path / "o", needs.get("simulate"))  # 1 GB is room enough
     assert list(tmp_path.iterdir()) == []  # the writable check left nothing
 
 

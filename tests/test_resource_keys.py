@@ -8,7 +8,7 @@ import pytest
 
 from rawehelix.cli.commands import COMMANDS
 from rawehelix.studies.store import outdir
-from rawehelix.studies import resources, scene
+from rawehelix.studies import needs, resources, scene
 from tests.test_refusals import assert_refused
 
 SIM = ["simulate", "nominal_operation", "--elements", "4"]
@@ -58,11 +58,37 @@ def test_the_branch_store_estimate_bounds_the_measured_points():
         assert measured < est < 1.6 * measured, (n, est)
 
 
-def test_every_registered_command_has_its_estimates():
-    """A command added to the registry without a memory step (resources.HEAVIEST) or an
-    output estimate (outdir.OUTPUT_BYTES) would be checked against the defaults."""
-    assert sorted(set(COMMANDS) - set(resources.HEAVIEST)) == []
-    assert sorted(set(COMMANDS) - set(outdir.OUTPUT_BYTES)) == []
+def test_every_registered_command_names_its_estimates():
+    """Each command of the registry names its own entry of studies/needs.py (a memory
+    step and an output estimate), and every entry is a command's: a new command without
+    one cannot be built (its ``needs`` is required and checked against its name)."""
+    assert all(c.needs is needs.get(name) for name, c in COMMANDS.items())
+    assert needs.NEEDS.names() == tuple(COMMANDS)
+    from rawehelix.cli.commands.base import Command
+    with pytest.raises(TypeError, match="needs"):
+        Command("new", "a new command", print, print)
+    with pytest.raises(ValueError, match="studies/needs.py's entry of its name"):
+        Command("new", "a new command", print, print, needs.get("modes"))
+
+
+def test_the_estimates_are_the_measured_ones():
+    """The numbers moved unchanged from resources.HEAVIEST and outdir.OUTPUT_BYTES (the
+    commands of then; a new command adds its own row)."""
+    MB = 1e6
+    table = {name: (n.memory_step, n.output_bytes) for name, n in needs.NEEDS.items()}
+    measured = {
+        "stationary": ("stationary", 5 * MB), "modes": ("modes", 20 * MB),
+        "simulate": ("dynamics", 200 * MB), "sweep": ("dynamics", 20 * MB),
+        "response": ("modes", 10 * MB), "orbits": ("modes", 50 * MB),
+        "section": ("stationary", 0.1 * MB), "converge": ("modes", 20 * MB),
+        "study": ("modes", 10 * MB), "envelope": ("modes", 10 * MB),
+        "calibrate": ("modes", 5 * MB), "extremes": ("modes", 50 * MB),
+        "labtest": ("stationary", 5 * MB)}
+    assert {name: table[name] for name in measured} == measured
+    with pytest.raises(ValueError, match="memory step 'disk'"):
+        needs.Needs("new", "disk", MB)
+    with pytest.raises(ValueError, match="output estimate"):
+        needs.Needs("new", "modes", float("nan"))
 
 
 @pytest.mark.parametrize("f1", [[0.0], ["x"], [float("nan")], [], [float("inf")]])
@@ -109,17 +135,18 @@ def test_every_study_stage_has_its_memory_step():
     """A study's or a calibration's point is checked stage by stage
     (resources.check_quantities): each stage of studies/quantities.py has its row."""
     from rawehelix.studies.quantities import STAGES
-    assert sorted(set(STAGES) - set(resources.HEAVIEST)) == []
+    for stage in STAGES:
+        assert resources.heaviest(stage) in needs.STEPS
 
 
 @pytest.mark.parametrize("lookup", [
     lambda: resources.estimate_bytes(scene.load("mobile_end", elements=2), "no_such_command"),
     lambda: resources.check(scene.load("mobile_end", scheme="spline", elements=2), "no_such_command"),
-    lambda: outdir.estimate_bytes("no_such_command"),
+    lambda: needs.get("no_such_command"),
 ])
 def test_an_unregistered_command_is_an_internal_error_not_a_default(lookup):
     """No silent fall-back: a command without its rows is an internal error naming
     the table and the command (it used to be estimated as 'modes' and 50 MB)."""
-    with pytest.raises(KeyError, match=r"internal: command 'no_such_command' has no .* in "
-                                       r"studies/(resources|store/outdir)\.py"):
+    with pytest.raises(KeyError, match=r"internal: command 'no_such_command' has no estimates "
+                                       r"in studies/needs\.py NEEDS"):
         lookup()

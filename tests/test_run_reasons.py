@@ -149,7 +149,8 @@ CAMEL = re.compile(r"\b[A-Z][a-z0-9]+(?:[A-Z][a-z0-9]+)+\b")
 ATTRIBUTE = re.compile(r"\b[A-Za-z_]\w*\.[a-z_]\w*\(|\b[A-Z]\w+\.[a-z_]\w+\b")
 REFUSERS = ["studies/orbit_method.py", "studies/orbits.py", "studies/envelope.py",
             "studies/forcing.py", "studies/sweep.py", "studies/sweep_advice.py",
-            "solvers/harmonic_balance.py", "solvers/hb_newton.py", "solvers/periodic.py",
+            "solvers/harmonic_balance/problem.py", "solvers/harmonic_balance/newton.py",
+            "solvers/harmonic_balance/scope.py", "solvers/periodic.py",
             "references/spline_galerkin/orbits.py", *sorted(
                 str(p.relative_to(ROOT)) for p in (ROOT / "periodic_orbits").glob("*.py"))]
 
@@ -171,15 +172,14 @@ def test_the_refusals_name_a_command_line_way():
     """Each refusal of a method names an option or scene key that works."""
     from rawehelix.periodic_orbits import floquet
     from rawehelix.periodic_orbits.problem import FREE_ROTATION
-    from rawehelix.solvers import harmonic_balance
-    from rawehelix.studies import orbit_method
+    from rawehelix.solvers.harmonic_balance import scope
     assert "--set controller.k1=" in FREE_ROTATION and "[controller]" in FREE_ROTATION
     assert "--method hb" in floquet.WAY_OUT
     plain = scene.load("mobile_end", elements=2)
     hysteretic = plain.replace(torsion_hysteresis={"rho": 0.5, "beta_m_n": 1.0})
-    assert "--method shooting" in harmonic_balance.cannot(hysteretic)
+    assert "--method shooting" in scope.cannot(hysteretic)
     spline = plain.replace(discretisation={"scheme": "spline"})
-    assert "--method shooting" in orbit_method.cannot(spline)
+    assert "--method shooting" in scope.cannot(spline)
 
 
 # -- harmonic balance: no point above its tolerance ---------------------------------------
@@ -224,7 +224,7 @@ def test_a_branch_takes_no_point_above_its_tolerance():
 def test_averaged_exponents_of_a_massless_unknown():
     """A singular mass (the mixed bending's moments carry none): the exponents are the
     condensed system's (x2 = x1 / 2: x1'' + 0.1 x1' + 1.5 x1 = 0)."""
-    from rawehelix.periodic_orbits.hill import averaged_exponents
+    from rawehelix.solvers.harmonic_balance.hill import averaged_exponents
     M, C = np.diag([1.0, 0.0]), np.diag([0.1, 0.0])
     K = np.array([[2.0, -1.0], [-1.0, 2.0]])
     lam = averaged_exponents([M], [C], [K], np.arange(2), 2)
@@ -236,7 +236,7 @@ def test_harmonic_balance_runs_with_the_mixed_bending():
     """orbits --method hb with discretisation.bending = "mixed" raised LinAlgError:
     now its orbit at 10 Hz, N = 4, is the interior-penalty bending's to 1e-3 in T max
     and its largest multiplier to 1e-4 (measured 242.40 N vs 242.48 N, 0.96502 both)."""
-    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
     found = {}
     for bending in ("ip", "mixed"):
         params = scene.load("mobile_end", elements=4, overrides={
@@ -271,6 +271,7 @@ class _Backend:
         return state, 1.0 + a * np.sin(self.omega * t)
 
     pack = unpack = staticmethod(lambda s: s)
+    parts = staticmethod(lambda s: None)  # no parts (solvers/periodic.py's Backend)
 
 
 def _sweep_params(max_periods):
@@ -381,7 +382,7 @@ def test_a_dropped_lu_is_destroyed():
     """petsc4py 3.18 leaves a dropped object to PETSc's garbage: an LU (its MUMPS
     factor) dropped by the continuation grew HB's Fig. 8 by ~7 MB a point at N = 4."""
     import scipy.sparse as sparse
-    from rawehelix.solvers.sparse_lu import LU
+    from rawehelix.solvers.harmonic_balance.sparse_lu import LU
     lu = LU(sparse.eye(50, format="csr") * 2.0)
     assert lu.solve(np.ones(50)) == pytest.approx(0.5)
     ksp, A = lu.ksp, lu.A
@@ -390,7 +391,7 @@ def test_a_dropped_lu_is_destroyed():
 
 
 def test_a_branch_keeps_the_matrices_of_its_newest_point_only():
-    from rawehelix.solvers.harmonic_balance import HarmonicBalance
+    from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
     from rawehelix.studies.orbits import branch
     hb = HarmonicBalance(scene.load("mobile_end", elements=4))
     points = branch(hb).trace(hb.orbit(hb.X_stationary, 10.0), 9.0, direction=-1.0,

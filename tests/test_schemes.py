@@ -50,7 +50,7 @@ def test_the_memory_estimate_is_the_schemes():
 
 
 def test_the_orbit_size_is_the_schemes():
-    from rawehelix.solvers.harmonic_balance import H_START
+    from rawehelix.solvers.harmonic_balance.scope import H_START
     fe, spline = load("fe"), load("spline")
     n = resources.unknowns(fe)
     assert resources.orbit_size(fe, "shooting") == 3 * n
@@ -60,9 +60,9 @@ def test_the_orbit_size_is_the_schemes():
 
 
 def test_harmonic_balance_refuses_the_spline_scheme_by_its_reason():
-    from rawehelix.studies import orbit_method
-    assert orbit_method.cannot(load("spline")) == cores.SplineCore.harmonic_balance_refusal
-    assert orbit_method.cannot(load("fe")) != cores.SplineCore.harmonic_balance_refusal
+    from rawehelix.solvers.harmonic_balance import scope
+    assert scope.cannot(load("spline")) == cores.SplineCore.harmonic_balance_refusal
+    assert scope.cannot(load("fe")) != cores.SplineCore.harmonic_balance_refusal
 
 
 def test_the_step_size_rule_is_the_fixed_step_schemes():

@@ -275,6 +275,7 @@ class DecayingOscillation:
 
     pack = unpack = staticmethod(lambda s: s)
     section_sampler = None  # the backend interface (solvers/periodic.py): no fields along s
+    parts = staticmethod(lambda s: None)  # ... and no parts to name
 
 
 @pytest.mark.parametrize("tau_periods", [3.0, 10.0])

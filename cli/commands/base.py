@@ -10,13 +10,14 @@ from pathlib import Path
 from typing import Callable
 
 from rawehelix.cli.text import printable
+from rawehelix.studies.needs import Needs
 from rawehelix.studies.scene import SceneError
 
 
 @dataclass
 class Command:
     """One ``rawehelix`` command: adding a command is one of these in
-    :data:`rawehelix.cli.commands.COMMANDS`."""
+    :data:`rawehelix.cli.commands.COMMANDS`, naming its needs (studies/needs.py)."""
 
     name: str
     help: str  # the one line of ``rawehelix --help``
@@ -24,9 +25,17 @@ class Command:
     #: scene: (rh, params, args, outdir, comm) -> exit status, in its locked output folder;
     #: without scene: (rh, args, comm) -> exit status, the command loads and locks itself
     run: Callable
+    #: its memory step and output estimate (studies/needs.py's entry of its name, required:
+    #: a command without one would be checked against nothing)
+    needs: Needs
     scene: bool = True  # takes SCENE and the scene options (-o, --elements, --set, ...)
     kept: str | None = None  # its finished points in the output folder (resumable: Ctrl-C)
     f1_grid: bool = False  # --f1 START:STOP:STEP sets the scene's [sweep] list
+
+    def __post_init__(self):
+        if not isinstance(self.needs, Needs) or self.needs.name != self.name:
+            raise ValueError(f"command {self.name!r}: its needs must be studies/needs.py's "
+                             f"entry of its name, not {self.needs!r}")
 
 
 def petsc_unused(p):
@@ -91,14 +100,16 @@ def say(comm, text: str):
         print(printable(text), flush=True)
 
 
-def check_branch_output(params, command, outdir, branches, lo, hi, method, max_points=None):
+def check_branch_output(params, command, outdir, branches, lo, hi, method, key: str,
+                        max_points=None):
     """The disk of the branches' stored points (orbits, envelope): their memory first
-    (studies/resources.py), then the folder's room (studies/store/outdir.py)."""
+    (studies/resources.py), then the folder's room (studies/store/outdir.py); ``key``:
+    the option that sets their count (--f1, --vary)."""
+    from rawehelix.studies import needs, resources
     from rawehelix.studies.store import outdir as outdir_check
-    from rawehelix.studies import resources
     resources.check(params, command)  # the discretisation's own check comes first
     points = resources.check_branches(params, branches, lo, hi, method,
-                                      key="--vary" if command == "envelope" else "--f1",
+                                      key=key,
                                       max_points=max_points or resources.MAX_BRANCH_POINTS)
-    outdir_check.check(outdir, command,
+    outdir_check.check(outdir, needs.get(command),
                        extra_bytes=points * resources.store_bytes_per_point(params, method))

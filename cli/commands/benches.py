@@ -7,6 +7,7 @@ from pathlib import Path
 
 from rawehelix.cli.commands.base import Command, overrides, petsc_unused, say
 from rawehelix.studies.store import outdir as outdir_check, outdir_lock
+from rawehelix.studies import needs
 from rawehelix.studies.scene import SceneError
 
 
@@ -21,7 +22,7 @@ def _extremes_arguments(p):
 def _extremes(rh, args, comm) -> int:
     from rawehelix.studies import extremes
     with outdir_lock.hold(args.output, comm, "extremes"):
-        outdir_check.check(args.output, "extremes")
+        outdir_check.check(args.output, needs.get("extremes"))
         unknown = [c for c in args.cases if c not in extremes.CASES]
         if unknown:
             raise SceneError("extremes", ", ".join(unknown),
@@ -69,7 +70,7 @@ def _labtest(rh, args, comm) -> int:
     from rawehelix.studies import labtest
     scene = rh.load_scene(args.scene, overrides=overrides(args))
     outdir = args.output or Path("results") / "labtest" / (args.test + "_fit" * args.fit)
-    outdir_check.check(outdir, "labtest")
+    outdir_check.check(outdir, needs.get("labtest"))
     with outdir_lock.hold(outdir, comm, "labtest"):  # one writer, one command, as every command
         result = rh.labtest(args.test, scene, tensions_N=_numbers("--tension", args.tension),
                             loads=_numbers("--loads", args.loads), fit=args.fit,
@@ -82,7 +83,7 @@ def _labtest(rh, args, comm) -> int:
 
 COMMANDS = [
     Command("extremes", "the scenes at the edges of the physics (studies/extremes)",
-            _extremes_arguments, _extremes, scene=False),
+            _extremes_arguments, _extremes, needs.get("extremes"), scene=False),
     Command("labtest", "the paper's lab tests (Sec. 4, Fig. 2) as virtual tests",
-            _labtest_arguments, _labtest, scene=False),
+            _labtest_arguments, _labtest, needs.get("labtest"), scene=False),
 ]

@@ -7,7 +7,7 @@ import logging
 
 from rawehelix.cli.commands.base import (Command, check_branch_output, method_argument,
                                           overrides, say)
-from rawehelix.studies import quantities
+from rawehelix.studies import needs, quantities
 from rawehelix.studies.scene import SceneError
 
 log = logging.getLogger("rawehelix")
@@ -23,7 +23,7 @@ def _converge(rh, params, args, outdir, comm) -> int:
     if args.quantity not in quantities.refined():
         raise SceneError("--quantity", args.quantity,
                          f"is not one of {', '.join(quantities.refined())}")
-    converge.run(params, args.quantity, outdir, name=params.name,
+    converge.run(params, quantities.refined()[args.quantity], outdir, name=params.name,
                  log=lambda m: say(comm, m), comm=comm)
     return 0
 
@@ -121,7 +121,7 @@ def _envelope(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies.sampling import parse_vary
     vary = parse_vary(args.vary[0])
     check_branch_output(params, "envelope", outdir, vary.count or envelope.DEFAULT_VALUES,
-                       lo, hi, args.method)
+                        lo, hi, args.method, key="--vary")
     try:
         result = rh.envelope(params, args.vary[0], lo, hi, comm=comm, outdir=outdir,
                              method=args.method,
@@ -137,11 +137,12 @@ def _envelope(rh, params, args, outdir, comm) -> int:
 
 COMMANDS = [
     Command("converge", "refinement study and work-precision figure", _converge_arguments,
-            _converge, kept="runs/*.json"),
+            _converge, needs.get("converge"), kept="runs/*.json"),
     Command("study", "named quantities over a design of scene keys, on MPI ranks",
-            _study_arguments, _study, kept="points/*.json"),
+            _study_arguments, _study, needs.get("study"), kept="points/*.json"),
     Command("envelope", "design map in (f1, a scene key): folds, PD / NS, first limits",
-            _envelope_arguments, _envelope, kept="tick*/window*/p*.json"),
+            _envelope_arguments, _envelope, needs.get("envelope"),
+            kept="tick*/window*/p*.json"),
     Command("calibrate", "fit scene keys to target quantities (least squares)",
-            _calibrate_arguments, _calibrate, kept="points/*.json"),
+            _calibrate_arguments, _calibrate, needs.get("calibrate"), kept="points/*.json"),
 ]

@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 from rawehelix.cli.commands.base import Command, check_branch_output, method_argument, say
+from rawehelix.studies import needs
 from rawehelix.studies.scene import SceneError
 
 
@@ -53,7 +54,7 @@ def _simulate(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import resources, simulate
     resources.check_run(params, "simulate")  # before allocating (rh.simulate's check)
     resources.check_simulate(params, args.until)  # its outputs, frames and steps
-    outdir_check.check(outdir, "simulate",
+    outdir_check.check(outdir, needs.get("simulate"),
                        extra_bytes=resources.simulate_output_bytes(params, args.until))
 
     def checkpoint(partial):  # the last good state and the series so far, every minute
@@ -87,7 +88,7 @@ def _sweep(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies.store.sweep_store import SweepError
     count = resources.frequency_count(params)
     resources.check_run(params, "sweep")  # before the disk's estimate counts its points
-    outdir_check.check(outdir, "sweep", points=count,
+    outdir_check.check(outdir, needs.get("sweep"), points=count,
                        extra_bytes=resources.sweep_output_bytes(params, count))
     try:
         result = rh.sweep(params, comm=comm, checkpoint=outdir)
@@ -140,7 +141,7 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     if args.sweep is not None:
         orbits.check_sweep_dir(args.sweep)
     check_branch_output(params, "orbits", outdir, comm.size, start, stop, args.method,
-                       args.max_points)
+                        key="--f1", max_points=args.max_points)
     try:
         result = rh.orbits(params, start, stop, comm=comm, outdir=outdir,
                            tension_step=args.tension_step, max_points=args.max_points,
@@ -203,22 +204,23 @@ def _none(p):
 
 COMMANDS = [
     Command("stationary", "stationary state with fixed ends (Sec. 5.1), under the ends' balanced "
-            "torque (a twisted state)", _none, _stationary),
+            "torque (a twisted state)", _none, _stationary, needs.get("stationary")),
     Command("modes", "natural modes about the stationary state (Table 3)", _modes_arguments,
-            _modes),
+            _modes, needs.get("modes")),
     Command("simulate", "dynamics from the stationary state (Secs. 5.2, 5.3)",
-            _simulate_arguments, _simulate),
+            _simulate_arguments, _simulate, needs.get("simulate")),
     Command("sweep", "sweep of the upper end's forcing frequency f1 (Fig. 8)", _sweep_arguments,
-            _sweep, kept="points/f1_*.json", f1_grid=True),
+            _sweep, needs.get("sweep"), kept="points/f1_*.json", f1_grid=True),
     Command("response", "linear frequency response to the upper end's circle",
-            _f1_grid_arguments, _response, f1_grid=True),
+            _f1_grid_arguments, _response, needs.get("response"), f1_grid=True),
     Command("orbits", "periodic orbits over f1 with Floquet stability, through folds",
-            _orbits_arguments, _orbits, kept="window*/p*.json"),
+            _orbits_arguments, _orbits, needs.get("orbits"), kept="window*/p*.json"),
     Command("operate", "operating points of the rotor and generator over the wind speed: "
-            "the power curve up to the helix's first limit", _operate_arguments, _operate),
+            "the power curve up to the helix's first limit", _operate_arguments, _operate,
+            needs.get("operate")),
     Command("campbell", "Campbell diagram: the helix's modes about its operating points "
             "against the rotor speed, the 1P, 2P, BP lines and their crossings",
-            _campbell_arguments, _campbell),
+            _campbell_arguments, _campbell, needs.get("campbell")),
     Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
-            _none, _section),
+            _none, _section, needs.get("section")),
 ]

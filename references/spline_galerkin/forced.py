@@ -21,6 +21,12 @@ class SplineBackend:
     def track_sections(self) -> None:
         """Nothing to track: the spline state has no section along s (the limits block)."""
 
+    @staticmethod
+    def parts(x) -> None:
+        """No parts to name: the spline state's coefficients mix the centre line and the
+        twist (solvers/periodic.py judges its tension alone)."""
+        return None
+
     def __init__(self, q: Normalised, N: int, rtol: float = 1e-7, atol: float = 1e-9):
         self.q, self.N, self.rtol, self.atol = q, N, rtol, atol
         self.q_now = q

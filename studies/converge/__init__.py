@@ -19,7 +19,9 @@ its own communicator; rank 0 gathers and writes ``converge.csv``,
 Modules, one job each:
 
 - :mod:`.methods`: the methods, one run of a method, the ladders (the quantities
-  by name are in the one registry :mod:`rawehelix.studies.quantities`);
+  by name are in the one registry :mod:`rawehelix.studies.quantities`, which
+  gives :func:`.study.run` the quantity; this room never imports it);
+- :mod:`.quantity`: what a named quantity is (:class:`~.quantity.Quantity`);
 - :mod:`.study`: the loop over the ladders, errors and observed orders;
 - :mod:`.cache`: finished (and failed) runs in ``DIR/runs/``, for resuming;
 - :mod:`.report`: ``converge.csv``, ``converge.md``, ``work_precision.png``.

@@ -18,11 +18,11 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import quantities
 from rawehelix.studies.store import writers
 from rawehelix.studies.converge import report
 from rawehelix.studies.converge.cache import RunCache
 from rawehelix.studies.converge.methods import Method
+from rawehelix.studies.converge.quantity import Quantity
 
 
 @dataclass
@@ -76,7 +76,7 @@ def step_label(method: Method, value) -> str:
     return f"N = {int(value)}"
 
 
-def _my_runs(qty: quantities.Quantity, params, jobs, cache: RunCache, comm, log) -> list:
+def _my_runs(qty: Quantity, params, jobs, cache: RunCache, comm, log) -> list:
     """(job index, values, wall time, failure) of this rank's share of the jobs."""
     mine, warm, evaluate = [], set(), qty.refinement.evaluate
     for k, (method, value) in enumerate(jobs):
@@ -111,7 +111,7 @@ def _finest(runs: list[Run], label: str) -> Run | None:
                key=lambda r: r.method.resolution(r.value_of_ladder), default=None)
 
 
-def _summarise(qty: quantities.Quantity, params, runs: list[Run], name: str):
+def _summarise(qty: Quantity, params, runs: list[Run], name: str):
     """(summary, runs by method): errors of the space ladders against the
     finest run of the reference method, of the dt ladders against the finest
     run of the time reference (when the quantity has one)."""
@@ -152,7 +152,7 @@ def _summarise(qty: quantities.Quantity, params, runs: list[Run], name: str):
     return summary, by_method
 
 
-def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: quantities.Quantity,
+def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: Quantity,
                   name: str):
     """summary.json, converge.csv, converge.md and work_precision.png in ``outdir``."""
     outdir.mkdir(parents=True, exist_ok=True)
@@ -163,16 +163,15 @@ def write_outputs(outdir: Path, summary: dict, by_method: dict, qty: quantities.
     report.work_precision_png(outdir / "work_precision.png", by_method, qty, name)
 
 
-def run(params: Parameters, quantity: str, outdir: Path | None, name: str = "scene",
+def run(params: Parameters, qty: Quantity, outdir: Path | None, name: str = "scene",
         comm=MPI.COMM_WORLD, log=print, methods: list | None = None) -> dict:
-    """Run the refinement study of ``quantity`` (``methods``: its own by
-    default); finished runs are kept in ``outdir/runs/``.  Returns the
-    summary on every rank."""
+    """Run the refinement study of the refined quantity ``qty`` (studies/quantities.py's
+    ``refined()``; ``methods``: its own by default); finished runs are kept in
+    ``outdir/runs/``.  Returns the summary on every rank."""
     start = time.perf_counter()
-    qty = quantities.refined()[quantity]
     methods = methods or qty.refinement.methods
     jobs = [(m, v) for m in methods for v in m.ladder]
-    cache = RunCache(Path(outdir) / "runs" if outdir is not None else None, params, quantity)
+    cache = RunCache(Path(outdir) / "runs" if outdir is not None else None, params, qty.name)
     gathered = comm.gather(_my_runs(qty, params, jobs, cache, comm, log), root=0)
     summary = None
     if comm.rank == 0:

@@ -3,7 +3,7 @@ Floquet stability by Hill's method: the periodic-orbit problem
 (:mod:`rawehelix.periodic_orbits.problem`) beside shooting (:mod:`.orbits`).
 
 The unknowns X are the Fourier coefficients of the dofs U up to harmonic H of
-f1 (:mod:`rawehelix.periodic_orbits.harmonics`, X[i P + l]); the twist's
+f1 (:mod:`.harmonics`, X[i P + l]); the twist's
 steady rotation is a known secular term, as in the shooting's "periodic modulo
 the rotation" (the controller's integral action, Eq. 40, fixes it):
 
@@ -19,15 +19,15 @@ bordered matrix has a zero pivot).
 
 H is chosen by accuracy (:meth:`HarmonicBalance.orbit` without a resolution): raised
 until the energy in the highest harmonic is below TAIL_TOL of the oscillation's
-(``Orbit.accuracy``).  The Floquet multipliers: Hill's method (periodic_orbits/hill.py)
+(``Orbit.accuracy``).  The Floquet multipliers: Hill's method (:mod:`.hill`)
 on F_A x'' + F_V x' + F_U x = 0 from the tangents at the samples, its exponents sorted
 by their eigenvectors' symmetry (Bentvelsen & Lazarus 2018), by shift-invert at 0
 (folds), i w/2 (period doubling) and the least damped exponents of the averaged system
 (:data:`SHIFTS`): the largest multiplier, not all of them.
 
-Where harmonic balance is the wrong tool it refuses, naming the other method:
-the hysteretic torsion (a non-smooth internal variable) and no controller (a
-free rotation).  The members' slack is non-smooth too: it needs many
+Where harmonic balance is the wrong tool it refuses, naming the other method
+(:mod:`.scope`): the hysteretic torsion (a non-smooth internal variable) and no
+controller (a free rotation).  The members' slack is non-smooth too: it needs many
 harmonics, which the accuracy test shows (docs/explanation/harmonic_balance.md).
 """
 
@@ -40,33 +40,21 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
-from rawehelix.periodic_orbits import harmonics, hill
-from rawehelix.periodic_orbits.problem import FREE_ROTATION, Orbit, PeriodicOrbitProblem
-from rawehelix.solvers import hb_newton
+from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem
 from rawehelix.solvers.dynamics import DynamicsSolver
-from rawehelix.solvers.hb_newton import Diverged
+from rawehelix.solvers.harmonic_balance import harmonics, hill, newton
+from rawehelix.solvers.harmonic_balance.newton import Diverged
+from rawehelix.solvers.harmonic_balance.scope import H_MAX, H_START, cannot
+from rawehelix.solvers.harmonic_balance.sparse_lu import LU
 from rawehelix.solvers.rod_operator import RodOperator
-from rawehelix.solvers.sparse_lu import LU
 from rawehelix.solvers.snes import SolverError
 
-H_START, H_MAX = 3, 40  # harmonics: the first tried, the most allowed
 TAIL_TOL = 1e-8  # the highest harmonic's share of the oscillation's energy, at most
 FINE = 256  # samples of T(0) per period for its extremes (a smooth signal's maximum
 # is then missed by (pi / 256)^2 / 2 = 8e-5 of its oscillation at the highest harmonic)
 SHIFTS = 2  # the least damped exponents of the averaged system used as Hill shifts
 HOMOTOPY_MIN = 1.0 / 64  # the shortest step in the end's amplitude (HarmonicBalance._start)
 START_RETRIES = 2  # the first orbit's search, H raised this many times where it fails
-
-
-def cannot(params: Parameters) -> str | None:
-    """Why harmonic balance cannot trace ``params``'s orbits (None: it can)."""
-    if params.normalised().steady_torque().k1 == 0.0:
-        return FREE_ROTATION
-    if params.model.torsion_hysteresis.active:
-        return ("the hysteretic torsion's internal twist is non-smooth and hardly moves over "
-                "a period (its multipliers are 1 - O(beta x twist travel): shooting carries "
-                "it): use --method shooting (or auto)")
-    return None
 
 
 class HarmonicBalance(PeriodicOrbitProblem):
@@ -325,8 +313,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
         return X, total, res
 
     def _newton(self, X, f1_Hz, H, tol, max_it, amplitude=1.0, plain=False):
-        """Newton at fixed f1 and H (solvers/hb_newton.py)."""
-        return hb_newton.newton(self, X, f1_Hz, H, tol, max_it, amplitude, plain)
+        """Newton at fixed f1 and H (:mod:`.newton`)."""
+        return newton.newton(self, X, f1_Hz, H, tol, max_it, amplitude, plain)
 
     def finish(self, X, f1_Hz, iterations, residual, start, resolution=None) -> Orbit:
         H = self._H(X, resolution)

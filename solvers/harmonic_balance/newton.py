@@ -1,4 +1,4 @@
-"""Harmonic balance's Newton at fixed f1 and H (solvers/harmonic_balance.py): PETSc LU
+"""Harmonic balance's Newton at fixed f1 and H (:mod:`.problem`): PETSc LU
 steps damped by Deuflhard's natural monotonicity, and the rule that a correction at
 round-off is convergence only where |G| is near its tolerance (issue 41: at
 ``ends.elongation = 1e9`` it stopped at |G|/|X| = 0.126 and the branch was reported)."""
@@ -9,7 +9,7 @@ import numpy as np
 
 from rawehelix.periodic_orbits.continuation import FLOOR_FACTOR
 from rawehelix.solvers.snes import SolverError
-from rawehelix.solvers.sparse_lu import LU
+from rawehelix.solvers.harmonic_balance.sparse_lu import LU
 
 BACKTRACK_MIN = 1.0 / 64  # the shortest fraction of a Newton step tried
 STEP_TOL = 1e-12  # a Newton correction this small (relative to X): converged at G's floor
