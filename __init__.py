@@ -22,7 +22,8 @@ docs/explanation/architecture.md):
   quantities, needs), over ``present/`` (figures, reports), ``analysis/`` (post-processing)
   and ``store/`` (outputs, stores, locks); ``converge/`` and ``extremes/`` are two drivers
 - ``rawehelix.solvers``: SNES, TS and SLEPc on the FE rod, and ``harmonic_balance/``
-- ``rawehelix.references``: the paper's shooting and spline-Galerkin schemes (no FE code)
+- ``rawehelix.references``: the paper's shooting and spline-Galerkin schemes and the
+  ring-and-tether network (no FE code)
 - ``rawehelix.models``: the rod models (unshearable, shearable) and the kinematics registry
 - ``rawehelix.periodic_orbits``: the periodic-orbit problem, Floquet, continuation (numpy)
 - ``rawehelix.meshes``: uniform and graded interval meshes
@@ -32,6 +33,8 @@ docs/explanation/architecture.md):
 - ``rawehelix.members``, ``fits``, ``families``, ``compat``, ``errors``: the members'
   numpy laws and limits, when a fit's data determine it, the mode families, the calls
   that differ between DOLFINx versions, the errors
+- ``rawehelix.operation``: the machine's numpy laws (rotor Cp/CT, generator, wind
+  profile and wind in time, the rigid-shaft torque balance)
 - ``rawehelix.section_math``, ``registry``: the section laws' algebra, the one registry class
 """
 
