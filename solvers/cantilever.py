@@ -54,7 +54,8 @@ class TipResult:
 class CantileverRod(RodDiscretisation):
     """:class:`RodDiscretisation` with the wall's conditions: r(0) = 0, alpha(0) = 0; s = 1 free."""
 
-    def _set_up_end_conditions(self, pin_twist: bool):
+    def _set_up_end_conditions(self, pin_twist: bool, free_top: bool = False):
+        # s = 1 is free whatever free_top says (the lifted top's flag of RodDiscretisation)
         wall = compat.locate_boundary_vertices(self.mesh, lambda x: np.isclose(x[0], 0.0))
         W_r, W_a = self.sub("centre_line"), self.sub("twist")  # the model's fields
         self.V_r, _ = compat.collapse(W_r)
