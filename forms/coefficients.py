@@ -5,7 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from rawehelix.forms.components import BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw
+from rawehelix.forms import wind as wind_profile
+from rawehelix.forms.components import (BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw,
+                                        WindProfile)
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
 from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
 from rawehelix.forms.extensible import ExtensibleKinematics
@@ -30,7 +32,8 @@ ENERGY_COMPONENTS = ()
 COMPONENTS = {"damping": KelvinVoigt.from_normalised,
               "bending_law": TensionDependentBending.from_normalised,
               "hysteresis": BoucWen.from_normalised,
-              "section": section_law.from_normalised}
+              "section": section_law.from_normalised,
+              "wind": wind_profile.from_normalised}
 
 
 @dataclass
@@ -70,6 +73,9 @@ class Coefficients:
     # the section law, a component (forms/section_law.py, chosen by the registry
     # section_laws.py): NonlinearSection of its law, or the null object SolidSection
     section: SectionLaw = field(default_factory=section_law.SolidSection)
+    # the wind's profile in the drag, a component (forms/wind.py): ProfileWind, or the
+    # null object UniformWind (the paper's v_w0 at every height)
+    wind: WindProfile = field(default_factory=wind_profile.UniformWind)
     # the ENERGY_COMPONENTS of the scene
     extra: tuple = ()
 

@@ -57,9 +57,17 @@ class Hysteresis(Protocol):
         """z's equation."""
 
 
+@runtime_checkable
+class WindProfile(Protocol):
+    """The wind's profile in the drag (forms/wind.py): ProfileWind, or the null UniformWind."""
+
+    def speed(self, r, c):
+        """The wind's speed (normalised) at the centre line r."""
+
+
 #: the section law's protocol is written beside the laws it describes
 #: (forms/section_law.py::SectionComponent, the registry's UFL half)
 SectionLaw = SectionComponent
 
 
-__all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw"]
+__all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw", "WindProfile"]

@@ -68,18 +68,21 @@ def measures(mesh, degree: int, chosen: int = 0):
     return (ufl.dx(domain=mesh, metadata=metadata), ufl.dS(domain=mesh), ufl.ds(domain=mesh))
 
 
-def aerodynamic_force(r_t, c: Coefficients):
-    """F~_A = -nu |v_A| v_A with v_A = r_t + v_w0 i_E, Eqs. (14) and (28).
+def aerodynamic_force(r_t, c: Coefficients, r=None):
+    """F~_A = -nu |v_A| v_A with v_A = r_t + v_w(z) i_E, Eqs. (14) and (28): v_w(z) the
+    wind component's speed at the height of r (forms/wind.py; v_w0, the paper's, for
+    the uniform wind, which reads no r).
 
     |v_A| is smoothed by 1e-14 under the root so that its derivative exists at
     v_A = 0 (it is then zero, as the exact one-sided limits agree)."""
-    v_a = r_t + c.v_w0 * I_E
+    v_a = r_t + c.wind.speed(r, c) * I_E
     return -c.nu * ufl.sqrt(ufl.dot(v_a, v_a) + 1e-14) * v_a
 
 
-def body_force(r_t, c: Coefficients):
-    """Gravity k_E plus drag F_A per unit length, the right side of Eq. (30)."""
-    return c.gravity * K_E + c.drag * aerodynamic_force(r_t, c)
+def body_force(r_t, c: Coefficients, r=None):
+    """Gravity k_E plus drag F_A per unit length at the centre line r, the right side of
+    Eq. (30)."""
+    return c.gravity * K_E + c.drag * aerodynamic_force(r_t, c, r)
 
 
 def elastic_residual(r, alpha, v, psi, c: Coefficients, degree: int, penalty, dx, dS, ds,
@@ -136,7 +139,7 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
     F = (elastic_residual(r, alpha, v, psi, c, degree, penalty, dx, dS, ds,
                           kappa=kappa, eta=third[0] if third and kappa is not None else None,
                           z=z)
-         - ufl.inner(body_force(r_t, c), v) * dx)
+         - ufl.inner(body_force(r_t, c, r), v) * dx)
     if z is not None:  # z's equation, of the hysteresis component (forms/hysteresis.py)
         # tau_t of Eq. (34): alpha_t', and the Frenet torsion's rate (None at rest)
         tau_t = (c.gamma_coupling * frenet_torsion_rate(r, r_t, c.gamma_eps) + d(alpha_t)

@@ -48,7 +48,7 @@ class ShearableRod(RodModel):
         r, alpha, n = f["centre_line"], f["twist"], f["director"]
         r_t = f_t["centre_line"] if w_t is not None else ufl.as_vector((0.0, 0.0, 0.0))
         F = (shearable.elastic_residual(r, alpha, n, tests, c, dx, ds)
-             - ufl.inner(rod.body_force(r_t, c), tests[0]) * dx)
+             - ufl.inner(rod.body_force(r_t, c, r), tests[0]) * dx)
         if w_tt is not None:
             F += (ufl.inner(f_tt["centre_line"], tests[0]) + f_tt["twist"] * tests[1]) * dx
             F += shearable.rotary_inertia(f_tt["director"], tests[2], c, dx)

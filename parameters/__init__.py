@@ -18,7 +18,14 @@ cross-checks), :mod:`.fingerprint` (compatibility of stored fingerprints),
 Every name stays importable from ``rawehelix.parameters``.
 """
 
+from rawehelix.operation.generator import LAWS as GENERATOR_LAWS
+from rawehelix.operation.rotor import AXES as ROTOR_AXES
+from rawehelix.operation.wind import PROFILES as WIND_PROFILES
 from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.generator import Generator
+from rawehelix.parameters.lifter import TOPS as LIFTER_TOPS, Lifter
+from rawehelix.parameters.rotor import Rotor
+from rawehelix.parameters.wind import Wind
 from rawehelix.parameters.damping import Damping
 from rawehelix.parameters.eilaw import PAPER_EI_LAW, EILaw
 from rawehelix.parameters.fingerprint import LATER_HELIX_SWITCHES, LATER_MODEL_SWITCHES
@@ -34,4 +41,5 @@ __all__ = ["ParameterError", "Damping", "PAPER_EI_LAW", "EILaw", "LATER_HELIX_SW
            "LATER_MODEL_SWITCHES", "TorsionHysteresis", "RPM", "Normalised", "BENDINGS", "MESHES",
            "PENALTY_MAX", "SCHEMES", "Discretisation", "Sweep", "Time", "GROUP_KEYS", "Parameters",
            "GAMMA_TREATMENTS", "KINEMATICS", "STIFFNESS", "Controller", "Ends", "Environment", "Helix", "Model",
-           "Torque"]
+           "Torque", "GENERATOR_LAWS", "ROTOR_AXES", "WIND_PROFILES", "LIFTER_TOPS", "Generator",
+           "Lifter", "Rotor", "Wind"]

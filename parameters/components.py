@@ -4,7 +4,7 @@ A component's scene section is a module here (its section dataclass, validated
 in __post_init__) that also gives:
 
 * ``HOLDER, KEY``: where the section lives in a scene (``Parameters.model.damping``:
-  ("model", "damping"));
+  ("model", "damping"); HOLDER None: a section of the scene itself, ``Parameters.wind``);
 * ``SECTION``: its dataclass (with ``active`` and ``describe()``, for Model.describe)
   when it is a table of its own (the scene's ``[damping]``):
   :func:`holds` makes it a field of its holder and studies/scene.py a scene section;
@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import dataclasses
 
-from rawehelix.parameters import damping, eilaw, hysteresis, section, shear
+from rawehelix.parameters import damping, eilaw, hysteresis, section, shear, wind
 
 #: the sections, in the order of their checks
-SECTIONS = (eilaw, damping, hysteresis, section, shear)
+SECTIONS = (eilaw, damping, hysteresis, section, shear, wind)
 
 
 def group_keys() -> dict:
@@ -56,13 +56,14 @@ def scene_sections() -> dict:
 
 def scene_holders() -> dict:
     """The section whose dataclass holds each component table: {"damping": "model", ...}."""
-    return {s.KEY: s.HOLDER for s in SECTIONS if s.SECTION is not None}
+    return {s.KEY: s.HOLDER for s in SECTIONS if s.SECTION is not None and s.HOLDER is not None}
 
 
 def holds(holder: str):
     """A class decorator, under ``@dataclass``: the component tables held by ``holder``
     become fields of the class, ``KEY: SECTION = field(default_factory=SECTION)``,
-    in the order of :data:`SECTIONS` (Model: damping, torsion_hysteresis)."""
+    in the order of :data:`SECTIONS` (Model: damping, torsion_hysteresis; ``holder``
+    None: the scene's own sections, Parameters: wind)."""
     def add(cls):
         for s in SECTIONS:
             if s.HOLDER == holder and s.SECTION is not None:

@@ -14,8 +14,16 @@ and ``active(params)``, False at the null object.  Today's:
 * ``controller``: the ground torque's PD controller of Eq. (40), off at
   ``controller.k1 = controller.k2 = 0``.
 
-A new end condition (the operation issues' rotor, generator, lifter, wind) is an
-entry appended to :data:`END_COMPONENTS` with its section; the checks that ask which
+* ``rotor``: the rotor's torque at the top (``[rotor]``, parameters/rotor.py), off
+  without a table;
+* ``generator``: the generator's torque at the ground (``[generator]``), off at
+  ``law = "paper"`` (Eq. 40: the ``controller``'s);
+* ``lifter``: the lifter's force on a free top end (``[lifter]``), off at
+  ``top = "fixed"``.
+
+The wind is a physics component (parameters/wind.py, parameters/components.py): it
+acts along the helix, not at an end.  A new end condition is an entry appended to
+:data:`END_COMPONENTS` with its section and its ``check``; the checks that ask which
 ends carry a torque (:func:`torques`) then see it.  :func:`get` refuses an unknown
 name once, with the list of names.
 """
@@ -25,11 +33,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+from rawehelix.parameters import generator, lifter, rotor
 from rawehelix.parameters.checks import ParameterError
+from rawehelix.parameters.generator import Generator
+from rawehelix.parameters.lifter import Lifter
+from rawehelix.parameters.rotor import Rotor
 from rawehelix.parameters.sections import Controller, Ends, Torque
 
 ENDS = ("ground", "top", "both")  # s = 0, s = L0, both
-LOADS = ("position", "torque")  # what a component prescribes at its end
+LOADS = ("position", "torque", "force")  # what a component prescribes at its end
 
 
 @dataclass(frozen=True)
@@ -44,6 +56,10 @@ class EndComponent:
     equation: str  # the paper's equation(s)
     off: str  # its null object, as a scene spells it ("" : none, always on)
     active: Callable  # params -> bool: False at its null object
+    check: Callable = lambda p: None  # params -> None: ParameterError for what it cannot run with
+    # (values, the scene's folder) -> its section, for a section that reads files beside
+    # the scene (a table); None: SECTION(**values)
+    read: Callable | None = None
 
     def __post_init__(self):
         if self.end not in ENDS or self.load not in LOADS:
@@ -61,6 +77,16 @@ END_COMPONENTS = (
                  "torque.top_Nm = 0", lambda p: p.torque.top_Nm != 0),
     EndComponent("controller", "controller", Controller, "ground", "torque", "Eq. (40)",
                  "controller off", lambda p: p.controller.active),
+    # issue 43: the machine in operation (operation/ has their laws)
+    EndComponent("rotor", "rotor", Rotor, "top", "torque",
+                 "Q = 1/2 rho pi R^2 V_n^3 Cp / Omega (its table)", "no rotor.table",
+                 lambda p: p.rotor.active, rotor.check, Rotor.from_scene),
+    EndComponent("generator", "generator", Generator, "ground", "torque",
+                 "mppt k Omega^2, a torque table, or Eq. (40)", "generator.law = 'paper'",
+                 lambda p: p.generator.active, generator.check, Generator.from_scene),
+    EndComponent("lifter", "lifter", Lifter, "top", "force",
+                 "the lifted top end's balance of forces", "lifter.top = 'fixed'",
+                 lambda p: p.lifter.active, lifter.check),
 )
 #: every end component by name
 REGISTRY = {c.name: c for c in END_COMPONENTS}
@@ -72,6 +98,23 @@ def get(name: str) -> EndComponent:
         return REGISTRY[name]
     except KeyError:
         raise ParameterError("end component", name, f"must be one of {tuple(REGISTRY)}") from None
+
+
+def check(params) -> None:
+    """Every end component's refusals of what it cannot run with (Parameters calls it)."""
+    for c in END_COMPONENTS:
+        c.check(params)
+
+
+def scene_sections() -> dict:
+    """The end components' tables of a scene, ``[KEY]`` -> its dataclass (studies/scene.py)."""
+    return {c.KEY: c.SECTION for c in END_COMPONENTS}
+
+
+def scene_readers() -> dict:
+    """``[KEY]`` -> how the scene loader builds a section that reads files beside the
+    scene (studies/scene.py): ``read(values, folder)``."""
+    return {c.KEY: c.read for c in END_COMPONENTS if c.read is not None}
 
 
 def active(params) -> tuple[EndComponent, ...]:
@@ -89,5 +132,5 @@ def torque_free() -> str:
     return ", ".join(c.off for c in END_COMPONENTS if c.load == "torque")
 
 
-__all__ = ["END_COMPONENTS", "ENDS", "EndComponent", "LOADS", "REGISTRY", "active", "get",
-           "torque_free", "torques"]
+__all__ = ["END_COMPONENTS", "ENDS", "EndComponent", "LOADS", "REGISTRY", "active", "check",
+           "get", "scene_readers", "scene_sections", "torque_free", "torques"]

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from rawehelix.parameters import components
+from rawehelix.parameters.generator import Generator
+from rawehelix.parameters.lifter import Lifter
+from rawehelix.parameters.rotor import Rotor
 from rawehelix.parameters.sections import Helix, Model
+from rawehelix.parameters.wind import Wind
 
 #: model switches added after results were stored (sweep checkpoints, the
 #: convergence cache): left out of :meth:`Parameters.as_dict` at their
@@ -19,8 +25,16 @@ LATER_SECTION_KEYS = {"rings": None}
 LATER_ENDS_SWITCHES = {"tension_N": None}
 
 
+#: the scene's sections added after results were stored (issue 43), at their defaults
+LATER_SECTIONS = {cls.__name__.lower(): dataclasses.asdict(cls())
+                  for cls in (Rotor, Generator, Lifter, Wind)}
+
+
 def drop_later_switches(data: dict) -> dict:
     """``data`` (Parameters as a dict) without the later switches at their defaults."""
+    for key, default in LATER_SECTIONS.items():
+        if data.get(key) == default:
+            data.pop(key)
     for section, switches in (("model", LATER_MODEL_SWITCHES),
                               ("helix", LATER_HELIX_SWITCHES), ("ends", LATER_ENDS_SWITCHES)):
         for key, default in switches.items():  # fingerprints stored before them

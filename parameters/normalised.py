@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rawehelix.operation import wind
 from rawehelix.parameters import components
 from rawehelix.parameters.forcing import EndForcing
 
@@ -81,9 +82,10 @@ class Normalised(EndForcing):
         return cls(
             L0=L0, t_scale=t_scale, force_scale=M * g, torque_scale=h.GJ_Nm2 / L0,
             sigma=sigma, mu=mu, beta=beta,
-            nu=env.air_density_kg_m3 * h.drag_length_m * L0**2 * h.drag_coefficient / (2 * M),
+            # the air's density and the reference wind: [wind]'s when it gives them
+            nu=wind.air_density(p) * h.drag_length_m * L0**2 * h.drag_coefficient / (2 * M),
             delta=beta * sigma / (2 * mu),  # (27)
-            v_w0=env.wind_speed_m_s / np.sqrt(g * L0),
+            v_w0=wind.reference_speed(p) / np.sqrt(g * L0),
             # eps0: nan until the elongation of ends.tension_N is found (Parameters.normalised)
             eps0=math.nan if e.elongation is None else e.elongation,
             Gamma0=math.radians(e.elevation_deg),

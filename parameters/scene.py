@@ -13,9 +13,13 @@ from rawehelix.parameters.normalised import Normalised
 from rawehelix.parameters.section import helix_stiffness as section_stiffness
 from rawehelix.parameters.numerics import Discretisation, Sweep, Time
 from rawehelix.parameters.sections import Controller, Ends, Environment, Helix, Model, Torque
+from rawehelix.parameters.generator import Generator
+from rawehelix.parameters.lifter import Lifter
+from rawehelix.parameters.rotor import Rotor
 
 
 @dataclass(frozen=True)
+@components.holds(None)
 class Parameters:
     """Everything physical and numerical about one scene, in SI units."""
 
@@ -30,6 +34,12 @@ class Parameters:
     sweep: Sweep = field(default_factory=Sweep)
     name: str = "scene"  # the scene file's stem: labels outputs, changes no number
     title: str = ""  # the scene's title, for figures
+    # the machine in operation, issue 43 (end components, parameters/end_components.py):
+    # each off by default, so the paper's scenes are unchanged
+    rotor: Rotor = field(default_factory=Rotor)
+    generator: Generator = field(default_factory=Generator)
+    lifter: Lifter = field(default_factory=Lifter)
+    # then the components' tables of the scene itself (components.holds(None)): wind
 
     def __post_init__(self):
         if self.helix.stiffness == "from_section":  # EA, EI, GJ of the section's members
@@ -46,6 +56,7 @@ class Parameters:
         # each component's refusals of what it cannot run with
         sections.check_kinematics(self)
         components.check(self)
+        end_components.check(self)
 
         self._check_groups()
 
@@ -54,11 +65,12 @@ class Parameters:
         and not 0 where the values they scale are not (:data:`GROUP_KEYS`)."""
         q = Normalised.from_parameters(self)
         for group, (formula, equation, numerators, others) in GROUP_KEYS.items():
-            scaled = [self.value(k) for k in numerators]
+            # an absent key (None: an absent EI law, [wind]'s density) scales nothing
+            scaled = [self.value(k) for k in numerators if self.value(k) is not None]
             value = getattr(q, group)
-            if None in scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
+            if not scaled or math.isfinite(value) and (value != 0 or 0 in scaled):
                 continue
-            keys = [*numerators, *others]
+            keys = [k for k in (*numerators, *others) if self.value(k) is not None]
             # named: the key of the most extreme size, the likeliest culprit
             culprit = max(keys, key=lambda k: abs(math.log10(abs(self.value(k)) or 1.0)))
             raise ParameterError(
@@ -143,6 +155,7 @@ class Parameters:
 #: not move the torque-free stationary state it is found on (the ends' circle keys do
 #: not either: it is found with the upper end at the circle's centre)
 KEEP_FOUND_ELONGATION = {"discretisation", "time", "sweep", "torque", "controller", "damping",
+                         "rotor", "generator",
                          "torsion_hysteresis", "name", "title"}
 
 _L0, _M, _g, _GJ = "helix.length_m", "helix.mass_kg", "environment.g_m_s2", "helix.GJ_Nm2"

@@ -43,6 +43,7 @@ from rawehelix.parameters import Parameters
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
+from rawehelix.solvers.end_torques import EndTorques, Machine, machine_of
 from rawehelix.solvers.fields import set_constant
 from rawehelix.solvers.probes import Probes
 from rawehelix.solvers.snes import (FloorConvergence, ReusedJacobian, SolverError, default_options,
@@ -99,6 +100,9 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
     rod
         The discretisation to integrate on (default: a new one of ``params``);
         :meth:`from_stationary` passes the stationary solver's.
+    machine
+        The rotor at the top and the generator at the ground (solvers/end_torques.py);
+        default: the scene's (machine_of; none: the paper's ends).
     end_twist
         A prescribed end twist (the torsion test of Sec. 4): alpha(0) = 0 and
         alpha(1) = ``end_twist(t~)`` [rad, t~ normalised]; the end torques are
@@ -112,7 +116,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
     """
 
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, options: dict | None = None,
-                 rod: RodDiscretisation | None = None, end_twist=None):
+                 rod: RodDiscretisation | None = None, end_twist=None,
+                 machine: Machine | None = None):
         self.params, self.comm = params, comm
         self._q_scene = params.normalised()
         self.rod = rod if rod is not None else RodDiscretisation(params, comm)
@@ -134,7 +139,9 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             if end_twist is not None and ts_type != "alpha2":
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
-            self.form = SecondOrder(self.rod, bcs) if ts_type == "alpha2" else FirstOrder(self.rod, bcs)
+            self.machine = machine if machine is not None else machine_of(params)
+            ends = EndTorques.of(self.q, self.machine)  # the rotor's and generator's (issue 43)
+            self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
             if end_twist is not None:
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
@@ -163,6 +170,23 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         solver.set_state(result.state)
         if solver.form.moving_top:  # the end starts with the circle's velocity, Eq. (70)
             solver.set_end_motion(params.ends.circle_frequency_Hz, 0.0)
+        return solver
+
+    @classmethod
+    def spinning(cls, params: Parameters, machine: Machine, spin: float, torque: float,
+                 comm=MPI.COMM_WORLD, options: dict | None = None,
+                 scene: str = "scene") -> "DynamicsSolver":
+        """A solver with ``machine`` started at t = 0 from the stationary state twisted by
+        ``torque`` at both ends (normalised, set_end_torques) spinning uniformly at
+        ``spin`` (normalised): at the rigid-shaft point Q = tau, the relative equilibrium."""
+        stationary = StationarySolver(params, comm, scene=scene)
+        stationary.set_end_torques(ground=torque, top=torque)
+        state = stationary.solve().state
+        state.w_t = np.zeros_like(state.w)  # alpha = spin t + phi(s):
+        state.w_t[stationary.rod.dofs("twist")] = spin
+        solver = cls(params, comm, options, rod=stationary.rod, machine=machine)
+        solver.set_state(state)  # Eq. (40)'s C: its ground torque balances the top's
+        solver.form.offset.value += torque
         return solver
 
     def residual_floor(self) -> float:

@@ -10,6 +10,10 @@ from mpi4py import MPI
 import dolfinx.fem
 
 
+#: the energy account's entries of a run with a rotor or a generator (None without)
+MACHINE_ENERGY = ("rotor_kinetic", "power_in", "power_generator", "power_drag")
+
+
 class DynamicsOutputs:
     """The output methods of :class:`DynamicsSolver` (a mixin: it uses the
     solver's ``rod``, ``form``, ``probes``, ``comm``, ``t`` and ``_good``)."""
@@ -39,9 +43,12 @@ class DynamicsOutputs:
     # -- energy (normalised) ----------------------------------------------------------
     def energy(self) -> dict:
         """Kinetic, potential, non-variational power and the power dissipated by the
-        structural damping, 2 D (0 without it), of the current state (collective)."""
+        structural damping, 2 D (0 without it), of the current state (collective);
+        with a rotor or a generator (solvers/end_torques.py) also the rotor's kinetic
+        energy, the power in at the top, the generator's power out and the drag's
+        power (ts_forms._Formulation._machine_forms)."""
         out = {"dissipation": 0.0}
-        for name in ("kinetic", "potential", "power_nv", "dissipation"):
+        for name in ("kinetic", "potential", "power_nv", "dissipation") + MACHINE_ENERGY:
             form = getattr(self.form, name)
             if form is not None:
                 out[name] = self.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)

@@ -52,6 +52,7 @@ from rawehelix.solvers.fields import set_constant
 from rawehelix.forms import rod
 from rawehelix.models.base import PAIR_ROLES
 from rawehelix.solvers.discrete import RodDiscretisation
+from rawehelix.solvers.end_torques import EndTorques, end_weights
 
 
 class Fields:
@@ -59,18 +60,22 @@ class Fields:
     curvature field ``kappa`` of the mixed bending form (None: r'') and the
     Bouc-Wen twist ``z`` of the hysteretic torsion (None: elastic)."""
 
-    def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None, n=None, n_t=None):
+    def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None, n=None, n_t=None,
+                 alpha_tt=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
+        self.alpha_tt = alpha_tt  # the twist's acceleration (a rotor's inertia at an end)
         self.kappa, self.z = kappa, z
         self.n, self.n_t = n, n_t  # the shearable rod's director and its rate
 
     @classmethod
-    def of(cls, model, u, v):
-        """The views of the state ``u`` and its rate ``v`` on ``model``'s space
-        (models/base.py): the roles' fields under the paper's names."""
+    def of(cls, model, u, v, a=None):
+        """The views of the state ``u``, its rate ``v`` (and acceleration ``a``) on
+        ``model``'s space (models/base.py): the roles' fields under the paper's names."""
         f, f_t = model.split(u), model.split(v)
+        alpha_tt = None if a is None else model.split(a)["twist"]
         return cls(f["centre_line"], f["twist"], f_t["centre_line"], f_t["twist"],
-                   f["curvature"], f["internal_twist"], f["director"], f_t["director"])
+                   f["curvature"], f["internal_twist"], f["director"], f_t["director"],
+                   alpha_tt)
 
     def roles(self) -> tuple[dict, dict]:
         """(fields, rates) by role, as the model's forms take them."""
@@ -90,8 +95,11 @@ class _Formulation:
 
     second_order: bool
 
-    def __init__(self, rod_: RodDiscretisation, bcs):
+    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques | None = None):
         self.rod = rod_
+        # the rotor and the generator (solvers/end_torques.py); None or off: the paper's ends
+        self.end_torques = end_torques if end_torques is not None and end_torques.machine.active \
+            else None
         mesh = rod_.mesh
         self.time = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))  # t~
         self.offset = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))  # C of Eq. (40)
@@ -100,6 +108,8 @@ class _Formulation:
         self._t_set = None  # (t, scene, moving end) of the data last set
         self.reuse = None  # a snes.ReusedJacobian: the Jacobian callbacks skip a fresh one
         self.time_data = []  # more callables t -> None for set_time (a prescribed end twist)
+        # the machine's energy account (_machine_forms); None without a rotor or generator
+        self.rotor_kinetic = self.power_in = self.power_generator = self.power_drag = None
 
     def _keep_jacobian(self, *shifts) -> bool:
         """True if the assembled Jacobian (and its LU) may serve again."""
@@ -107,8 +117,18 @@ class _Formulation:
 
     def _coefficients(self, fields: Fields) -> rod.Coefficients:
         c = self.rod.c
-        self.m0 = controller_torque(c, self.rod.q, fields, self.time, self.offset)
-        return dataclasses.replace(c, m0=self.m0)
+        if self.end_torques is None:  # the paper's ends, Eqs. (39)-(40)
+            self.m0 = controller_torque(c, self.rod.q, fields, self.time, self.offset)
+            return dataclasses.replace(c, m0=self.m0)
+        ends = self.end_torques
+        top, ground = end_weights(self.rod.mesh)  # each end's law on its own end only
+        given = dataclasses.replace(c, mN=ends.given(c, fields, self.time))  # m_N(t) of (40)
+        paper = controller_torque(given, self.rod.q, fields, self.time, self.offset)  # (40)
+        self.m0 = ufl.conditional(ground, ends.ground(fields, paper), 0.0)
+        self.mN = ufl.conditional(top, ends.top(c, fields, self.time), 0.0)
+        # the top's work in: the torques but the rotor's inertia (its kinetic energy)
+        self.m_in = ufl.conditional(top, ends.driving(c, fields, self.time), 0.0)
+        return dataclasses.replace(c, m0=self.m0, mN=self.mN)
 
     def _compile(self, F, J, fields: Fields, c_dyn):
         self.F = dolfinx.fem.form(F)
@@ -124,6 +144,8 @@ class _Formulation:
         # 2 D, the power of the structural damping (forms/damping.py); None: undamped
         D = model.dissipation(f, f_t, rod_.c, rod_.degree, rod_.penalty, rod_.measures)
         self.dissipation = None if D is None else dolfinx.fem.form(2 * D)
+        if self.end_torques is not None:
+            self._machine_forms(fields)
         self.b = compat.create_vector(self.F)
         self._scratch = self.b.duplicate()
         owned = self.b.getLocalSize()
@@ -131,6 +153,22 @@ class _Formulation:
         self.bc_dofs = dofs[dofs < owned]  # this rank's owned Dirichlet dofs
         self._bc_values = None  # g at bc_dofs, after each set_time
         self.A = compat.create_matrix(self.J)
+
+    def _machine_forms(self, fields: Fields):
+        """The energy account of the rotor and the generator (normalised, x beta / delta
+        like forms/energy.py): the rotor's kinetic energy 1/2 beta j alpha_t(1)^2, the
+        power in beta (mN + Q) alpha_t(1), the generator's power out beta m0 alpha_t(0)
+        and the drag's power int F_A . r_t (Eq. 14)."""
+        rod_, c = self.rod, self.rod.c
+        dx, _, ds = rod_.measures
+        top, _ = end_weights(rod_.mesh)
+        j = self.end_torques.inertia
+        self.rotor_kinetic = dolfinx.fem.form(
+            ufl.conditional(top, 0.5 * c.beta * j * fields.alpha_t**2, 0.0) * ds)
+        self.power_in = dolfinx.fem.form(c.beta * self.m_in * fields.alpha_t * ds)
+        self.power_generator = dolfinx.fem.form(c.beta * self.m0 * fields.alpha_t * ds)
+        drag = rod.body_force(fields.r_t, c) - c.gravity * rod.K_E  # (14): gravity is in U
+        self.power_drag = dolfinx.fem.form(ufl.inner(drag, fields.r_t) * dx)
 
     def set_time(self, t: float):
         """Time-dependent data: torque ramp (69), end motion (36)/(70)."""
@@ -200,15 +238,15 @@ class SecondOrder(_Formulation):
 
     second_order = True
 
-    def __init__(self, rod_: RodDiscretisation, bcs):
-        super().__init__(rod_, bcs)
+    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques | None = None):
+        super().__init__(rod_, bcs, end_torques)
         W = rod_.W
         self.u = rod_.w  # (r, alpha)
         self.v = dolfinx.fem.Function(W, name="velocity")  # (r_t, alpha_t)
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.shift_v = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
         self.shift_a = dolfinx.fem.Constant(rod_.mesh, PETSc.ScalarType(0.0))
-        fields = Fields.of(rod_.model, self.u, self.v)
+        fields = Fields.of(rod_.model, self.u, self.v, self.a)
         c_dyn = self._coefficients(fields)
         F = rod_.model.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree,
                                 rod_.penalty, rod_.measures)
@@ -262,19 +300,21 @@ class FirstOrder(_Formulation):
 
     second_order = False
 
-    def __init__(self, rod_: RodDiscretisation, bcs_second_order):
+    def __init__(self, rod_: RodDiscretisation, bcs_second_order,
+                 end_torques: EndTorques | None = None):
         model = rod_.model
         model.refuse("first_order", rod_.params.name)  # RodModel.refusals (models/)
         mesh = rod_.mesh
         self.W2 = compat.function_space(mesh, model.pair_element(mesh.ufl_cell(), rod_.degree))
         self.x = dolfinx.fem.Function(self.W2, name="state")
         self.x_t = dolfinx.fem.Function(self.W2, name="rate")
-        super().__init__(rod_, self._end_conditions(rod_))
+        super().__init__(rod_, self._end_conditions(rod_), end_torques)
         self.shift = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
         f, vel = model.split_pair(self.x)  # X = (fields, velocities)
         f_t, acc = model.split_pair(self.x_t)  # X_t = (rates, accelerations)
         tests, tests_v = model.split_pair(ufl.TestFunction(self.W2))
-        fields = Fields(f["centre_line"], f["twist"], vel["centre_line"], vel["twist"])
+        fields = Fields(f["centre_line"], f["twist"], vel["centre_line"], vel["twist"],
+                        alpha_tt=acc["twist"])
         c_dyn = self._coefficients(fields)
         dx = rod_.measures[0]
         F = sum(ufl.inner(f_t[role] - vel[role], tests[role]) for role in PAIR_ROLES) * dx \

@@ -91,6 +91,9 @@ def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
                 "(helix.EA_N, helix.EI_Nm2)")
     if not params.model.bending:
         return "model.bending = false: the references need a bending stiffness"
+    if not params.wind.uniform:
+        return (f"wind.profile = {params.wind.profile!r}: the references' drag is the "
+                "uniform wind of Eq. (14)")
     return (reference_of(params).not_applicable(params)
             or shooting.not_applicable(params.normalised()))
 

@@ -3,8 +3,10 @@
 A scene has the sections of :class:`rawehelix.parameters.Parameters`
 (``[helix]``, ``[ends]``, ``[environment]``, ``[torque]``, ``[controller]``,
 ``[model]``, ``[discretisation]``, ``[time]``, ``[sweep]``), the physics components'
-sections (``[damping]``, ``[torsion_hysteresis]``: parameters/components.py, which
-names them and the section that holds them) and an optional top-level ``title``.  ``studies/scenes/example.toml`` documents every key.
+sections (``[damping]``, ``[torsion_hysteresis]``, ``[wind]``: parameters/components.py,
+which names them and the section that holds them), the end components' (``[rotor]``,
+``[generator]``, ``[lifter]``: parameters/end_components.py; a table file they name
+is read relative to the scene file) and an optional top-level ``title``.  ``studies/scenes/example.toml`` documents every key.
 
 Any problem raises :class:`SceneError`, whose message names the file, the key
 and what is allowed; the command line turns it into exit status 2 before any
@@ -22,31 +24,36 @@ from pathlib import Path
 
 from rawehelix.errors import SceneError  # noqa: F401  (re-exported)
 from rawehelix.parameters import (Controller, Discretisation, Ends, Environment, Helix, Model,
-                                  ParameterError, Parameters, Sweep, Time, Torque, components)
+                                  ParameterError, Parameters, Sweep, Time, Torque, components,
+                                  end_components)
 from rawehelix.parameters.sections import ONE_OF_ENDS, STIFFNESS_KEYS
 
 SECTIONS = {
     "helix": Helix, "ends": Ends, "environment": Environment, "torque": Torque,
     "controller": Controller, "model": Model, "discretisation": Discretisation,
     "time": Time, "sweep": Sweep,
-    **components.scene_sections(),  # [damping], [torsion_hysteresis]
+    **components.scene_sections(),  # [damping], [torsion_hysteresis], [wind]
+    **end_components.scene_sections(),  # and [rotor], [generator], [lifter]
 }
 NESTED = components.scene_holders()  # sections held by another section's dataclass
+READERS = end_components.scene_readers()  # sections that read a file beside the scene
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"
 
 
 _TYPE_NAMES = {"float": "a number", "int": "an integer", "str": "a string", "bool": "true or false",
-               "EILaw | None": "an inline table {a_Nm2_per_N = .., b_Nm2 = ..}"}
+               "EILaw | None": "an inline table {a_Nm2_per_N = .., b_Nm2 = ..}",
+               "tuple[float, ...]": "an array of numbers [1.0, 2.5, ..]"}
 
 
 def value_type(type_name: str) -> str:
-    """The type a scene value of a field of this annotation has: an optional number
-    (``float | None``, ``int | None``: absent is None, as TOML has no null) is a number
-    when a scene sets it.  The one place that reads an optional key's annotation."""
+    """The type a scene value of a field of this annotation has: an optional number,
+    string or array (``float | None``, ``str | None``: absent is None, as TOML has no
+    null) is one when a scene sets it.  The one place that reads an optional key's annotation."""
     base, _, none = type_name.partition(" | ")
-    return base if none == "None" and base in ("float", "int") else type_name
+    return base if none == "None" and base in ("float", "int", "str", "tuple[float, ...]") \
+        else type_name
 
 
 def key_type(key: str) -> str:
@@ -76,9 +83,16 @@ def _check_type(path, key: str, value, type_name: str):
         "str": isinstance(value, str),
         "bool": isinstance(value, bool),
         "EILaw | None": isinstance(value, dict),  # helix.EI_law: Helix validates the keys
+        "tuple[float, ...]": isinstance(value, list) and all(  # a table's column
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value),
     }[type_name]
     if not ok:
         raise SceneError(path, key, f"must be {_TYPE_NAMES[type_name]}, got {value!r}")
+    if type_name == "tuple[float, ...]":
+        if any(isinstance(v, int) and abs(v) > sys.float_info.max for v in value):
+            raise SceneError(path, key, "must be an array of finite numbers (an integer is "
+                             f"past {sys.float_info.max:.4g})")
+        return tuple(float(v) for v in value)
     if type_name == "float" and isinstance(value, int) and abs(value) > sys.float_info.max:
         raise SceneError(path, key, f"must be a finite number (at most {sys.float_info.max:.4g} "
                          f"in size), got an integer of {len(str(abs(value)))} digits")
@@ -106,7 +120,9 @@ def _section(path, name: str, table) -> object:
         raise SceneError(path, "ends.elongation, ends.tension_N", f"{ONE_OF_ENDS}; the scene "
                          f"gives {given}")
     try:
-        return cls(**values)
+        # a section with files beside the scene (the rotor's table) reads them itself
+        read = READERS.get(name)
+        return cls(**values) if read is None else read(values, Path(str(path)).parent)
     except ParameterError as err:
         raise _scene_error(path, err) from None
 

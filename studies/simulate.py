@@ -36,8 +36,9 @@ from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
+from rawehelix.solvers.energy_account import EnergyAccount
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, schemes
+from rawehelix.studies import limits, machine, schemes
 from rawehelix.studies.analysis import metrics, structure_limits
 from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
@@ -91,6 +92,7 @@ class TimeSeries:
     _start: float = 0.0
     #: (n, 3): t [s], the smallest and largest member force [N] at each tracked step
     limits_history: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    columns: tuple = COLUMNS  # + machine.COLUMNS with a rotor or a generator
 
     @property
     def t_s(self) -> np.ndarray:
@@ -126,7 +128,7 @@ class TimeSeries:
         outdir.mkdir(parents=True, exist_ok=True)
         with open(outdir / "time_series.csv", "w", newline="") as f:
             out = csv.writer(f)
-            out.writerow(COLUMNS)
+            out.writerow(self.columns)
             out.writerows([[f"{x:.9g}" for x in row] for row in self.rows])
         if self.final_state is not None:
             writers.write_npz(outdir / "state.npz", self.final_state)
@@ -166,8 +168,9 @@ class _Recorder:
     ``fields_every`` (collective).  ``limits_every``: the limits block takes every
     k-th output step (1: every one)."""
 
-    def __init__(self, solver, fields_every: int, tracker, limits_every: int = 1):
+    def __init__(self, solver, fields_every: int, tracker, limits_every: int = 1, machine=None):
         self.q = solver.q
+        self.machine = machine  # solvers/end_torques.Machine when active: its columns
         self.rows: list[tuple] = []
         self.frames: list[Frame] = []
         self.fields_every = max(1, fields_every)
@@ -189,6 +192,8 @@ class _Recorder:
                *(float(q.spin_rpm(v[k])) for k in ("spin0", "spin_mid", "spin1")),
                float(q.torque_Nm(v["m0"])), float(q.tension_N(v["tension0"])),
                float(q.tension_N(v["tension1"])), float(q.length_m(lateral)))
+        if self.machine is not None:
+            row += machine.row(self.machine, row[0], row[1], row[3], row[4])
         self.rows.append(row)
         k = len(self.rows) - 1
         if k % self.limits_every == 0:
@@ -240,8 +245,6 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     ``checkpoint(partial)``: called every ``checkpoint_every_s`` of wall time.
     Raises :class:`SceneError` for a scene this solver cannot run and
     :class:`SimulationError` (with the partial series) when the dynamics stop."""
-    from rawehelix.solvers.dynamics import DynamicsSolver
-
     start = time.perf_counter()
     refusal = schemes.of(params).simulate_refusal
     if refusal:
@@ -255,10 +258,16 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     q = params.normalised()
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s
-    solver = DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name)
+    ends = machine.of(params)  # the rotor and the generator (issue 43); off: the paper's
+    solver, start_point = machine.solver(params, ends, comm, options)
     tracker = structure_limits.of_params(params)
     rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)),
-                    tracker=tracker, limits_every=LIMITS_EVERY)
+                    tracker=tracker, limits_every=LIMITS_EVERY,
+                    machine=ends if ends.active else None)
+    columns = COLUMNS + (machine.COLUMNS if ends.active else ())
+    account = EnergyAccount() if ends.active else None
+    if account is not None:
+        account(solver)
     if LIMITS_EVERY > 1:
         tracker.sampled_every_s = LIMITS_EVERY * tm.output_every_s
     show = (progress if progress is not None else sys.stdout.isatty()) and comm.rank == 0
@@ -271,12 +280,14 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                "dofs": solver.rod.dof_count(), "ranks": comm.size,
                "ts_type": solver.ts.getType(), "target_rpm": params.controller.target_rpm,
                "model": params.describe_model()}
+    if start_point:
+        summary["machine"] = start_point
     loop_start = time.perf_counter()
 
     def result(complete: bool, error: str | None = None) -> TimeSeries:
-        rows = np.array(rec.rows) if rec.rows else np.zeros((0, len(COLUMNS)))
+        rows = np.array(rec.rows) if rec.rows else np.zeros((0, len(columns)))
         series = TimeSeries(params, rows, list(rec.frames), _state_file(solver), dict(summary),
-                            comm.rank, start, np.array(tracker.history).reshape(-1, 3))
+                            comm.rank, start, np.array(tracker.history).reshape(-1, 3), columns)
         s = series.summary
         s.update({"complete": complete, "error": error,
                   "simulated_s": float(rows[-1, 0]) if len(rows) else 0.0,
@@ -286,11 +297,15 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                   "settling_time_s": metrics.settling_time(rows[:, 0], rows[:, 1:4],
                                                            params.controller.target_rpm),
                   "limits": comm.bcast(tracker.block() if comm.rank == 0 else None, root=0)})
+        if account is not None:  # work in = generator + dissipated + stored (issue 43)
+            s["energy"] = account.summary(q)
         if len(rows):
             s["final"] = {"spin_rpm": {"s0": rows[-1, 1], "mid": rows[-1, 2], "L0": rows[-1, 3]},
                           "ground_torque_Nm": rows[-1, 4], "tension_s0_N": rows[-1, 5],
                           "tension_L0_N": rows[-1, 6], "lateral_mid_m": rows[-1, 7]}
             s["tension_range_N"] = [float(rows[:, 5:7].min()), float(rows[:, 5:7].max())]
+            if ends.active:  # the machine's columns (studies/machine.py)
+                s["final"].update(zip(machine.COLUMNS, map(float, rows[-1, len(COLUMNS):])))
             s["real_time_factor"] = s["simulated_s"] / max(s["solve_s"], 1e-12)
         return series
 
@@ -304,10 +319,22 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
             checkpoint(result(False))  # collective
             last_checkpoint[0] = time.perf_counter()
 
+    stopped = []  # a step's own stop (the rotor out of its table), raised through PETSc
+
+    def on_step(sv):
+        try:
+            machine.check_step(ends, sv)
+        except SolverError as err:
+            stopped.append(err)
+            raise
+        account(sv)
+
     try:
         solver.advance(until_s / q.t_scale, on_output=on_output,
+                       on_step=on_step if account is not None else None,
                        output_every=tm.output_every_s / q.t_scale)
     except SolverError as err:
+        err = stopped[0] if stopped else err
         rec.frame(solver, float(q.time_s(solver.state().t)))
         raise SimulationError(str(err), result(False, str(err))) from None
     finally:
@@ -337,5 +364,8 @@ def report(result: TimeSeries) -> str:
                      f"{f['spin_rpm']['L0']:.3f} rpm (s = 0, L0/2, L0), ground torque "
                      f"{f['ground_torque_Nm']:.3f} Nm, T(0) = {f['tension_s0_N']:.2f} N"
                      + (f"; settled (2 %) at {settle:.3f} s" if settle is not None else ""))
-    lines[-1] += structure_limits.line(s.get("limits"))
+    if f and "power_W" in f:
+        lines.append(f"  rotor {f['rotor_rpm']:.3f} rpm, generator power {f['power_W']:.2f} W, "
+                     f"thrust {f['thrust_N']:.2f} N at a hub wind of {f['wind_hub_m_s']:.3g} m/s")
+    lines[-1] += structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy"))
     return "\n".join(lines)

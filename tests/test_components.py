@@ -6,21 +6,22 @@ import dataclasses
 
 import pytest
 
-from rawehelix.parameters import Model, Normalised, components, fingerprint
+from rawehelix.parameters import Model, Normalised, Parameters, components, fingerprint
 from rawehelix.studies import scene
 
 
 def test_each_table_is_a_scene_section_held_by_its_holder():
     tables = {s.KEY: s for s in components.SECTIONS if s.SECTION is not None}
-    assert tables  # damping, torsion_hysteresis
+    assert tables  # damping, torsion_hysteresis, wind (held by the scene itself: HOLDER None)
     for key, s in tables.items():
         assert scene.SECTIONS[key] is s.SECTION
-        assert scene.NESTED[key] == s.HOLDER
-        holder = {f.name: f for f in dataclasses.fields(scene.SECTIONS[s.HOLDER])}
+        assert scene.NESTED.get(key) == s.HOLDER
+        holder = {f.name: f for f in dataclasses.fields(
+            Parameters if s.HOLDER is None else scene.SECTIONS[s.HOLDER])}
         assert holder[key].default_factory is s.SECTION
         # what Model.describe and the fingerprints ask of a section
         assert s.SECTION().active is False and isinstance(s.SECTION().describe(), str)
-    assert set(scene.NESTED) == set(tables)
+    assert set(scene.NESTED) == {k for k, s in tables.items() if s.HOLDER is not None}
 
 
 def test_model_keeps_its_fields_in_their_order():
@@ -58,13 +59,15 @@ def test_group_of_an_active_section_reaches_normalised():
 
 def _implementations():
     """Every class of each component of forms/coefficients.py, null objects included."""
-    from rawehelix.forms import coefficients, damping, eilaw, hysteresis, section_law
-    from rawehelix.forms.components import BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw
+    from rawehelix.forms import coefficients, damping, eilaw, hysteresis, section_law, wind
+    from rawehelix.forms.components import (BendingLaw, Damping, Hysteresis, Kinematics,
+                                            SectionLaw, WindProfile)
     return [(Kinematics, cls) for cls in coefficients.KINEMATICS.values()] + [
         (Damping, damping.KelvinVoigt), (Damping, damping.NoneDamping),
         (BendingLaw, eilaw.TensionDependentBending), (BendingLaw, eilaw.ConstantBending),
         (Hysteresis, hysteresis.BoucWen), (Hysteresis, hysteresis.NoneHysteresis),
-        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.NonlinearSection)]
+        (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.NonlinearSection),
+        (WindProfile, wind.UniformWind), (WindProfile, wind.ProfileWind)]
 
 
 @pytest.mark.parametrize("protocol, cls", _implementations(),

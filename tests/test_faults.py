@@ -62,6 +62,11 @@ FAULTS = [
      "--quantity: tension: unknown quantity"),
     (["calibrate", "stationary_table2", "--fit", "helix.EI_Nm2", "--target", "nosuch=1"], 2,
      "--target: nosuch: unknown quantity"),
+    # issue 43: simulate with a rotor starts at a stable rigid-shaft operating point
+    (["simulate", "rotor_example", "--elements", "2", "--set", 'generator.law="torque"',
+      "--set", "generator.torque_Nm=500", "--set", "generator.mppt_gain_Nms2=0"], 2,
+     "wind.speed_m_s: 6.6131 m/s (V_n = 4.676 m/s along the rotor's axis) gives the rotor no "
+     "stable operating point"),
 ]
 
 

@@ -246,10 +246,18 @@ def check(way: str, load, changed: list[str]):
     return "loaded"
 
 
+def beside(tmp_dir: Path) -> None:
+    """The shipped scenes' tables (the rotor's CSV) beside a scene written to ``tmp_dir``:
+    a table's path is relative to its scene."""
+    for table in scene.SCENE_DIR.glob("*.csv"):
+        (tmp_dir / table.name).write_bytes(table.read_bytes())
+
+
 def check_file(tmp_dir: Path, scene_name: str, changes: list[tuple[str, object]]):
     data = base(scene_name)
     for key, value in changes:
         data = apply(data, key, value)
+    beside(tmp_dir)
     path = tmp_dir / f"{scene_name}.toml"
     path.write_text(dump(data))
     way = "file, one key" if len(changes) == 1 else "file, several keys"
@@ -345,6 +353,7 @@ def run_cli(tmp_dir: Path, scene_name: str, changes) -> subprocess.CompletedProc
     data = base(scene_name)
     for key, value in changes:
         data = apply(data, key, value)
+    beside(tmp_dir)
     path = tmp_dir / f"{scene_name}.toml"
     path.write_text(dump(data))
     out = tmp_dir / "out"

@@ -16,7 +16,7 @@ from rawehelix.cli import main as cli
 from rawehelix.studies import scene
 from tests_util import write_scene
 
-SHIPPED = ("stationary_table2", "nominal_operation", "mobile_end", "example")
+SHIPPED = ("stationary_table2", "nominal_operation", "mobile_end", "example", "rotor_example")
 
 
 @pytest.mark.parametrize("name", SHIPPED)

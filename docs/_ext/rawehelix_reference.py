@@ -72,7 +72,8 @@ SUFFIX_UNITS = {"_m": "m", "_kg": "kg", "_N": "N", "_Nm": "N m", "_Nm2": "N m^2"
                 "_Hz": "Hz", "_deg": "deg", "_rpm": "rpm", "_m_s": "m/s", "_m_s2": "m/s^2",
                 "_kg_m3": "kg/m^3", "_m_n": "(m/rad)^n"}
 _TYPE_WORDS = {"float": "number", "int": "integer", "str": "string", "bool": "true/false",
-               "EILaw | None": "inline table", "int | None": "integer"}
+               "EILaw | None": "inline table", "int | None": "integer", "str | None": "string", "float | None": "number",
+               "tuple[float, ...] | None": "array of numbers"}
 
 
 def field_comments(cls) -> dict[str, str]:
@@ -122,8 +123,10 @@ def _probes(type_name: str):
         return [0.5, 2.0, 1.0, 0.0, -1.0, 1e-300, 1e300, -1e300, math.nan, math.inf, -math.inf]
     if type_name in ("int", "int | None"):
         return [-10**6, -1, 0, 1, 2, 10**6]
-    if type_name == "str":
+    if type_name in ("str", "str | None"):
         return ["?"]
+    if type_name == "tuple[float, ...] | None":  # a table's column, 4 rows (Rotor.reference_example)
+        return [(4.0, 3.0, 2.0, 1.0), (-1.0, 0.5, 0.6, 0.7), (0.1, 0.7, 0.2, 0.3)]
     if type_name == "EILaw | None":
         return [{}, {"a_Nm2_per_N": -1.0, "b_Nm2": 1.0}, {"a_Nm2_per_N": 1.0, "b_Nm2": 0.0}]
     return []
@@ -220,6 +223,10 @@ def scene_key_rows(sections=None, base=None):
     for section, cls in sections.items():
         holder = scene.NESTED.get(section)
         start = getattr(getattr(base, holder), section) if holder else getattr(base, section)
+        # a section whose ranges are checked only when it is on (the rotor: with a table)
+        # gives an instance that is on to start the probes from
+        if hasattr(cls, "reference_example"):
+            start = cls.reference_example()
         fields = [f for f in dataclasses.fields(cls) if f.name not in scene.NESTED]
         notes = field_comments(cls)
         str_fields = [f.name for f in fields if f.type == "str"]
@@ -289,7 +296,19 @@ def _cross_section_rules() -> list[tuple[str, str]]:
               {"damping": {"axial_s": 1e-3}, **ip_only},
               {"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 1.0}, **ip_only},
               {"helix": {"stiffness": "from_section"}},
-              {"helix": {"stiffness": "from_section"}, "section": {"tether_EA_N": 6e3}}]
+              {"helix": {"stiffness": "from_section"}, "section": {"tether_EA_N": 6e3}},
+              # the machine's sections against the paper's ends, wind and scheme
+              {"generator": {"law": "mppt", "mppt_gain_Nms2": 0.1}},
+              {"rotor": {"radius_m": 2.0, "tsr": (1.0, 3.0, 5.0), "cp": (0.1, 0.3, 0.4),
+                         "ct": (0.2, 0.5, 0.7)}},
+              {"wind": {"speed_m_s": 5.0}},
+              {"wind": {"speed_m_s": 10.0, "air_density_kg_m3": 1.2},
+               "environment": {"air_density_kg_m3": 1.1}},
+              {"wind": {"speed_m_s": 10.0, "profile": "power"}, "environment": {"wind_speed_m_s": 0.0},
+               "discretisation": {"scheme": "spline"}},
+              {"lifter": {"top": "circle"}},
+              {"lifter": {"top": "lifted", "force_N": 300.0},
+               "ends": {"circle_radius_m": 0.1, "circle_frequency_Hz": 1.0}}]
     found = []
     for trial in trials:
         try:
