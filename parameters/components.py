@@ -54,6 +54,12 @@ def scene_sections() -> dict:
     return {s.KEY: s.SECTION for s in SECTIONS if s.SECTION is not None}
 
 
+def scene_readers() -> dict:
+    """``[KEY]`` -> ``read(values, folder)`` of the sections that read a file beside the
+    scene (a module's ``read``: the wind's file)."""
+    return {s.KEY: s.read for s in SECTIONS if getattr(s, "read", None) is not None}
+
+
 def scene_holders() -> dict:
     """The section whose dataclass holds each component table: {"damping": "model", ...}."""
     return {s.KEY: s.HOLDER for s in SECTIONS if s.SECTION is not None and s.HOLDER is not None}

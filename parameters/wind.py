@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from pathlib import Path
 
 from rawehelix.operation.wind import FLOOR_M, PROFILES
+from rawehelix.parameters import wind_time
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 
 DEFAULT_AIR_DENSITY = 1.225  # environment.air_density_kg_m3's default [kg/m^3]
@@ -34,6 +36,28 @@ class Wind:
     roughness_m: float = 0.03  # z0 of profile "log" [m]
     # the air's density for the drag and the rotor; absent: environment.air_density_kg_m3 [kg/m^3]
     air_density_kg_m3: float | None = None
+    # how the wind changes in time (operation/wind_series.py): "steady", "step" (to
+    # step_to_m_s), "gust" (IEC 61400-1's extreme operating gust), "turbulent" (IEC
+    # Kaimal spectrum and coherence, pyconturb) or "file" (a CSV of the hub's wind)
+    kind: str = "steady"
+    step_to_m_s: float | None = None  # "step": V_ref after the step [m/s]
+    step_time_s: float = 10.0  # "step": the ramp's start [s]
+    rise_time_s: float = 2.0  # "step": its rise time, a half-cosine ramp; 0 a jump [s]
+    gust_start_s: float = 10.0  # "gust": the gust's start; it lasts 10.5 s [s]
+    # "gust", "turbulent": IEC 61400-1's turbulence class, "A+", "A", "B" or "C"
+    # (I_ref 0.18, 0.16, 0.14, 0.12)
+    turbulence_class: str = "B"
+    wind_class: str = "III"  # "gust": IEC's wind turbine class "I", "II", "III" (V_ref 50, 42.5, 37.5 m/s)
+    # "gust", "turbulent": the hub's height above the ground end; absent: the top end's [m]
+    hub_height_m: float | None = None
+    seed: int = 0  # "turbulent": the random seed, 0 to 2^32 - 1
+    # "turbulent": sigma_u / V_hub; absent: the class's, I_ref (0.75 V_hub + 5.6) / V_hub [-]
+    turbulence_intensity: float | None = None
+    duration_s: float = 600.0  # "turbulent": the series' length, >= time.until_s [s]
+    time_step_s: float = 0.05  # "turbulent": its step (Nyquist 1 / (2 dt)) [s]
+    # "file": a CSV of the hub's wind (its path relative to the scene file): the columns
+    # time_s (uniform step) and speed_m_s, or u_m_s, v_m_s, w_m_s (along -x, lateral, up)
+    file: str | None = None
 
     def __post_init__(self):
         if self.profile not in PROFILES:
@@ -56,6 +80,23 @@ class Wind:
             raise ParameterError("wind.roughness_m", self.roughness_m,
                                  f"must be below wind.reference_height_m = "
                                  f"{self.reference_height_m!r} (the log law's ln(z_ref/z0) > 0)")
+        wind_time.check_section(self)
+
+    @classmethod
+    def from_scene(cls, values: dict, folder: Path) -> "Wind":
+        """The section as a scene gives it: ``file`` relative to the scene's ``folder``
+        (studies/scene.py), kept as its absolute path."""
+        name = values.get("file")
+        if isinstance(name, str) and name and not Path(name).is_absolute():
+            values = {**values, "file": str((folder / name).resolve())}
+        return cls(**values)
+
+    @property
+    def series(self) -> dict:
+        """kind "file": the file's columns, {time_s, and speed_m_s or u_m_s, v_m_s,
+        w_m_s: numpy arrays} (read and checked once, at construction); None for the
+        other kinds."""
+        return getattr(self, "_series", None)
 
     @classmethod
     def reference_example(cls) -> "Wind":
@@ -77,6 +118,9 @@ class Wind:
             return "wind: environment.wind_speed_m_s, uniform (Eq. 14)"
         return f"wind: {self.profile}, {self.speed_m_s:g} m/s at {self.reference_height_m:g} m"
 
+
+#: how the scene loader builds the section (studies/scene.py): a file beside the scene
+read = Wind.from_scene
 
 _L0 = ("helix.length_m",)
 #: its normalised groups (parameters/scene.py::GROUP_KEYS): heights / L0; and the
@@ -133,3 +177,4 @@ def check(params) -> None:
         raise ParameterError("wind.profile", w.profile,
                              "is implemented by the FE scheme only (the references' drag is "
                              "the uniform wind of Eq. 14)")
+    wind_time.check(params)

@@ -33,6 +33,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ scripts/install.sh 
   echo "install: pip install -e . (numpy==$numpy_version)"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e . "numpy==$numpy_version" \
       "import-linter==2.1"  # lint-imports: the import contracts of .importlinter (tests/test_architecture.py)
+  # pyconturb (operation/turbulence.py, the turbulent wind): --no-deps, because pip
+  # does not see Debian's h5py (dist-info h5py._debian_h5py_serial) and would install
+  # PyPI's over it; numpy, scipy, pandas and h5py are already there
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps "pyconturb==2.7.4"
   # pyvista renders off screen; it is optional and must not move numpy.  Before 0.46:
   # later ones bring cyclopts -> rich -> markdown-it-py >= 2.2, which shadows Debian's
   # 2.1 and breaks Debian's myst-parser (make docs), with a resolver error at install.

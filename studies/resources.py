@@ -53,7 +53,7 @@ import math
 import os
 
 from rawehelix.errors import SceneError
-from rawehelix.parameters import Parameters, schemes
+from rawehelix.parameters import Parameters, schemes, wind_time
 from rawehelix.parameters.schemes import FECore
 
 BASE_BYTES = 0.25e9  # Python, DOLFINx, PETSc, matplotlib: the smallest run's peak RSS
@@ -209,6 +209,9 @@ def check_simulate(params: Parameters, until_s: float | None = None, key: str = 
     tm = params.time
     if until_s is None:
         until_s, key = tm.until_s, "time.until_s"
+    short = wind_time.too_short(params, until_s, key)  # the wind's series must cover the run
+    if short:
+        raise SceneError(*short)
     outputs, frames = until_s / tm.output_every_s, until_s / tm.fields_every_s
     kept = (BYTES_PER_OUTPUT * outputs,
             frames * (BYTES_PER_FRAME + BYTES_PER_FRAME_NODE * _nodes(params)))

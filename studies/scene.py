@@ -36,7 +36,8 @@ SECTIONS = {
     **end_components.scene_sections(),  # and [rotor], [generator], [lifter]
 }
 NESTED = components.scene_holders()  # sections held by another section's dataclass
-READERS = end_components.scene_readers()  # sections that read a file beside the scene
+# sections that read a file beside the scene
+READERS = {**end_components.scene_readers(), **components.scene_readers()}
 REQUIRED = ("helix", "ends")
 TOP_LEVEL = {"title": str}
 SCENE_DIR = Path(__file__).parent / "scenes"

@@ -67,6 +67,13 @@ FAULTS = [
       "--set", "generator.torque_Nm=500", "--set", "generator.mppt_gain_Nms2=0"], 2,
      "wind.speed_m_s: 6.6131 m/s (V_n = 4.676 m/s along the rotor's axis) gives the rotor no "
      "stable operating point"),
+    # issue 44: the wind in time (tests/test_wind_series.py has every key and file fault)
+    (["stationary", "gust_rated", "--set", "wind.speed_m_s=45"], 2,
+     "not below V_e1 = 42 m/s of wind.wind_class = 'III'"),
+    (["stationary", "gust_rated", "--set", 'wind.turbulence_class="D"'], 2,
+     'wind.turbulence_class: "D" must be one of'),
+    (["simulate", "turbulent_rated", "--until", "700"], 2,
+     "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
 ]
 
 
