@@ -59,9 +59,10 @@ def solver(params, machine: Machine, comm, options):
 
 def row(machine: Machine, t_s: float, spin0_rpm: float, spin1_rpm: float,
         ground_torque_Nm: float) -> tuple:
-    """The :data:`COLUMNS` at an output time (SI)."""
+    """The :data:`COLUMNS` at an output time (SI), in the wind of that time."""
+    now = machine.at(t_s)
     return (spin1_rpm, ground_torque_Nm * spin0_rpm * RPM,
-            thrust(machine, spin1_rpm * RPM, t_s), machine.wind_hub_m_s)
+            thrust(now, spin1_rpm * RPM, t_s), now.wind_hub_m_s)
 
 
 def thrust(machine: Machine, omega_rad_s: float, t_s: float) -> float:
@@ -78,7 +79,8 @@ def check_step(machine: Machine, solver) -> None:
     """After each step: the rotor's tip-speed ratio inside its table (:func:`thrust`)."""
     if machine.rotor is not None:
         q = solver.q
-        thrust(machine, float(solver.probes.value("spin1")) / q.t_scale, float(q.time_s(solver.t)))
+        t_s = float(q.time_s(solver.t))
+        thrust(machine.at(t_s), float(solver.probes.value("spin1")) / q.t_scale, t_s)
 
 
 __all__ = ["COLUMNS", "check_step", "of", "row", "solver", "start_point", "thrust"]
