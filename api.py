@@ -26,7 +26,7 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
 __all__ = ["load_scene", "section", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "envelope",
+           "envelope", "operate",
            "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters"]
 
 
@@ -102,6 +102,30 @@ def stationary(scene: Parameters, comm=None):
     scene = _ready(scene, "stationary", comm)
     from rawehelix.studies import stationary as study
     return study.compute(scene, comm)
+
+
+def operate(scene: Parameters, wind_m_s, comm=None):
+    """The operating points of the scene's rotor (``[rotor]``) and generator
+    (``[generator]``) at the wind speeds ``wind_m_s`` [m/s]: relative
+    equilibria (the spin Omega closed by the torque balance, the helix's stationary state
+    under the rotor's torque), every branch of the balance traced through folds in the
+    wind, up to the helix's first limit.  An :class:`~rawehelix.studies.operate.Operate`
+    with ``points`` and ``summary`` (``summary["points"]``: wind_m_s, rotor_rpm, tsr,
+    power_W, rotor_power_W, torque_top_Nm, torque_ground_Nm, thrust_N, tension_max_N,
+    tension_min_N, twist_deg, stable, branch; ``"limits"`` with ``first_limit``;
+    ``"stopped"``: why the curve ends).  A scene without a rotor or generator, or wind
+    speeds with no operating point in the rotor's table, raise SceneError.
+
+    Args:
+        scene: the validated scene (:func:`load_scene`).
+        wind_m_s: the wind speeds [m/s] at the reference height (ascending or not).
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
+    comm = _world(comm)
+    from rawehelix.studies import operate as study
+    winds = study.check_winds(wind_m_s)
+    planned = study.plan(scene, winds)  # numpy: the refusals before any FE work
+    scene = _ready(scene, "operate", comm)
+    return study.compute(scene, winds, comm, planned)
 
 
 def modes(scene: Parameters, count: int | None = None, comm=None):

@@ -32,6 +32,8 @@ sections and keeps the others' last results.
 10. ``orbits``: the cost of a continuation point of the FE periodic orbits at
     N = 4 and 8 (benchmarks/orbits.py), the former full-Newton dense map
     against the chord steps with the sparse tangent, CPU time in one process.
+15. ``operate``: the power curve of 25 wind speeds at N = 8 and an operating point's
+    stationary solves (benchmarks/operate.py).
 14. ``hb``: harmonic balance (benchmarks/harmonic_balance.py): the whole curve at N = 8
     against the sweep, at N = 32, a fold curve over EI x 4, and a point's parts.
 11. ``curve``: the issue-13 target, the whole Fig. 8 curve by continuation
@@ -57,6 +59,7 @@ import numpy as np
 from rawehelix import fits
 
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
+import operate as operate_bench  # benchmarks/operate.py
 import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
@@ -654,11 +657,13 @@ def markdown(r: dict) -> str:
                      f"{c['ratio']:.2f} | {TARGETS['curve']} |")
     if r.get("hb"):
         lines += hb_bench.markdown(r["hb"])
+    if r.get("operate"):
+        lines += operate_bench.markdown(r["operate"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb")
+            "orbits", "curve", "hb", "operate")
 
 
 def main():
@@ -693,7 +698,8 @@ def main():
                      ("study", lambda: study_bench.bench_study(repeats)),
                      ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
                      ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
-                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of))):
+                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of)),
+                     ("operate", lambda: operate_bench.bench_operate(8, repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

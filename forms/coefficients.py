@@ -7,13 +7,14 @@ from typing import Any
 
 from rawehelix.forms import wind as wind_profile
 from rawehelix.forms.components import (BendingLaw, Damping, Hysteresis, Kinematics, SectionLaw,
-                                        WindProfile)
+                                        SpinDragLaw, WindProfile)
 from rawehelix.forms.damping import KelvinVoigt, NoneDamping
 from rawehelix.forms.eilaw import ConstantBending, TensionDependentBending
 from rawehelix.forms.extensible import ExtensibleKinematics
 from rawehelix.forms.hysteresis import BoucWen, NoneHysteresis
 from rawehelix.forms.paper import PaperKinematics
 from rawehelix.forms.shearable import ShearableKinematics
+from rawehelix.forms.spin_drag import NoSpinDrag, SpinDrag
 from rawehelix.forms import section_law
 
 #: the kinematics components by the name a scene gives (model.kinematics, parameters/sections.py):
@@ -33,6 +34,7 @@ COMPONENTS = {"damping": KelvinVoigt.from_normalised,
               "bending_law": TensionDependentBending.from_normalised,
               "hysteresis": BoucWen.from_normalised,
               "section": section_law.from_normalised,
+              "spin_drag": SpinDrag.from_normalised,
               "wind": wind_profile.from_normalised}
 
 
@@ -73,6 +75,9 @@ class Coefficients:
     # the section law, a component (forms/section_law.py, chosen by the registry
     # section_laws.py): NonlinearSection of its law, or the null object SolidSection
     section: SectionLaw = field(default_factory=section_law.SolidSection)
+    # the spinning tethers' torque loss, a component (forms/spin_drag.py): SpinDrag, or
+    # the null object NoSpinDrag
+    spin_drag: SpinDragLaw = field(default_factory=NoSpinDrag)
     # the wind's profile in the drag, a component (forms/wind.py): ProfileWind, or the
     # null object UniformWind (the paper's v_w0 at every height)
     wind: WindProfile = field(default_factory=wind_profile.UniformWind)

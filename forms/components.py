@@ -58,6 +58,23 @@ class Hysteresis(Protocol):
 
 
 @runtime_checkable
+class SpinDragLaw(Protocol):
+    """The spinning tethers' torque loss (forms/spin_drag.py): SpinDrag, or the null
+    NoSpinDrag."""
+
+    fields: tuple
+
+    def dissipation(self, alpha_t, c, dx):
+        """The dissipation potential D(alpha_t)."""
+
+    def power(self, alpha_t, c, dx):
+        """The power it takes, alpha_t dD/d alpha_t."""
+
+    def residual(self, alpha_t, psi, c, dx):
+        """Its torque in the twist equation, delta dD/d alpha_t [psi]."""
+
+
+@runtime_checkable
 class WindProfile(Protocol):
     """The wind's profile in the drag (forms/wind.py): ProfileWind, or the null UniformWind."""
 
@@ -73,4 +90,5 @@ class WindProfile(Protocol):
 SectionLaw = SectionComponent
 
 
-__all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw", "WindProfile"]
+__all__ = ["BendingLaw", "Damping", "Hysteresis", "Kinematics", "SectionLaw", "SpinDragLaw",
+           "WindProfile"]

@@ -147,6 +147,8 @@ def residual_of_fields(r, alpha, r_t, r_tt, alpha_tt, tests, c: Coefficients, de
         F += c.hysteresis.residual(z, z_t, tau_t, third[0], dx, c)
     if moving:  # the damping component: Kelvin-Voigt from its dissipation potential, or none
         F += c.damping.residual(r, r_t, alpha_t, v, psi, c, degree, penalty, measures)
+        if alpha_t is not None and psi is not None:  # the spin drag (forms/spin_drag.py), or none
+            F += c.spin_drag.residual(alpha_t, psi, c, dx)
     if r_tt is not None:
         F += (ufl.inner(r_tt, v) + alpha_tt * psi) * dx
     return F

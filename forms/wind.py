@@ -67,6 +67,9 @@ class ProfileWind:
 
     def factor(self, r):
         """f(z~) at the centre line r (z~ = -r . k_E)."""
+        if r is None:  # a caller of forms/rod.py's drag that gave no centre line
+            raise ValueError("a wind profile's drag needs the centre line r (its height): "
+                             "pass r to forms/rod.py's aerodynamic_force and body_force")
         return self.law(-r[2], self)
 
 

@@ -132,6 +132,16 @@ class RodModel(abc.ABC):
     def dissipation(self, fields: dict, rates: dict, c, degree: int, penalty, measures):
         """The dissipation potential D; None: the model dissipates nothing."""
 
+    def dissipated_power(self, fields: dict, rates: dict, c, degree: int, penalty, measures):
+        """The power the dissipative components take: 2 D of the structural damping
+        (:meth:`dissipation`, quadratic in the rates) plus the spin drag's
+        alpha_t dD/d alpha_t (forms/spin_drag.py, cubic); None: nothing dissipates."""
+        D = self.dissipation(fields, rates, c, degree, penalty, measures)
+        spin = (None if rates["twist"] is None
+                else c.spin_drag.power(rates["twist"], c, measures[0]))
+        parts = [P for P in (None if D is None else 2 * D, spin) if P is not None]
+        return sum(parts[1:], parts[0]) if parts else None
+
     @abc.abstractmethod
     def non_variational_power(self, fields: dict, rates: dict, c, dx):
         """The power of the terms that are not the variation of an energy."""

@@ -35,8 +35,9 @@ def _log(z, w):
     return np.log(np.maximum(z, z0) / z0) / math.log(w.reference_height_m / z0)
 
 
+UNIFORM = "uniform"  # the paper's profile: V_ref at every height
 #: the profiles' factors V(z) / V_ref by name (forms/wind.py has the same in UFL)
-FACTORS = {"uniform": _uniform, "power": _power, "log": _log}
+FACTORS = {UNIFORM: _uniform, "power": _power, "log": _log}
 PROFILES = tuple(FACTORS)
 
 

@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import dataclasses
 
-from rawehelix.parameters import damping, eilaw, hysteresis, section, shear, wind
+from rawehelix.parameters import damping, eilaw, hysteresis, section, shear, spin_drag, wind
 
 #: the sections, in the order of their checks
-SECTIONS = (eilaw, damping, hysteresis, section, shear, wind)
+SECTIONS = (eilaw, damping, hysteresis, section, shear, wind, spin_drag)
 
 
 def group_keys() -> dict:

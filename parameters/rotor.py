@@ -18,7 +18,14 @@ COLUMNS = ("tsr", "cp", "ct")
 class Rotor:
     """The rotor: R, its inertia, mass and blades, and its table (a CSV file or inline
     arrays).  Q = 1/2 rho pi R^2 V_n^3 Cp(lambda) / Omega, F = 1/2 rho pi R^2 V_n^2
-    CT(lambda), lambda = Omega R / V_n (operation/rotor.py)."""
+    CT(lambda), lambda = Omega R / V_n (operation/rotor.py).
+
+    The table is ``tsr``, ``cp`` and ``ct``: a scene's ``table`` file is read into them
+    by the scene loader (relative to the scene's folder), and ``table`` then records
+    where they came from.  In code, change the table through them
+    (``params.replace(rotor={"tsr": .., "cp": .., "ct": ..})``): a ``replace`` of
+    ``table`` alone keeps the arrays it already has; ``Rotor(table=FILE)`` without
+    arrays reads FILE relative to the working folder."""
 
     radius_m: float | None = None  # R, the rotor's radius; required with a table [m]
     spin_inertia_kgm2: float = 0.0  # J, the rotor's moment of inertia about its axis [kg m^2]

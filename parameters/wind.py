@@ -15,7 +15,7 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
-from rawehelix.operation.wind import FLOOR_M, PROFILES
+from rawehelix.operation.wind import FLOOR_M, PROFILES, UNIFORM
 from rawehelix.parameters import wind_time
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 
@@ -111,7 +111,7 @@ class Wind:
     @property
     def uniform(self) -> bool:
         """The same speed at every height (the paper's wind, or [wind]'s uniform one)."""
-        return not self.active or self.profile == "uniform"
+        return not self.active or self.profile == UNIFORM
 
     def describe(self) -> str:
         if not self.active:
@@ -164,7 +164,7 @@ def check(params) -> None:
     w, env = params.wind, params.environment
     if not w.active:
         return
-    if env.wind_speed_m_s != 0 and not (w.profile == "uniform" and env.wind_speed_m_s == w.speed_m_s):
+    if env.wind_speed_m_s != 0 and not (w.profile == UNIFORM and env.wind_speed_m_s == w.speed_m_s):
         raise ParameterError("wind.speed_m_s", w.speed_m_s,
                              f"and environment.wind_speed_m_s = {env.wind_speed_m_s!r} both give "
                              "the wind: keep [wind] and remove environment.wind_speed_m_s")
@@ -173,7 +173,7 @@ def check(params) -> None:
         raise ParameterError("wind.air_density_kg_m3", w.air_density_kg_m3,
                              f"and environment.air_density_kg_m3 = {env.air_density_kg_m3!r} "
                              "differ: give the air's density once")
-    if w.profile != "uniform" and params.discretisation.scheme != "fe":
+    if w.profile != UNIFORM and params.discretisation.scheme != "fe":
         raise ParameterError("wind.profile", w.profile,
                              "is implemented by the FE scheme only (the references' drag is "
                              "the uniform wind of Eq. 14)")

@@ -1,5 +1,11 @@
 """Pseudo-arclength continuation of periodic orbits in f1, through folds.
 
+Branch asks its problem only for the protocol below (G, its Jacobians, a Newton at
+fixed parameter, a finished point with ``X``, ``f1_Hz``, ``multipliers``), so any
+problem with that protocol is continued the same way: the operating points of issue 43
+(solvers/rigid_shaft_branch.py) continue a torque balance in the wind V_n, which they
+hand to Branch as its parameter ``f1_Hz``.
+
 The orbits are those of a periodic-orbit problem
 (:class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`: shooting with
 the FE or the spline scheme), which gives the residual G(X, f1), its Jacobians

@@ -6,7 +6,8 @@ Eq. (30),
     mu r'''' = [(T - mu kappa^2) r']' + k_E + F_A,   T = sigma (|r'| - 1)   (29)-(33)
 
 with F_A = -nu v_w0^2 i_E (drag on the full relative velocity v_A = v_w0 i_E,
-Eq. 28) into the first-order system (67)-(68) for the state
+Eq. 28; with a wind profile, [wind], -nu v(z)^2 i_E at each point's height) into the
+first-order system (67)-(68) for the state
 
     y = (x, z, x_s, z_s, x_ss, z_ss, x_sss, z_sss).
 
@@ -41,6 +42,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
+from rawehelix.operation import wind
 from rawehelix.parameters import Normalised
 from rawehelix.references.budget import OverBudget, budget, watched
 
@@ -59,6 +61,29 @@ def load_vector(normalised: Normalised) -> np.ndarray:
     return np.array([-q.drag * q.nu * q.v_w0**2, q.gravity])
 
 
+def drag_factor(normalised: Normalised):
+    """The wind profile's (V(z)/V_ref)^2 as a function of the state's z (the height above
+    the ground end is -z L0: k_E points down), which scales the drag of
+    :func:`load_vector` along the rod; None for the uniform wind (the paper's: the
+    drag is the same everywhere).  The profile is operation/wind.py's numpy law, the
+    FE path's is forms/wind.py's UFL."""
+    q = normalised
+    if q.wind_profile == wind.UNIFORM:
+        return None
+    profile = wind.WindProfile(1.0, q.wind_reference * q.L0, q.wind_profile, q.wind_exponent,
+                               q.wind_roughness * q.L0)
+    return lambda z: profile.factor(-z * q.L0) ** 2
+
+
+def uniform_load_only(params) -> str | None:
+    """Why a reference that integrates a uniform load (the elastica's resultant
+    N = N(0) - q s) does not model the scene's wind, or None."""
+    if params.wind.uniform:
+        return None
+    return (f"wind.profile = {params.wind.profile!r}: the elastica's reference integrates "
+            "a uniform load (the drag of a uniform wind)")
+
+
 def _bending_modulus(normalised: Normalised) -> float:
     mu = normalised.mu * normalised.bending
     if not mu > 0:
@@ -74,15 +99,17 @@ def rhs(normalised: Normalised):
     sigma = normalised.sigma
     mu = _bending_modulus(normalised)
     qx, qz = load_vector(normalised)
+    profile = drag_factor(normalised)  # None: the uniform wind's drag qx everywhere
 
     def f(s, y):
         x_s, z_s, x_ss, z_ss, x_sss, z_sss = y[2:8]
+        q_x = qx if profile is None else qx * profile(y[1])  # the drag at this height
         stretch = np.sqrt(x_s**2 + z_s**2)  # |r'|
         tension = sigma * (stretch - 1.0)  # T, Eq. (29)
         kappa2 = x_ss**2 + z_ss**2  # kappa^2, Eq. (34)
         # f_s = d/ds (T - mu kappa^2), Eq. (68)
         f_s = sigma / stretch * (x_s * x_ss + z_s * z_ss) - 2.0 * mu * (x_ss * x_sss + z_ss * z_sss)
-        x_4 = (f_s * x_s + (tension - mu * kappa2) * x_ss + qx) / mu  # (67), drag -nu v_w0^2
+        x_4 = (f_s * x_s + (tension - mu * kappa2) * x_ss + q_x) / mu  # (67), drag -nu v(z)^2
         z_4 = (f_s * z_s + (tension - mu * kappa2) * z_ss + qz) / mu  # (67), gravity +1
         return np.array([x_s, z_s, x_ss, z_ss, x_sss, z_sss, x_4, z_4])
 

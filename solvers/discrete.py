@@ -43,7 +43,8 @@ class RodDiscretisation:
     #: the full rod (solvers/planar.py's PlanarRod is the reduced (x, z) one)
     planar = False
 
-    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, pin_twist: bool = True):
+    def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, pin_twist: bool = True,
+                 free_top: bool = False):
         disc = params.discretisation
         if not schemes.of(params).fe_assembled:
             raise ValueError(f"discretisation.scheme = {disc.scheme!r}: this solver is the FE scheme")
@@ -63,7 +64,7 @@ class RodDiscretisation:
         self.c = rod.Coefficients.from_normalised(
             self.q, params.model, make=lambda v: dolfinx.fem.Constant(self.mesh, PETSc.ScalarType(v)))
         self.measures = rod.measures(self.mesh, disc.degree, disc.quadrature_degree)
-        self._set_up_end_conditions(pin_twist)
+        self._set_up_end_conditions(pin_twist, free_top)
 
     # -- end conditions, Eqs. (35), (36), (66), (70) ------------------------------
     def sub(self, role: str):
@@ -77,10 +78,12 @@ class RodDiscretisation:
             return np.zeros(0, dtype=int)
         return np.asarray(compat.collapse(self.sub(role))[1], dtype=int)
 
-    def _set_up_end_conditions(self, pin_twist: bool):
+    def _set_up_end_conditions(self, pin_twist: bool, free_top: bool = False):
         """The model's end conditions (models/unshearable.py) as dolfinx bcs:
         ``bcs`` all of them, ``twist_bcs`` alpha = 0 everywhere (model.twist =
-        false), ``curvature_bcs`` kappa = 0 at the ends (mixed form)."""
+        false), ``curvature_bcs`` kappa = 0 at the ends (mixed form).  ``free_top``:
+        without the top's position (36), whose force is then a natural term
+        (the lifted top, solvers/lifted.py)."""
         mesh = self.mesh
         vertices = {"bottom": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 0.0)),
                     "top": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 1.0))}
@@ -100,6 +103,8 @@ class RodDiscretisation:
             self._curvature_problem = None
         self.bcs, self.twist_bcs, self.curvature_bcs, self.end_dofs = [], [], [], {}
         for end in self.model.end_conditions(pin_twist):
+            if free_top and end.value == "top_position":
+                continue
             W_sub, V = self.sub(end.role), spaces[end.role]
             dofs = (self.all_dofs(W_sub, V) if end.where == "all" else
                     dolfinx.fem.locate_dofs_topological((W_sub, V), 0, vertices[end.where]))

@@ -13,8 +13,10 @@ import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from rawehelix import compat
+from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import fields
 from rawehelix.forms.kinematics import tension
@@ -49,13 +51,44 @@ class StationaryResult:
 class StationarySolver:
     """Newton for the stationary residual of Eqs. (30)-(31) on one discretisation."""
 
+    #: what a slack state's message advises: the fixed top's tension is its elongation's
+    SLACK_ADVICE = "increase ends.elongation"
+
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
                  planar: bool = False):
+        if params.lifter.active:  # the top held by a force: solvers/lifted.py's solver
+            raise SceneError(
+                params.name, "lifter.top",
+                "'lifted' holds the top end by the lifter's force, which `rawehelix "
+                "stationary` solves; this command (or ends.tension_N) holds the top at "
+                "[ends]' position: set lifter.top = 'fixed', or give ends.elongation")
         self.params, self.scene = params, scene
         # planar: the reduced (x, z) model (solvers.planar), for planar torque-free scenes
         self.rod = PlanarRod(params, comm) if planar else RodDiscretisation(params, comm)
-        self.F = self.rod.stationary_residual()
+        self.F = self._with_spin_drag(self.rod.stationary_residual(), planar)
         self.newton = NewtonSolver(self.F, self.rod.w, self.rod.bcs, prefix="rawehelix_")
+        self._observables(planar)
+
+    def _with_spin_drag(self, F, planar: bool):
+        """F plus the spin drag's torque (forms/spin_drag.py) of a relative equilibrium
+        spinning at alpha_t = Omega (:meth:`set_spin`; 0 until set): the operating point's
+        state.  F itself when the scene has no spin drag."""
+        self.spin = None
+        if planar or self.rod.q.spin_drag == 0:
+            return F
+        self.spin = dolfinx.fem.Constant(self.rod.mesh, PETSc.ScalarType(0.0))
+        psi = self.rod.model.split(self.rod.test)["twist"]
+        return F + self.rod.c.spin_drag.residual(self.spin, psi, self.rod.c, self.rod.measures[0])
+
+    def set_spin(self, omega: float):
+        """The spin Omega (normalised: rad per t_scale) of the relative equilibrium whose
+        spin drag (forms/spin_drag.py) loads the twist equation; the stationary state
+        (Sec. 5.1) has Omega = 0.  Without a spin drag there is nothing to set."""
+        if self.spin is not None:
+            self.spin.value = omega
+
+    def _observables(self, planar: bool):
+        """The tension field's space and expression (Eq. 29)."""
         p = self.rod.degree
         self.V_T = compat.scalar_space(self.rod.mesh, "DG", p - 1)
         self.tension_expr = (tension(self.rod.centre_line(), self.rod.c.sigma) if planar  # (29)
@@ -95,6 +128,13 @@ class StationarySolver:
         self.rod.c.m0.value = ground
         self.rod.c.mN.value = top
 
+    def end_twist(self) -> float | None:
+        """alpha(L0) - alpha(0) [rad] of the full rod's state, on rank 0 (None elsewhere).
+        Collective."""
+        rod = self.rod
+        s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
+        return None if alpha is None else float(alpha[-1, 0] - alpha[0, 0])
+
     def _check_taut(self, result):
         """Eq. (22) is Hooke's law for a taut helix; a compressed one is slack
         (bars and tethers cannot carry it) and the model does not hold."""
@@ -107,7 +147,7 @@ class StationarySolver:
             raise SlackError(
                 f"{self.scene}: the stationary tension falls to {where[1]:.4g} N at "
                 f"s = {self.rod.q.length_m(where[0]):.4g} m: the helix is slack, and the "
-                f"tension law (22) does not hold for compression; increase ends.elongation")
+                f"tension law (22) does not hold for compression; {self.SLACK_ADVICE}")
 
     def gather(self) -> StationaryResult:
         s, x = self.rod.gather_centre_line()

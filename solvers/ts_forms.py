@@ -141,9 +141,10 @@ class _Formulation:
         self.potential = dolfinx.fem.form(model.stored_energy(
             f, rod_.c, rod_.degree, rod_.penalty, rod_.measures))
         self.power_nv = dolfinx.fem.form(model.non_variational_power(f, f_t, rod_.c, dx))
-        # 2 D, the power of the structural damping (forms/damping.py); None: undamped
-        D = model.dissipation(f, f_t, rod_.c, rod_.degree, rod_.penalty, rod_.measures)
-        self.dissipation = None if D is None else dolfinx.fem.form(2 * D)
+        # the dissipated power: 2 D of the structural damping (forms/damping.py) and the
+        # spin drag's (forms/spin_drag.py); None: nothing dissipates
+        P = model.dissipated_power(f, f_t, rod_.c, rod_.degree, rod_.penalty, rod_.measures)
+        self.dissipation = None if P is None else dolfinx.fem.form(P)
         if self.end_torques is not None:
             self._machine_forms(fields)
         self.b = compat.create_vector(self.F)

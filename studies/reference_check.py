@@ -67,9 +67,11 @@ def references() -> dict[str, Reference]:
     (models/kinematics.py::Kinematics.reference)."""
     from rawehelix.references import shooting, shooting_shear
     return {"shooting": Reference(shooting.solve, too_many_segments),
-            "extensible_elastica": Reference(shooting.solve_extensible),
+            "extensible_elastica": Reference(shooting.solve_extensible,
+                                             shooting.uniform_load_only),
             "shearable_elastica": Reference(shooting_shear.solve_shearable,
-                                            shooting_shear.not_applicable)}
+                                            lambda p: shooting.uniform_load_only(p)
+                                            or shooting_shear.not_applicable(p))}
 
 
 def reference_of(params: Parameters) -> Reference:
@@ -83,6 +85,9 @@ def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
     from rawehelix import section_laws
     from rawehelix.references import shooting
     law = params.value("section.law")
+    if params.lifter.active:
+        return ("lifter.top = 'lifted': the references hold the top end fixed (the lifted "
+                "top's check is the elastic catenary, tests/test_lifted.py)")
     if twisted:
         return ("the state is twisted by the ends' torque (torque.top_Nm), and the "
                 "references are torque-free, planar rods")
@@ -91,9 +96,6 @@ def not_applicable(params: Parameters, twisted: bool = False) -> str | None:
                 "(helix.EA_N, helix.EI_Nm2)")
     if not params.model.bending:
         return "model.bending = false: the references need a bending stiffness"
-    if not params.wind.uniform:
-        return (f"wind.profile = {params.wind.profile!r}: the references' drag is the "
-                "uniform wind of Eq. (14)")
     return (reference_of(params).not_applicable(params)
             or shooting.not_applicable(params.normalised()))
 

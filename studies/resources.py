@@ -65,6 +65,7 @@ HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dy
             "spin_up": "dynamics", "sweep": "dynamics", "converge": "modes",
             "modes": "modes", "response": "modes", "orbits": "modes",
             "section": "stationary",  # closed forms, no FE (the smallest estimate)
+            "operate": "stationary",  # one stationary solver at a time, a point after another
             "envelope": "modes",  # its branches are orbits' (and their linearisations)
             # a design's points: the stage its quantities need (check_quantities); the
             # worst (modes) for the command as a whole

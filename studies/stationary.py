@@ -55,11 +55,17 @@ class Stationary:
 def solve(params: Parameters, comm=MPI.COMM_WORLD, top_torque: float = 0.0):
     """Newton alone (no shooting reference): ``(solver, result, planar)`` on the
     FE rod of :func:`compute` (the planar (x, z) rod where ``model.reduction``
-    allows it and the state is torque-free); ``top_torque`` (normalised, Eq. 39) the
+    allows it and the state is torque-free; the lifted top's solver with
+    ``[lifter] top = "lifted"``, the rotor at rest); ``top_torque`` (normalised, Eq. 39) the
     torque of both ends, balanced (:func:`static_torque`): the twisted state.  The
     parameter studies' stationary quantities take the torque-free one."""
     from rawehelix.solvers.stationary import StationarySolver, reduced
 
+    if params.lifter.active:  # the top held by the lifter's force (solvers/lifted.py)
+        from rawehelix.solvers import lifted
+        q = params.normalised()
+        solver, top = lifted.stationary(params, comm=comm, top_torque_Nm=q.torque_Nm(top_torque))
+        return solver, top.result, False
     planar = reduced(params) and top_torque == 0.0
     solver = StationarySolver(params, comm, scene=params.name, planar=planar)
     if top_torque:
@@ -105,10 +111,23 @@ def static_torque(params: Parameters) -> float:
 
 
 def sag_m(params: Parameters, result) -> float:
-    """The sag [m] of a stationary result: the centre line's largest distance from the chord."""
+    """The sag [m] of a stationary result: the centre line's largest distance from the
+    chord (to the top of Eq. 66, or to where the lifted top found itself)."""
     from rawehelix.solvers.stationary import sag
     q = params.normalised()
-    return q.L0 * sag(result.centre_line, q.top_position())
+    return q.L0 * sag(result.centre_line,
+                      result.centre_line[-1] if params.lifter.active else q.top_position())
+
+
+def lifter_block(params: Parameters, top) -> dict:
+    """summary.json's ``lifter``: where the lifted top found itself and the forces on it
+    (solvers/lifted.py's LiftedResult, SI)."""
+    return {"top": "lifted", "top_position_m": [float(x) for x in top.top_m],
+            "chord_elevation_deg": float(top.chord_elevation_deg),
+            "chord_length_m": float(np.linalg.norm(top.top_m)),
+            "end_tangent": [float(x) for x in top.end_tangent],
+            "force_N": params.lifter.force_N,
+            "top_force_N": [float(x) for x in top.load.total_N()]}
 
 
 def limits_block(params: Parameters, solver) -> dict | None:
@@ -143,7 +162,15 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
-    solver, result, planar = solve(params, comm, top_torque)
+    top = None  # the lifted top's result (solvers/lifted.py), or None: the top fixed
+    if params.lifter.active:
+        from rawehelix.solvers import lifted
+        # refuses a lifter too weak to hold the helix up before any work
+        solver, top = lifted.stationary(params, comm=comm,
+                                        top_torque_Nm=q.torque_Nm(top_torque))
+        result, planar = top.result, False
+    else:
+        solver, result, planar = solve(params, comm, top_torque)
     block = limits_block(params, solver)  # collective; before residual_at moves the state
     twist = twist_of(solver) if top_torque else None  # collective
     mean_tension = solver.mean_tension()  # collective
@@ -182,6 +209,8 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
             "shooting": check.status,
             "limits": block,
         }
+        if top is not None:
+            summary["lifter"] = lifter_block(params, top)
         if check.compared:
             x_ref = q.length_m(reference.centre_line(result.s))
             out.shooting_centre_line_m = x_ref
@@ -201,10 +230,7 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
 
 def twist_of(solver) -> float | None:
     """alpha(L0) - alpha(0) [rad] of the solver's state, on rank 0.  Collective."""
-    from rawehelix.solvers import fields
-    rod = solver.rod
-    s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
-    return None if alpha is None else float(alpha[-1, 0] - alpha[0, 0])
+    return solver.end_twist()
 
 
 def ends_block(params: Parameters, mean_tension_N: float) -> dict:
@@ -231,6 +257,12 @@ def report(result: Stationary) -> str:
         lines.append(f"  ends.tension_N = {ends['tension_N']:g} N ({ends['tension_at']}): "
                      f"elongation found {ends['elongation']:.6g}; mean tension{here} "
                      f"{ends['mean_tension_N']:.3f} N")
+    if "lifter" in s:
+        lift = s["lifter"]
+        x, y, z = lift["top_position_m"]
+        lines.append(f"  lifted top at ({x:.4f}, {y:.4f}, {z:.4f}) m (z down): chord "
+                     f"{lift['chord_length_m']:.4f} m at {lift['chord_elevation_deg']:.3f} deg "
+                     f"elevation, under the lifter's {lift['force_N']:g} N")
     if torque:
         lines.append(f"  torque {torque['top_Nm']:g} N m at the top, held by the ground "
                      f"(Eq. 40 at rest): twist alpha(L0) - alpha(0) = "

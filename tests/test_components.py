@@ -59,14 +59,16 @@ def test_group_of_an_active_section_reaches_normalised():
 
 def _implementations():
     """Every class of each component of forms/coefficients.py, null objects included."""
-    from rawehelix.forms import coefficients, damping, eilaw, hysteresis, section_law, wind
+    from rawehelix.forms import (coefficients, damping, eilaw, hysteresis, section_law,
+                                 spin_drag, wind)
     from rawehelix.forms.components import (BendingLaw, Damping, Hysteresis, Kinematics,
-                                            SectionLaw, WindProfile)
+                                            SectionLaw, SpinDragLaw, WindProfile)
     return [(Kinematics, cls) for cls in coefficients.KINEMATICS.values()] + [
         (Damping, damping.KelvinVoigt), (Damping, damping.NoneDamping),
         (BendingLaw, eilaw.TensionDependentBending), (BendingLaw, eilaw.ConstantBending),
         (Hysteresis, hysteresis.BoucWen), (Hysteresis, hysteresis.NoneHysteresis),
         (SectionLaw, section_law.SolidSection), (SectionLaw, section_law.NonlinearSection),
+        (SpinDragLaw, spin_drag.SpinDrag), (SpinDragLaw, spin_drag.NoSpinDrag),
         (WindProfile, wind.UniformWind), (WindProfile, wind.ProfileWind)]
 
 

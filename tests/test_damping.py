@@ -33,7 +33,6 @@ from rawehelix.forms import damping as damping_forms, extensible
 from rawehelix.forms import rod as rod_forms
 from rawehelix.forms.kinematics import frenet_torsion
 from rawehelix.parameters import ParameterError
-from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.modal import ModalSolver
 from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import scene
@@ -217,36 +216,14 @@ def test_spin_up_with_damping_closes_its_energy_balance():
     2.16e-4 (normalised, M g L0) of an external work 0.509, balance within
     5.0e-7 (0.23 % of the dissipated energy, 1e-6 of the work: the
     trapezoidal rule's O(dt^2))."""
+    from tests_util import spin_up_energy_balance
     p = scene.load("nominal_operation", elements=4, degree=3).replace(
         damping=ALL_ON, time={"dt_s": 2e-3})
-    solver = DynamicsSolver.from_stationary(p, options={"ts_alpha_radius": 1.0,
-                                                        "ts_adapt_type": "none"})
-    form, c = solver.form, solver.rod.c
-    f = form.fields
-    dx, _, ds = solver.rod.measures
-    x = ufl.SpatialCoordinate(solver.rod.mesh)
-    external = dolfinx.fem.form(  # drag (Eq. 28) and the end torques (38)-(40), x beta/delta
-        ufl.inner(rod_forms.body_force(f.r_t, c) - c.gravity * ufl.as_vector((0.0, 0.0, 1.0)), f.r_t) * dx
-        + c.beta * (c.mN * x[0] - form.m0 * (1 - x[0])) * f.alpha_t * ds)
-    q = solver.q
-    dt = 2e-3 / q.t_scale
-    rows = []
-
-    def out(sv):
-        e = sv.energy()
-        rows.append((e["kinetic"] + e["potential"], e["power_nv"], e["dissipation"],
-                     dolfinx.fem.assemble_scalar(external)))
-    solver.advance(3.0 / q.t_scale, on_output=out, output_every=dt)
-    E, p_nv, p_d, p_ext = np.array(rows).T
-
-    def work(p_):
-        return np.concatenate([[0.0], np.cumsum(dt * (p_[1:] + p_[:-1]) / 2)])
-    dissipated = work(p_d)
-    balance = E - E[0] - work(p_ext) - work(p_nv) + dissipated
-    print(f"\nspin-up: E - E0 = {E[-1] - E[0]:.4e}, external work {work(p_ext)[-1]:.4e}, "
-          f"dissipated {dissipated[-1]:.4e}, non-variational {work(p_nv)[-1]:.4e}, "
+    dE, W_ext, W_nv, dissipated, balance = spin_up_energy_balance(p, 3.0)
+    print(f"\nspin-up: E - E0 = {dE[-1]:.4e}, external work {W_ext[-1]:.4e}, "
+          f"dissipated {dissipated[-1]:.4e}, non-variational {W_nv[-1]:.4e}, "
           f"max |balance| {np.abs(balance).max():.3e}")
-    assert len(rows) > 1000
+    assert len(balance) > 1000
     assert dissipated[-1] > 0
     assert np.abs(balance).max() < 1e-2 * dissipated[-1]
 

@@ -56,6 +56,12 @@ FAULTS = [
     (["modes", "stationary_table2", "--set", "ends.tension_N=200"], 2, "the scene gives both"),
     (["stationary", "nominal_operation", "--elements", "2"], 2,
      "controller.target_rpm: 120 rpm with controller.k1 = 0.5 > 0"),
+    # issue 43: a lifter too weak to hold the helix up
+    (["stationary", "stationary_table2", "--elements", "2", "--set", 'lifter.top="lifted"',
+      "--set", "lifter.force_N=3"], 2, "lifter.force_N: the lifter cannot hold the helix up"),
+    (["modes", "stationary_table2", "--elements", "2", "--set", 'lifter.top="lifted"',
+      "--set", "lifter.force_N=200"], 2,
+     "lifter.top: 'lifted' holds the top end by the lifter's force, which `rawehelix stationary`"),
     (["converge", "stationary_table2", "--quantity", "nothing"], 2, "--quantity: nothing"),
     (["extremes", "nosuchcase"], 2, "unknown case(s)"),
     (["study", "stationary_table2", "--vary", "helix.EI_Nm2=1:2:3", "--quantity", "tension"], 2,
@@ -74,6 +80,10 @@ FAULTS = [
      'wind.turbulence_class: "D" must be one of'),
     (["simulate", "turbulent_rated", "--until", "700"], 2,
      "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
+    # issue 43: operate's wind speeds and a scene without a rotor
+    (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
+    (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
+     "rotor: 'operate' needs a [rotor] section"),
 ]
 
 

@@ -1,8 +1,8 @@
 """Bad input of the machine's sections (issue 43: [rotor], [generator], [lifter], [wind]):
 refused before any work with exit status 2, one line on stderr naming the key (and the
-table's row and line), nothing written.  Two run as subprocesses (the real command
-line); the rest through the same entry point in-process (cli.main), as
-tests/test_scenes.py does."""
+table's row and line), nothing written.  Each table fault and one bad key run as
+subprocesses (the real command line); the other keys through the same entry point
+in-process (cli.main), as tests/test_scenes.py does."""
 
 from __future__ import annotations
 
@@ -64,10 +64,22 @@ def refused(argv, tmp_path, capsys) -> str:
     return err
 
 
+def refused_by_the_command_line(argv, tmp_path) -> str:
+    """The real command line (a subprocess): exit 2, one line, no traceback, nothing
+    written (neither -o nor ./results)."""
+    run = subprocess.run([*RAWEHELIX, *argv, "-o", str(tmp_path / "out")], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2, run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and "Traceback" not in run.stderr
+    assert not (tmp_path / "out").exists() and not (tmp_path / "results").exists()
+    return run.stderr
+
+
 @pytest.mark.parametrize("csv, words", TABLE_FAULTS, ids=[w.split(":")[-1][:30] for _, w in TABLE_FAULTS])
-def test_each_table_fault_names_its_row(tmp_path, capsys, csv, words):
+def test_each_table_fault_names_its_row(tmp_path, csv, words):
+    """Each fault class of a rotor table, through the real command line."""
     path = rotor_scene(tmp_path, csv)
-    err = refused(["stationary", str(path)], tmp_path, capsys)
+    err = refused_by_the_command_line(["stationary", str(path)], tmp_path)
     assert str(path) in err and words in err, err
 
 
@@ -105,18 +117,10 @@ def test_each_bad_key_is_named(tmp_path, capsys, changes, words):
     assert words in err, err
 
 
-@pytest.mark.parametrize("command, csv, words", [
-    ("stationary", TABLE_FAULTS[0][0], TABLE_FAULTS[0][1]),
-    ("modes", None, "wind.speed_m_s: 6.6131 and environment.wind_speed_m_s = 10.0 both give the wind"),
-])
-def test_the_command_line_refuses_in_one_line(tmp_path, command, csv, words):
-    """The real command line (a subprocess): exit 2, one line, no traceback, no folder."""
-    path = rotor_scene(tmp_path, csv)
-    argv = [str(path), "-o", str(tmp_path / "out")]
-    if csv is None:
-        argv += ["--set", "environment.wind_speed_m_s=10"]
-    run = subprocess.run([*RAWEHELIX, command, *argv], cwd=tmp_path, capture_output=True,
-                         text=True, timeout=120)
-    assert run.returncode == 2, run.stderr
-    assert len(run.stderr.strip().splitlines()) == 1 and words in run.stderr, run.stderr
-    assert not (tmp_path / "out").exists() and not (tmp_path / "results").exists()
+def test_the_command_line_refuses_a_bad_key_in_one_line(tmp_path):
+    """A key of the machine's sections, through the real command line (modes)."""
+    path = rotor_scene(tmp_path)
+    err = refused_by_the_command_line(["modes", str(path), "--set",
+                                       "environment.wind_speed_m_s=10"], tmp_path)
+    assert ("wind.speed_m_s: 6.6131 and environment.wind_speed_m_s = 10.0 both give the wind"
+            in err), err

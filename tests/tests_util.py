@@ -97,3 +97,40 @@ def world_folder(tmp_path_factory, name: str,
     if comm.size == 1:
         pytest.skip(why)
     return comm, Path(comm.bcast(str(tmp_path_factory.mktemp(name)) if comm.rank == 0 else None))
+
+
+def spin_up_energy_balance(params, until_s: float, dt_s: float = 2e-3):
+    """Spin ``params`` up from its stationary state at a fixed step ``dt_s`` (alpha2 with
+    spectral radius 1, the trapezoidal rule) for ``until_s``: (E - E0, external work,
+    non-variational work, dissipated energy, balance) in time (normalised, M g L0), the
+    works by the trapezoidal rule; balance = E - E0 - W_ext - W_nv + W_diss.  External:
+    the drag (Eq. 28) and the end torques (38)-(40), x beta/delta."""
+    import dolfinx.fem
+    import numpy as np
+    import ufl
+    from rawehelix.forms import rod as rod_forms
+    from rawehelix.solvers.dynamics import DynamicsSolver
+    solver = DynamicsSolver.from_stationary(params, options={"ts_alpha_radius": 1.0,
+                                                             "ts_adapt_type": "none"})
+    form, c = solver.form, solver.rod.c
+    f = form.fields
+    dx, _, ds = solver.rod.measures
+    x = ufl.SpatialCoordinate(solver.rod.mesh)
+    external = dolfinx.fem.form(
+        ufl.inner(rod_forms.body_force(f.r_t, c) - c.gravity * ufl.as_vector((0.0, 0.0, 1.0)),
+                  f.r_t) * dx
+        + c.beta * (c.mN * x[0] - form.m0 * (1 - x[0])) * f.alpha_t * ds)
+    dt = dt_s / solver.q.t_scale
+    rows = []
+
+    def out(sv):
+        e = sv.energy()
+        rows.append((e["kinetic"] + e["potential"], e["power_nv"], e["dissipation"],
+                     dolfinx.fem.assemble_scalar(external)))
+    solver.advance(until_s / solver.q.t_scale, on_output=out, output_every=dt)
+    E, p_nv, p_d, p_ext = np.array(rows).T
+
+    def work(p_):
+        return np.concatenate([[0.0], np.cumsum(dt * (p_[1:] + p_[:-1]) / 2)])
+    W_ext, W_nv, W_d = work(p_ext), work(p_nv), work(p_d)
+    return E - E[0], W_ext, W_nv, W_d, E - E[0] - W_ext - W_nv + W_d

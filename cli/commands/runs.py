@@ -158,6 +158,22 @@ def _orbits(rh, params, args, outdir, comm) -> int:
     return 0
 
 
+def _operate_arguments(p):
+    p.add_argument("--wind", required=True, metavar="LO:HI:STEP",
+                   help="wind speeds in m/s at the reference height (the scene's [wind] "
+                        "profile, or environment.wind_speed_m_s's uniform wind)")
+
+
+def _operate(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies.store import outdir as outdir_check
+    from rawehelix.studies import operate
+    winds = operate.parse_wind(args.wind)
+    operate.plan(params, winds, key="--wind", text=args.wind)  # numpy: refuses before any work
+    outdir_check.check(outdir, "operate", points=len(winds))
+    result = rh.operate(params, winds, comm=comm)
+    return _written(comm, result, operate.report(result), outdir)
+
+
 def _none(p):
     """No options of its own."""
 
@@ -175,6 +191,8 @@ COMMANDS = [
             _f1_grid_arguments, _response, f1_grid=True),
     Command("orbits", "periodic orbits over f1 with Floquet stability, through folds",
             _orbits_arguments, _orbits, kept="window*/p*.json"),
+    Command("operate", "operating points of the rotor and generator over the wind speed: "
+            "the power curve up to the helix's first limit", _operate_arguments, _operate),
     Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
             _none, _section),
 ]
