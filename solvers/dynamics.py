@@ -40,7 +40,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
-from rawehelix.solvers import weather
+from rawehelix.solvers import release, weather
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
@@ -146,9 +146,14 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             self.weather = weather.of(self.machine, self.q, self.rod.mesh, self.rod.c.wind)
             if self.weather is not None:
                 self.rod.c, ends = self.weather.install(self.rod.c, ends)
+            # a start-up's generator release (issue 44): latched after each step
+            self.release = release.of(self.machine, self.q, self.rod.mesh)
+            if self.release is not None:
+                ends = self.release.install(ends)
             self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
-            if self.weather is not None:
-                self.form.time_data.append(self.weather)
+            for set_data in (self.weather, self.release):
+                if set_data is not None:
+                    self.form.time_data.append(set_data)
             if end_twist is not None:
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
@@ -381,6 +386,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             self._callback_error = NonFiniteState()
             raise self._callback_error
         self._remember(t)
+        if self.release is not None and not first:
+            self.release.latch(self)
         if self._on_step is not None and not first:
             self._on_step(self)
         eps = 1e-9 * max(1.0, t)

@@ -299,6 +299,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                   "limits": comm.bcast(tracker.block() if comm.rank == 0 else None, root=0)})
         if account is not None:  # work in = generator + dissipated + stored (issue 43)
             s["energy"] = account.summary(q)
+        if solver.release is not None:  # a start-up from rest (issue 44)
+            s["startup"] = machine.startup(ends, solver.release, rows)
         if len(rows):
             s["final"] = {"spin_rpm": {"s0": rows[-1, 1], "mid": rows[-1, 2], "L0": rows[-1, 3]},
                           "ground_torque_Nm": rows[-1, 4], "tension_s0_N": rows[-1, 5],
@@ -367,5 +369,6 @@ def report(result: TimeSeries) -> str:
     if f and "power_W" in f:
         lines.append(f"  rotor {f['rotor_rpm']:.3f} rpm, generator power {f['power_W']:.2f} W, "
                      f"thrust {f['thrust_N']:.2f} N at a hub wind of {f['wind_hub_m_s']:.3g} m/s")
-    lines[-1] += structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy"))
+    lines[-1] += (machine.startup_line(s.get("startup"), s["simulated_s"])
+                  + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy")))
     return "\n".join(lines)

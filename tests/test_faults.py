@@ -80,6 +80,11 @@ FAULTS = [
      'wind.turbulence_class: "D" must be one of'),
     (["simulate", "turbulent_rated", "--until", "700"], 2,
      "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
+    # issue 44: a start-up from rest needs a table from tsr 0; its release speed >= 0
+    (["simulate", "rotor_example", "--elements", "2", "--set", "generator.release_rpm=60"], 2,
+     "rotor.table: starts at tsr 1 with cp 0.034861: a start-up from rest"),
+    (["simulate", "startup", "--elements", "2", "--set", "generator.release_rpm=-1"], 2,
+     "generator.release_rpm: -1.0 must be a finite number of rpm >= 0"),
     # issue 43: operate's wind speeds and a scene without a rotor
     (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
     (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
