@@ -40,7 +40,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
-from rawehelix.solvers import release, weather
+from rawehelix.solvers import weather
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
@@ -142,18 +142,10 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                                  "(the first-order form sets its own end conditions)")
             self.machine = machine if machine is not None else machine_of(params)
             ends = EndTorques.of(self.q, self.machine)  # the rotor's and generator's (issue 43)
-            # the wind in time (issue 44): the drag's and the rotor's, set at each time
-            self.weather = weather.of(self.machine, self.q, self.rod.mesh, self.rod.c.wind)
-            if self.weather is not None:
-                self.rod.c, ends = self.weather.install(self.rod.c, ends)
-            # a start-up's generator release (issue 44): latched after each step
-            self.release = release.of(self.machine, self.q, self.rod.mesh)
-            if self.release is not None:
-                ends = self.release.install(ends)
+            # the wind in time and a start-up's release (issue 44), each set at each time
+            self.weather, self.release, ends = weather.install(self.machine, self.q, self.rod, ends)
             self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
-            for set_data in (self.weather, self.release):
-                if set_data is not None:
-                    self.form.time_data.append(set_data)
+            self.form.time_data += [x for x in (self.weather, self.release) if x is not None]
             if end_twist is not None:
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))

@@ -24,6 +24,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from rawehelix.forms.wind import MovingWind
+from rawehelix.solvers import release
 from rawehelix.solvers.end_torques import EndTorques, Machine, rotor_torque
 
 
@@ -72,4 +73,17 @@ def of(machine: Machine, q, mesh, steady) -> Weather | None:
     return None if machine.history is None else Weather(machine, q, mesh, steady)
 
 
-__all__ = ["Weather", "of"]
+def install(machine: Machine, q, rod, ends: EndTorques):
+    """(weather, release, end torques) of a dynamic run on ``rod``: the wind in time
+    (the rod's coefficients then take its MovingWind) and a start-up's generator
+    release (solvers/release.py), each None when off; both set at each time."""
+    moving = of(machine, q, rod.mesh, rod.c.wind)
+    if moving is not None:
+        rod.c, ends = moving.install(rod.c, ends)
+    latch = release.of(machine, q, rod.mesh)
+    if latch is not None:
+        ends = latch.install(ends)
+    return moving, latch, ends
+
+
+__all__ = ["Weather", "install", "of"]

@@ -286,6 +286,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
 
     def result(complete: bool, error: str | None = None) -> TimeSeries:
         rows = np.array(rec.rows) if rec.rows else np.zeros((0, len(columns)))
+        slack = comm.bcast(tracker.slack_time_fraction() if comm.rank == 0 else None, root=0)
         series = TimeSeries(params, rows, list(rec.frames), _state_file(solver), dict(summary),
                             comm.rank, start, np.array(tracker.history).reshape(-1, 3), columns)
         s = series.summary
@@ -308,6 +309,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
             s["tension_range_N"] = [float(rows[:, 5:7].min()), float(rows[:, 5:7].max())]
             if ends.active:  # the machine's columns (studies/machine.py)
                 s["final"].update(zip(machine.COLUMNS, map(float, rows[-1, len(COLUMNS):])))
+            s["statistics"] = statistics(rows, columns, slack)
             s["real_time_factor"] = s["simulated_s"] / max(s["solve_s"], 1e-12)
         return series
 
@@ -351,6 +353,18 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                  s.get("real_time_factor", 0.0))
     series.summary = comm.bcast(s, root=0)
     return series
+
+
+def statistics(rows, columns, slack: float | None) -> dict:
+    """The run's statistics over its outputs (a seed study's quantities, issue 44): the
+    mean generator power (with a machine), the largest tension at each end, and
+    ``slack``, the fraction of the limits block's times at which any member was slack
+    (structure_limits.Tracker.slack_time_fraction)."""
+    col = {name: i for i, name in enumerate(columns)}
+    power = rows[:, col["power_W"]] if "power_W" in col else None
+    return {"power_mean_W": None if power is None else float(np.mean(power)),
+            "tension_s0_max_N": float(rows[:, 5].max()), "tension_L0_max_N": float(rows[:, 6].max()),
+            "slack_time_fraction": slack}
 
 
 def report(result: TimeSeries) -> str:
