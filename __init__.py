@@ -23,9 +23,10 @@ Subpackages:
 
 __version__ = "0.2.0"
 
-from rawehelix.api import (Parameters, SceneError, SolverError, envelope, labtest,  # noqa: E402
-                           load_scene, modes, operate, orbits, response, section, simulate,
-                           stationary, sweep, torsion_loop)
+from rawehelix.api import (Parameters, SceneError, SolverError, campbell, envelope,  # noqa: E402
+                           labtest, load_scene, modes, operate, orbits, response, section,
+                           simulate, stationary, sweep, torsion_loop)
 
 __all__ = ["load_scene", "section", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "envelope", "operate", "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters", "__version__"]
+           "envelope", "operate", "campbell", "labtest", "torsion_loop", "SceneError", "SolverError",
+           "Parameters", "__version__"]

@@ -26,7 +26,7 @@ from rawehelix.errors import SceneError, SolverError
 from rawehelix.parameters import Parameters
 
 __all__ = ["load_scene", "section", "stationary", "modes", "response", "simulate", "sweep", "orbits",
-           "envelope", "operate",
+           "envelope", "operate", "campbell",
            "labtest", "torsion_loop", "SceneError", "SolverError", "Parameters"]
 
 
@@ -148,6 +148,27 @@ def modes(scene: Parameters, count: int | None = None, comm=None):
     scene = _ready(scene, "modes", comm)
     from rawehelix.studies import modes as study
     return study.compute(scene, count=count, comm=comm)
+
+
+def campbell(scene: Parameters, wind_m_s, envelope: dict | None = None, comm=None):
+    """The Campbell diagram of the helix: at the operating points of the
+    scene's ``[rotor]`` and ``[generator]`` at each wind speed, the lowest modes of each
+    family about the relative equilibrium (the rotor's spin inertia and aerodynamic
+    damping, the generator's dtau/dOmega in the torsional family), each point's
+    stability, and every crossing of the 1P, 2P and BP (blades) lines with a mode:
+    :mod:`rawehelix.studies.campbell` (``rawehelix campbell``).  ``result.summary``
+    (``points[]``, ``crossings[]``), ``result.write(outdir)``.
+
+    Args:
+        scene: the validated scene (:func:`load_scene`), with a ``[rotor]``.
+        wind_m_s: the wind speeds [m/s] at the wind's reference height.
+        envelope: an ``envelope`` run's summary (its summary.json as a dict): the band
+            of forcing frequencies where the forced helix slackens, on the figure.
+        comm: the MPI communicator (default ``MPI.COMM_WORLD``)."""
+    comm = _world(comm)
+    scene = _ready(scene, "campbell", comm)
+    from rawehelix.studies import campbell as study
+    return study.compute(scene, wind_m_s, comm=comm, envelope=envelope)
 
 
 def response(scene: Parameters, f1_Hz=None, comm=None):

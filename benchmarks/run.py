@@ -34,6 +34,8 @@ sections and keeps the others' last results.
     against the chord steps with the sparse tangent, CPU time in one process.
 15. ``operate``: the power curve of 25 wind speeds at N = 8 and an operating point's
     stationary solves (benchmarks/operate.py).
+16. ``campbell``: the Campbell diagram of those 25 points against the power curve
+    (benchmarks/campbell.py).
 14. ``hb``: harmonic balance (benchmarks/harmonic_balance.py): the whole curve at N = 8
     against the sweep, at N = 32, a fold curve over EI x 4, and a point's parts.
 11. ``curve``: the issue-13 target, the whole Fig. 8 curve by continuation
@@ -58,6 +60,7 @@ import numpy as np
 
 from rawehelix import fits
 
+import campbell as campbell_bench  # benchmarks/campbell.py
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
 import operate as operate_bench  # benchmarks/operate.py
 import study as study_bench  # benchmarks/study.py
@@ -659,11 +662,13 @@ def markdown(r: dict) -> str:
         lines += hb_bench.markdown(r["hb"])
     if r.get("operate"):
         lines += operate_bench.markdown(r["operate"])
+    if r.get("campbell"):
+        lines += campbell_bench.markdown(r["campbell"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb", "operate")
+            "orbits", "curve", "hb", "operate", "campbell")
 
 
 def main():
@@ -699,7 +704,8 @@ def main():
                      ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
                      ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
                      ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of)),
-                     ("operate", lambda: operate_bench.bench_operate(8, repeats))):
+                     ("operate", lambda: operate_bench.bench_operate(8, repeats)),
+                     ("campbell", lambda: campbell_bench.bench_campbell(8, repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -1,7 +1,7 @@
 """The rawehelix command line: a thin layer over the Python API (:mod:`rawehelix.api`).
 
-    rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [PETSc options]
-    rawehelix modes SCENE [--scheme fe|spline] [--elements N] [--degree p] [--count k] [-o DIR]
+    rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [--scheme fe|network] [PETSc options]
+    rawehelix modes SCENE [--scheme fe|spline|network] [--elements N] [--degree p] [--count k] [-o DIR]
     rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
     rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
     rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
@@ -159,6 +159,10 @@ def main(argv: list[str] | None = None) -> int:
             params = rh.load_scene(args.scene, elements=args.elements, degree=args.degree,
                                    scheme=args.scheme,
                                    overrides=overrides(args, command.f1_grid))
+            from rawehelix.parameters import schemes as scheme_cores
+            refusal = scheme_cores.of(params).command_refusal(args.command)
+            if refusal:  # before any work or folder
+                raise SceneError("--scheme", params.discretisation.scheme, refusal)
             from rawehelix.solvers import tension_target
             params = tension_target.resolve(params, comm)  # ends.tension_N -> its elongation
             outdir = args.output or Path("results") / params.name / args.command

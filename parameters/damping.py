@@ -57,7 +57,7 @@ def check(params) -> None:
     """What the damping cannot run with (``params`` a whole scene): the spline scheme and
     the mixed bending form (forms/damping.py is written on the FE scheme's IP form)."""
     disc = params.discretisation
-    if params.model.damping.active and (disc.scheme != "fe" or disc.bending != "ip"):
+    if params.model.damping.active and (disc.continuum_scheme != "fe" or disc.bending != "ip"):
         raise ParameterError("damping", params.model.damping,
                              "structural damping is implemented by the FE scheme with "
                              "discretisation.bending = 'ip' only (forms/damping.py)")

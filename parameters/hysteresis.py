@@ -81,7 +81,7 @@ def check(params) -> None:
     """What the hysteresis cannot run with (``params`` a whole scene): the spline
     scheme, the mixed bending form (its third field is z's place) and model.twist = false."""
     disc, section = params.discretisation, params.model.torsion_hysteresis
-    if section.active and (disc.scheme != "fe" or disc.bending != "ip" or not params.model.twist):
+    if section.active and (disc.continuum_scheme != "fe" or disc.bending != "ip" or not params.model.twist):
         raise ParameterError("torsion_hysteresis", section,
                              "hysteretic torsion is implemented by the FE scheme with "
                              "discretisation.bending = 'ip' and model.twist = true only "

@@ -14,7 +14,11 @@ from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
 #: even be compiled ("inf" in the C code)
 PENALTY_MAX = 1.0e4
 
-SCHEMES = ("fe", "spline")
+SCHEMES = ("fe", "spline", "network")
+#: the schemes that are a model of their own, compared beside the continuum (the FE
+#: scheme): the scene's model options (kinematics, section law, damping, ...) are the
+#: continuum's and are checked as the FE scheme's (Discretisation.continuum_scheme)
+BESIDE_CONTINUUM = ("network",)
 
 
 def check_scheme(name: str) -> None:
@@ -33,7 +37,9 @@ QUADRATURE_MAX = 40
 
 @dataclass(frozen=True)
 class Discretisation:
-    scheme: str = "fe"  # "fe" (FEniCSx, C0 interior penalty) or "spline" (paper, Sec. 3)
+    # "fe" (FEniCSx, C0 interior penalty), "spline" (paper, Sec. 3) or "network" (the
+    # rings and tethers of [section], references/network: stationary and modes, beside the FE)
+    scheme: str = "fe"
     elements: int = 16  # N
     degree: int = 3  # Lagrange degree p of the FE scheme (>= 2)
     mesh: str = "uniform"  # "uniform" or "graded" (gmsh, refined toward the ends)
@@ -43,6 +49,12 @@ class Discretisation:
     # kappa = r'' as its own field (Ciarlet-Raviart, second order, docs/explanation/large_n.md)
     bending: str = "ip"
     quadrature_degree: int = 0  # cell quadrature: 0 the rule 3p, -1 UFL's estimate, > 0 that degree
+
+    @property
+    def continuum_scheme(self) -> str:
+        """The scheme of the continuum a run computes: its own, or "fe" for a scheme
+        compared beside it (:data:`BESIDE_CONTINUUM`)."""
+        return "fe" if self.scheme in BESIDE_CONTINUUM else self.scheme
 
     def __post_init__(self):
         check_scheme(self.scheme)

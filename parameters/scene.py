@@ -51,7 +51,7 @@ class Parameters:
                 raise ParameterError("model.twist", False,
                                      f"needs a torque-free scene ({end_components.torque_free()}): "
                                      "torque is carried by the twist, Eq. (31)")
-            if self.discretisation.scheme != "fe":
+            if self.discretisation.continuum_scheme != "fe":
                 raise ParameterError("model.twist", False, "is implemented by the FE scheme only")
         # each component's refusals of what it cannot run with
         sections.check_kinematics(self)

@@ -11,7 +11,7 @@ name once, with the list.
 
 from __future__ import annotations
 
-from rawehelix.parameters.numerics import SCHEMES, check_scheme
+from rawehelix.parameters.numerics import BESIDE_CONTINUUM, SCHEMES, check_scheme
 
 
 class SchemeCore:
@@ -31,6 +31,17 @@ class SchemeCore:
 
     #: why harmonic balance cannot trace its orbits (None: it can; studies/orbit_method.py)
     harmonic_balance_refusal: str | None = None
+    #: a model of its own, run beside the FE continuum (numerics.BESIDE_CONTINUUM)
+    beside_continuum: bool = False
+    #: the ``rawehelix`` commands that run it (None: every command that takes a scene)
+    commands: tuple[str, ...] | None = None
+
+    def command_refusal(self, command: str) -> str | None:
+        """Why the command ``command`` does not run this scheme (None: it does)."""
+        if self.commands is None or command in self.commands:
+            return None
+        return (f"'{self.name}' runs {', '.join(repr(c) for c in self.commands)} only, not "
+                f"'{command}': use --scheme fe or spline")
 
     def unknowns(self, params, planar: bool = False) -> int:
         """The unknowns of the rod's discrete state."""
@@ -90,9 +101,36 @@ class SplineCore(SchemeCore):
                 f"the spline scheme's dense matrices, {self.BYTES_PER_N2 / 1e3:g} kB N^2")
 
 
+class NetworkCore(SchemeCore):
+    """The ring-and-tether network (references/network): a model of its own, run beside
+    the FE continuum; a stationary solve and modes, no time integration yet."""
+
+    name, has_degree, fixed_time_step, fe_assembled = "network", False, False, False
+    beside_continuum = True
+    commands = ("stationary", "modes", "section")
+    integrator = "none (the network has a stationary solve and modes only)"
+    harmonic_balance_refusal = ("the network reference has no time integration yet: use "
+                                "--scheme fe or spline")
+    #: the dense eigenproblem's K, M, their eigenvectors and eigh's work: bytes per dof^2
+    BYTES_PER_DOF2 = 40.0
+
+    def unknowns(self, params, planar=False):
+        """6 (rings - 2): each interior ring's centre and rotation (the end rings held)."""
+        return 6 * max(params.model.section.ring_count(params.helix.length_m) - 2, 1)
+
+    def period_state_size(self, params):
+        return 2 * self.unknowns(params)
+
+    def memory_bytes(self, params, step):
+        n = self.unknowns(params)
+        return (self.BYTES_PER_DOF2 * float(n) ** 2,
+                f"the network's dense matrices, {n} dofs at {self.BYTES_PER_DOF2:g} B dof^2")
+
+
 #: every scheme's core by name
-CORES: dict[str, SchemeCore] = {s.name: s for s in (FECore(), SplineCore())}
+CORES: dict[str, SchemeCore] = {s.name: s for s in (FECore(), SplineCore(), NetworkCore())}
 assert tuple(CORES) == SCHEMES, "the cores name the schemes of SCHEMES"
+assert tuple(c.name for c in CORES.values() if c.beside_continuum) == BESIDE_CONTINUUM
 
 
 def get(name: str) -> SchemeCore:
@@ -106,4 +144,4 @@ def of(params) -> SchemeCore:
     return get(params.discretisation.scheme)
 
 
-__all__ = ["CORES", "FECore", "SchemeCore", "SplineCore", "get", "of"]
+__all__ = ["CORES", "FECore", "NetworkCore", "SchemeCore", "SplineCore", "get", "of"]

@@ -17,8 +17,9 @@ import math
 from dataclasses import dataclass
 
 from rawehelix import section_laws
-from rawehelix.members import Members
+from rawehelix.members import Members, critical_twist
 from rawehelix.parameters.checks import ParameterError, _non_negative, _positive
+from rawehelix.parameters.numerics import BESIDE_CONTINUUM
 
 #: the section laws' names, the registry's (section_laws.py): "saturating" is the fallback
 #: law of issue 29 (members.py::ConeSection), the solid's EA and EI inside the cone
@@ -53,6 +54,16 @@ class Section:
     slack_width: float = 1.0e-5  # w, the strain over which a tether goes slack (regularisation) [-]
     torsion: str = "helix"  # the twist's moment: "helix" (GJ_Nm2) or "members" (their torque)
     ring: str = "worst"  # the ring's phase: "worst" (a member on the bending plane) or "turning" (with alpha)
+    # the mass of one ring of the network reference (--scheme network) [kg]; None: the
+    # helix's mass lumped at the rings, helix.mass_kg / (rings - 1) each (the end rings,
+    # fixed, half that); the network's tethers are massless
+    ring_mass_kg: float | None = None
+    # a ring's moment of inertia about its own axis (network reference) [kg m^2]; None:
+    # a hoop's, ring mass x R^2 (its mass at the tethers' radius)
+    ring_polar_inertia_kgm2: float | None = None
+    # a ring's moment of inertia about a diameter (network reference) [kg m^2]; None: a
+    # hoop's, ring mass x R^2 / 2
+    ring_diametral_inertia_kgm2: float | None = None
 
     def __post_init__(self):
         if section_laws.refusal(self.law):
@@ -77,7 +88,8 @@ class Section:
                                  "must lie in [0, 60) degrees")
         _non_negative("section", self, "self_stress_N", "bar_EA_N")
         _positive("section", self, "slack_width")
-        for name in ("radius_m", "tether_EA_N", "breaking_force_N", "ring_spacing_m"):
+        for name in ("radius_m", "tether_EA_N", "breaking_force_N", "ring_spacing_m",
+                     "ring_mass_kg", "ring_polar_inertia_kgm2", "ring_diametral_inertia_kgm2"):
             if getattr(self, name) is not None:
                 _positive("section", self, name)
         if self.rings is not None:
@@ -125,6 +137,18 @@ class Section:
         if self.rings is not None:
             return helix.length_m / (self.rings - 1)
         return self.ring_spacing_m
+
+    def ring_count(self, length_m: float) -> int:
+        """The rings along a helix of length L0 [m], both ends included: ``rings``, or
+        L0 / ring_spacing_m + 1 rounded (at least 2); ParameterError when neither is
+        given (the network reference, --scheme network, needs them)."""
+        if self.rings is not None:
+            return self.rings
+        if self.ring_spacing_m is not None:
+            return max(2, round(length_m / self.ring_spacing_m) + 1)
+        raise ParameterError("section.rings", None,
+                             "--scheme network needs the rings: set section.rings (>= 3, both "
+                             "end rings included) or section.ring_spacing_m")
 
     def describe(self) -> str:
         return (f"section: {self.law}, torsion by the {self.torsion}, {self.tethers} tethers, "
@@ -204,13 +228,51 @@ def normalise(p, scales: dict) -> dict:
             "section_ring_turns": section.ring == "turning"}
 
 
+#: the most rings of the network reference: its modes are a dense eigenproblem of
+#: 6 (rings - 2) dofs (1000 rings: 6e3 dofs, ~1.4 GB and a minute for scipy's eigh)
+NETWORK_MAX_RINGS = 1000
+
+
+def check_network_rings(section: Section, helix, rings: int) -> None:
+    """Refuse a network (--scheme network) of fewer than 3 rings (none free) or more
+    than NETWORK_MAX_RINGS, bars too soft to hold the self-stress, or rings so far
+    apart that the lay alone turns a bay past Tulloch's collapse angle
+    (members.py::critical_twist of the bay's chord): such a network has no state near
+    its straight chord.  delta_0 = l tan(beta) / R, l = L0 / (rings - 1)."""
+    if not 3 <= rings <= NETWORK_MAX_RINGS:
+        raise ParameterError("section.rings", rings,
+                             f"--scheme network needs 3 to {NETWORK_MAX_RINGS} rings (one free "
+                             "between the held end rings; its modes are a dense eigenproblem "
+                             "of 6 (rings - 2) dofs): set section.rings or "
+                             "section.ring_spacing_m")
+    m = section.members(helix)
+    if m.P0 > 0 and m.n * m.P0 >= m.EA_b:
+        raise ParameterError("section.bar_EA_N", m.EA_b,
+                             f"must exceed n P0 = {m.n * m.P0:g} N for the network's bars: "
+                             "they would shorten by more than their length to hold the "
+                             "self-stress (section.self_stress_N)")
+    l = helix.length_m / (rings - 1)
+    lay = l * math.tan(m.beta) / m.R
+    if lay <= 0:
+        return
+    crit = critical_twist(m.R, math.hypot(l, 2 * m.R * math.sin(lay / 2))) \
+        if math.isfinite(lay) else 0.0
+    if lay >= crit:
+        raise ParameterError("section.rings", rings,
+                             f"turns each bay of the network by its lay, l tan(beta) / R = "
+                             f"{lay:.3g} rad, past Tulloch's collapse angle {crit:.3g} rad of "
+                             "its tethers: give more rings (section.rings)")
+
+
 def check(params) -> None:
     """What the tensegrity law cannot run with (``params`` a whole scene): its resultants
     are the variation of the members' energy, so it needs the extensible kinematics
     (model.kinematics = "extensible") of the FE scheme with the IP bending form."""
     section, disc = params.model.section, params.discretisation
+    if disc.scheme in BESIDE_CONTINUUM:  # the network's rings, before any work
+        check_network_rings(section, params.helix, section.ring_count(params.helix.length_m))
     if section.active and (params.model.kinematics not in ("extensible", "shearable")
-                           or disc.scheme != "fe" or disc.bending != "ip"):
+                           or disc.continuum_scheme != "fe" or disc.bending != "ip"):
         raise ParameterError("section.law", section.law,
                              f"'{section.law}' needs model.kinematics = 'extensible' (or "
                              "'shearable') on the FE scheme with discretisation.bending = 'ip' "

@@ -202,7 +202,7 @@ def check_kinematics_name(name: str) -> None:
 def check_kinematics(params) -> None:
     """What the extensible kinematics cannot run with (``params`` a whole scene)."""
     disc = params.discretisation
-    if params.model.kinematics == "extensible" and (disc.scheme != "fe" or disc.bending != "ip"):
+    if params.model.kinematics == "extensible" and (disc.continuum_scheme != "fe" or disc.bending != "ip"):
         raise ParameterError("model.kinematics", "extensible",
                              "is implemented by the FE scheme with discretisation.bending "
                              "= 'ip' only (forms/extensible.py)")

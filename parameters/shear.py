@@ -61,7 +61,7 @@ def check(params) -> None:
                                  "is read by the shearable rod only: set model.kinematics = "
                                  "'shearable', or remove it")
         return
-    if disc.scheme != "fe" or disc.bending != "ip":
+    if disc.continuum_scheme != "fe" or disc.bending != "ip":
         raise ParameterError("model.kinematics", "shearable",
                              "is implemented by the FE scheme (discretisation.scheme = 'fe', "
                              "bending = 'ip', its default) only")

@@ -12,6 +12,8 @@ twist on DG_(p-1) (:mod:`rawehelix.forms.hysteresis`), which needs no end condit
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import ufl
 from mpi4py import MPI
@@ -27,6 +29,14 @@ from rawehelix.forms import rod
 from rawehelix.models import rod_model
 from rawehelix.parameters import Parameters, schemes
 from rawehelix.meshes import interval
+
+
+def _same(a, b) -> bool:
+    """Equal values, NaN equal to NaN (a group not yet known, such as eps0)."""
+    try:
+        return bool(a == b) or (a != a and b != b)
+    except (TypeError, ValueError):
+        return a is b
 
 
 def unit_tangent_of(centre_line, s, h: float = 1e-6):
@@ -135,6 +145,18 @@ class RodDiscretisation:
     def set_top_position(self, position):
         position = np.asarray(position, dtype=float)
         set_constant(self.r_top, position)
+
+    def set_wind(self, params: Parameters):
+        """The rod of ``params``, the same scene at another wind speed: only the helix's
+        drag (Eq. 14) changes, through v_w0 (Eq. 27), a constant of the forms.  Raises
+        ValueError if ``params`` changes another normalised group (it needs its own rod)."""
+        q = params.normalised()
+        changed = sorted(f.name for f in dataclasses.fields(q) if f.name != "v_w0"
+                         and not _same(getattr(q, f.name), getattr(self.q, f.name)))
+        if changed:
+            raise ValueError(f"set_wind: the scene also changes {changed}: build its own rod")
+        self.c.v_w0.value = q.v_w0
+        self.params, self.q = params, q
 
     # -- states ------------------------------------------------------------------
     def get_state(self, w=None, w_t=None, t: float = 0.0) -> RodState:

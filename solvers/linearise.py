@@ -59,7 +59,7 @@ class Linearisation:
     """The forms of (*) and of the kinetic energies on one rod; :meth:`assemble`
     evaluates them about a state."""
 
-    def __init__(self, rod):
+    def __init__(self, rod, ends=None):
         rod.model.refuse("modal", rod.params.name)  # hysteresis: z = A tau about z = 0
         self.rod = rod
         # separate fields for w, w_t, w_tt: the three Jacobians of F at (w0, 0, 0)
@@ -74,9 +74,14 @@ class Linearisation:
         F_K = rod.model.residual(rod.w, self.w_t, self.w_tt, rod.test,
                                  rod.model.conservative(rod.c), rod.degree, rod.penalty,
                                  rod.measures)
-        self.a_K = dolfinx.fem.form(ufl.derivative(F_K, rod.w, du))
-        self.a_C = dolfinx.fem.form(ufl.derivative(F, self.w_t, du))
-        self.a_M = dolfinx.fem.form(ufl.derivative(F, self.w_tt, du))
+        a = {"K": ufl.derivative(F_K, rod.w, du), "C": ufl.derivative(F, self.w_t, du),
+             "M": ufl.derivative(F, self.w_tt, du)}
+        # the end components' lumped terms (forms/end_loads.py: a rotor's spin inertia,
+        # the aerodynamic and generator damping, Eq. 40's gains); none by default
+        for key, form in (ends.forms(du, rod.test) if ends is not None else {}).items():
+            a[key] = a[key] + form
+        self.a_K, self.a_C, self.a_M = (dolfinx.fem.form(a[k]) for k in "KCM")
+        self.twist_dofs = rod.dofs("twist")
         self.bcs = self._fixed_ends()
         self.a_energy = {kind: {k: dolfinx.fem.form(a) for k, a in forms.items()}
                          for kind, forms in self._energy_forms().items()}
@@ -119,11 +124,13 @@ class Linearisation:
             family["rotation"] = rod.c.rotary * ufl.dot(n, m) * dx
         return {"family": family, "component": comps}
 
-    def assemble(self, state: RodState):
+    def assemble(self, state: RodState, spin: float = 0.0):
         """K, C, M and the energy matrices about ``state`` (its velocity is
-        ignored: the linearisation is about (w0, 0, 0)).  Returns (K, C, M)."""
+        ignored: the linearisation is about (w0, (0, spin), 0), ``spin`` the uniform
+        twist rate of a relative equilibrium, normalised).  Returns (K, C, M)."""
         self.rod.set_state(state)
         self.w_t.x.array[:] = 0.0
+        self.w_t.x.array[self.twist_dofs] = spin
         self.w_tt.x.array[:] = 0.0
         self.K = _assemble(self.a_K, self.bcs, 1.0)
         self.C = _assemble(self.a_C, self.bcs, 0.0)

@@ -83,14 +83,15 @@ class ModalSolver:
     scene : name used in error messages.
     rod : the discretisation to share (e.g. a StationarySolver's); a new one
         by default.
+    ends : the end components' lumped terms (forms/end_loads.py), or None.
     """
 
     def __init__(self, params: Parameters, comm=MPI.COMM_WORLD, scene: str = "scene",
-                 rod: RodDiscretisation | None = None):
+                 rod: RodDiscretisation | None = None, ends=None):
         self.params, self.comm, self.scene = params, comm, scene
         self.rod = rod if rod is not None else RodDiscretisation(params, comm)
         self.q = self.rod.q
-        self.lin = Linearisation(self.rod)
+        self.lin = Linearisation(self.rod, ends)
         self.classifier = None
         self.stationary_result = None
         self.mean_tension_value = None
@@ -112,10 +113,11 @@ class ModalSolver:
         return solver
 
     # -- linearisation ------------------------------------------------------------------
-    def linearise(self, state: RodState):
-        """Assemble K, C, M (and the energy matrices) about ``state``; the
+    def linearise(self, state: RodState, spin: float = 0.0):
+        """Assemble K, C, M (and the energy matrices) about ``state`` (with the
+        uniform twist rate ``spin``, normalised, of a relative equilibrium); the
         rod holds the state afterwards.  Returns (K, C, M)."""
-        K, C, M = self.lin.assemble(state)
+        K, C, M = self.lin.assemble(state, spin)
         if self.classifier is None:
             self.classifier = Classifier(self.lin)
         self.mean_tension_value = self.lin.mean_tension
@@ -234,7 +236,7 @@ class ModalSolver:
                 continue  # the conjugate of a mode kept
             fractions, comps = self.classifier.energy_fractions(xr, xi)
             if abs(lam) < zero_abs:
-                if fractions["torsional"] < 0.99:
+                if not self.is_rigid_rotation(fractions):
                     raise SolverError(f"{self.scene}: a zero eigenvalue {lam:.3e} that is not a "
                                       f"rigid rotation (fractions {fractions})")
                 if rigid is not None:
@@ -256,6 +258,11 @@ class ModalSolver:
         return modes
 
     # -- classification and checks ------------------------------------------------------
+    def is_rigid_rotation(self, fractions: dict) -> bool:
+        """A zero eigenvalue is the rigid rotation alpha = const: its vector's kinetic
+        energy is the twist's."""
+        return fractions["torsional"] >= 0.99
+
     def block_residuals(self, lam: complex, xr, xi) -> dict:
         return self.classifier.block_residuals(lam, xr, xi)
 

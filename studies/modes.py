@@ -274,9 +274,7 @@ def report(result: ModesResult) -> str:
     any family with fewer modes than asked for."""
     info = result.info
     scheme = schemes.get(info["scheme"])
-    disc = (f"N = {info['elements']}, p = {info['degree']} ({info['dofs']} dofs, "
-            if scheme.has_degree else f"N = {info['elements']} (")
-    lines = [f"Modes of the stationary state, scheme {info['scheme']}, {disc}"
+    lines = [f"Modes of the stationary state, scheme {info['scheme']}, {scheme.size_label(info)}"
              f"{info['wall_s']:.2f} s), ascending frequency", format_table(result)]
     if any(m.family == OVERDAMPED for m in result):
         lines.append("note: 'Overdamped' rows are real eigenvalues (one root each of an "

@@ -65,12 +65,12 @@ def too_many_segments(params: Parameters) -> str | None:
 def references() -> dict[str, Reference]:
     """The references by the name a kinematics gives them
     (models/kinematics.py::Kinematics.reference)."""
-    from rawehelix.references import shooting, shooting_shear
+    from rawehelix.references import drag, shooting, shooting_shear
     return {"shooting": Reference(shooting.solve, too_many_segments),
             "extensible_elastica": Reference(shooting.solve_extensible,
-                                             shooting.uniform_load_only),
+                                             drag.uniform_load_only),
             "shearable_elastica": Reference(shooting_shear.solve_shearable,
-                                            lambda p: shooting.uniform_load_only(p)
+                                            lambda p: drag.uniform_load_only(p)
                                             or shooting_shear.not_applicable(p))}
 
 

@@ -70,7 +70,8 @@ HEAVIEST = {"stationary": "stationary", "labtest": "stationary", "simulate": "dy
             # a design's points: the stage its quantities need (check_quantities); the
             # worst (modes) for the command as a whole
             "study": "modes", "calibrate": "modes",
-            "extremes": "modes"}  # its cases' eigenproblems
+            "extremes": "modes",  # its cases' eigenproblems
+            "campbell": "modes"}  # an eigenproblem at each operating point
 BYTES_PER_POINT = 2e3  # a sweep's, response's or study's record of one point
 SECONDS_PER_POINT = 0.01  # the least a point costs (a stationary solve at N = 2)
 WALL_LIMIT_S = 30 * 86400.0  # a count longer than this at the least cost is refused

@@ -5,7 +5,10 @@ name.
 * ``fe``: FEniCSx, C0 interior penalty in space and generalised-alpha (or a
   PETSc TS) in time (:mod:`rawehelix.solvers`);
 * ``spline``: the paper's spline-Galerkin reference (Sec. 3), integrated by
-  Radau with adaptive steps (:mod:`rawehelix.references.spline_galerkin`).
+  Radau with adaptive steps (:mod:`rawehelix.references.spline_galerkin`);
+* ``network``: the tensegrity as rigid rings and tension-only tethers
+  (:mod:`rawehelix.references.network`), its stationary state and modes; ``stationary``
+  prints it beside the FE continuum (:meth:`Scheme.stationary_beside`).
 
 A :class:`Scheme` gives what the studies need of a scheme: the stationary
 tension, the spectrum of the linearised stationary state, the forced
@@ -26,7 +29,8 @@ from mpi4py import MPI
 
 from rawehelix.families import LATERAL
 from rawehelix.parameters import SCHEMES, Parameters
-from rawehelix.parameters.schemes import CORES, FECore, SchemeCore, SplineCore, check_scheme
+from rawehelix.parameters.schemes import (CORES, FECore, NetworkCore, SchemeCore, SplineCore,
+                                          check_scheme)
 
 
 @dataclass
@@ -51,6 +55,15 @@ class Scheme(SchemeCore):
 
     #: why ``rawehelix simulate`` refuses the scheme (None: it runs it)
     simulate_refusal: str | None = None
+
+    def stationary_beside(self, params: Parameters) -> dict | None:
+        """The scheme's own stationary state, summarised beside the FE continuum's by
+        ``rawehelix stationary`` (None: the scheme is not run beside it)."""
+        return None
+
+    def size_label(self, info: dict) -> str:
+        """The discretisation's size in a modes report's header, ``info`` the run's."""
+        return f"N = {info['elements']} ("
 
     def stationary_tension_N(self, params: Parameters) -> float:
         """The stationary tension at s = 0 [N] (Sec. 5.1), on this rank."""
@@ -87,15 +100,18 @@ class Scheme(SchemeCore):
 
 class FE(FECore, Scheme):
 
+    def size_label(self, info):
+        return f"N = {info['elements']}, p = {info['degree']} ({info['dofs']} dofs, "
+
     def stationary_tension_N(self, params):
         from rawehelix.solvers.stationary import StationarySolver
         result = StationarySolver(params, MPI.COMM_SELF).solve()
         return params.normalised().tension_N(result.tension[0])
 
     def spectrum(self, params, comm=None, scene="scene", nev=None, shapes=True):
-        from rawehelix.solvers.modal import ModalSolver
+        from rawehelix.solvers.spin_modes import static_modal_solver
         comm = comm or MPI.COMM_WORLD
-        solver = ModalSolver.from_stationary(params, comm, scene=scene)
+        solver = static_modal_solver(params, comm, scene=scene)  # a [rotor]'s J lumped
         if not shapes:  # eigenvalues only
             return Spectrum(solver.solve(keep_vectors=False, require_families=False), {})
         found = solver.solve(nev=nev, require_families=False)
@@ -203,8 +219,83 @@ class Spline(SplineCore, Scheme):
         return ts.time_s, ts.spin_rpm
 
 
+class Network(NetworkCore, Scheme):
+    simulate_refusal = ("'simulate' has no network scheme yet (the network reference has a "
+                        "stationary solve and modes): use --scheme fe")
+
+    @staticmethod
+    def _refused(params, command: str):
+        from rawehelix.studies.scene import SceneError
+        raise SceneError(params.name, "discretisation.scheme",
+                         f"'network' runs 'stationary' and 'modes' only, not {command}: use "
+                         "--scheme fe or spline")
+
+    @staticmethod
+    def _stationary(params):
+        from rawehelix.references.network import Network as RingNetwork, solve
+        return solve(RingNetwork.from_parameters(params))
+
+    def stationary_tension_N(self, params):
+        return float(self._stationary(params).tension_N()[0])
+
+    def stationary_beside(self, params):
+        import time
+        start = time.perf_counter()
+        result = self._stationary(params)
+        f_min, bay, _ = result.smallest_tether_force
+        T = result.tension_N()
+        net = result.network
+        return {"scheme": self.name, "rings": net.count, "spacing_m": net.spacing_m,
+                "sag_m": result.sag_m(), "tension_s0_N": float(T[0]),
+                "tension_s1_N": float(T[-1]), "smallest_tether_force_N": f_min,
+                # the bay's middle along the unstretched helix
+                "smallest_at_s_m": (bay + 0.5) * net.spacing_m,
+                "slack_tethers": len(result.slack), "newton_iterations": result.iterations,
+                # the top ring's turn about the chord beyond the lay (a torque end's twist)
+                "twist_end_to_end_rad": result.state.theta + net.end_twist_rad,
+                "wall_s": time.perf_counter() - start}
+
+    def size_label(self, info):
+        return f"{info['rings']} rings ({info['dofs']} dofs, "
+
+    def spectrum(self, params, comm=None, scene="scene", nev=None, shapes=True):
+        from rawehelix.references.network import modes
+        result = self._stationary(params)
+        found = modes.modes(result)
+        t_scale = params.normalised().t_scale
+        out = [NetworkMode(complex(0.0, 2 * np.pi * m.frequency_Hz * t_scale), m.family,
+                           {k: v for k, v in m.fractions.items()}, [modes.DOFS_OF[m.family]])
+               for m in found]
+        P = len(found)
+        return Spectrum(out, {"rings": result.network.count, "dofs": P, "gamma": "off",
+                              "model": "network of rigid rings and tension-only tethers "
+                                       "(references/network)"})
+
+    def forced_backend(self, params, comm=MPI.COMM_SELF, accurate=False, ts_type=None):
+        self._refused(params, "a forced response")
+
+    def period_map(self, params):
+        self._refused(params, "orbits")
+
+    def driven_frequencies(self, params, m, f_max_Hz, natural_modes):
+        self._refused(params, "a forced response")
+
+    def spin_series(self, params, until_s, every_s, ts_type=None, fixed_steps=False):
+        self._refused(params, "a spin-up")
+
+
+@dataclass
+class NetworkMode:
+    """A network mode as the studies read one (the spline's and FE's fields)."""
+
+    eigenvalue: complex  # normalised (i omega sqrt(L0/g))
+    family: str
+    fractions: dict
+    dominant: list
+
+
 #: every scheme by name
-SCHEME_REGISTRY: dict[str, Scheme] = {s.name: s for s in (FE(), Spline())}
+SCHEME_REGISTRY: dict[str, Scheme] = {s.name: s for s in (FE(), Spline(), Network())}
 assert tuple(SCHEME_REGISTRY) == SCHEMES == tuple(CORES), \
     "the registry names the schemes of parameters.SCHEMES, each with its core"
 
@@ -220,4 +311,4 @@ def of(params: Parameters) -> Scheme:
     return get(params.discretisation.scheme)
 
 
-__all__ = ["FE", "SCHEME_REGISTRY", "Scheme", "Spectrum", "Spline", "get", "of"]
+__all__ = ["FE", "Network", "SCHEME_REGISTRY", "Scheme", "Spectrum", "Spline", "get", "of"]

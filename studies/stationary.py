@@ -154,11 +154,14 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
     ``ends`` block gives both."""
     from rawehelix.studies import reference_check
 
-    if not schemes.of(params).fe_assembled:
+    scheme = schemes.of(params)
+    if not scheme.fe_assembled and not scheme.beside_continuum:
         raise SceneError(params.name, "discretisation.scheme",
                          "'stationary' runs the FE scheme; the spline reference's stationary "
                          "state is part of 'modes'")
     top_torque = static_torque(params)  # refuses an unbalanced scene before any work
+    beside = scheme.stationary_beside(params)  # a model of its own, beside the FE's
+    params = params.replace(discretisation={"scheme": params.discretisation.continuum_scheme})
     start = time.perf_counter()
     q = params.normalised()
     disc = params.discretisation
@@ -211,6 +214,8 @@ def compute(params: Parameters, comm=MPI.COMM_WORLD) -> Stationary:
         }
         if top is not None:
             summary["lifter"] = lifter_block(params, top)
+        if beside is not None:
+            summary["beside"] = beside
         if check.compared:
             x_ref = q.length_m(reference.centre_line(result.s))
             out.shooting_centre_line_m = x_ref
@@ -279,7 +284,34 @@ def report(result: Stationary) -> str:
                      f" x the load's (|F| at the chord, Newton's first guess): the reference "
                      f"is not the discrete solution, which differs from it by the |dr| above "
                      f"(both |F| fall like N^-1/2, Sec. 5.1)")
+    if s.get("beside"):
+        lines.append(_beside_line(s["beside"], s))
     return "\n".join(lines) + structure_limits.line(s.get("limits"))
+
+
+def _beside_line(b: dict, s: dict) -> str:
+    """The scheme run beside the FE continuum (--scheme network), against it."""
+    def gap(mine, theirs):
+        return f"{100 * (mine / theirs - 1):+.2f} %" if theirs else "-"
+    f_fe = ((s.get("limits") or {}).get("min_member_force_N") or {}).get("value")
+    tether = (f"smallest tether force {b['smallest_tether_force_N']:.2f} N at s = "
+              f"{b['smallest_at_s_m']:.2f} m"
+              + (f" (continuum {f_fe:.2f} N)" if f_fe is not None else ""))
+    torque = s.get("torque")
+    twist = (f", twist {b['twist_end_to_end_rad']:.6g} rad "
+             f"({gap(b['twist_end_to_end_rad'], torque['twist_end_to_end_rad'])})"
+             if torque else "")
+    from rawehelix import section_laws
+    law = (s.get("limits") or {}).get("law")
+    other = ("; the continuum's section is not the members' (section.law = "
+             f"{law!r}): --set section.law=tensegrity --set model.kinematics=extensible "
+             "compares the same members"
+             if law is not None and not section_laws.get(law).members else "")
+    return (f"  {b['scheme']} beside it ({b['rings']} rings, l = {b['spacing_m']:.4g} m, "
+            f"{b['newton_iterations']} Newton iterations, {b['wall_s']:.2f} s): sag "
+            f"{b['sag_m']:.5f} m ({gap(b['sag_m'], s['sag_m'])}), T(0) = "
+            f"{b['tension_s0_N']:.3f} N ({gap(b['tension_s0_N'], s['tension_N']['s0'])}){twist}, "
+            f"{tether}, {b['slack_tethers']} slack{other}")
 
 
 def _status(status: str) -> str:

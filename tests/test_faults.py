@@ -63,6 +63,15 @@ FAULTS = [
       "--set", "lifter.force_N=200"], 2,
      "lifter.top: 'lifted' holds the top end by the lifter's force, which `rawehelix stationary`"),
     (["converge", "stationary_table2", "--quantity", "nothing"], 2, "--quantity: nothing"),
+    # the network reference (references/network): its rings, and the commands it runs
+    (["modes", "stationary_table2", "--scheme", "network"], 2,
+     "section.rings: --scheme network needs the rings"),
+    (["stationary", "stationary_table2", "--scheme", "network", "--set", "section.rings=2"], 2,
+     "section.rings: 2 --scheme network needs 3 to 1000 rings"),
+    (["modes", "stationary_table2", "--scheme", "network", "--set", "section.rings=5", "--set",
+      "section.lay_angle_deg=16.8"], 2, "past Tulloch's collapse angle"),
+    (["sweep", "mobile_end", "--scheme", "network", "--set", "section.rings=5"], 2,
+     "'network' runs 'stationary', 'modes', 'section' only, not 'sweep'"),
     (["extremes", "nosuchcase"], 2, "unknown case(s)"),
     (["study", "stationary_table2", "--vary", "helix.EI_Nm2=1:2:3", "--quantity", "tension"], 2,
      "--quantity: tension: unknown quantity"),
@@ -73,13 +82,6 @@ FAULTS = [
       "--set", "generator.torque_Nm=500", "--set", "generator.mppt_gain_Nms2=0"], 2,
      "wind.speed_m_s: 6.6131 m/s (V_n = 4.676 m/s along the rotor's axis) gives the rotor no "
      "stable operating point"),
-    # issue 44: the wind in time (tests/test_wind_series.py has every key and file fault)
-    (["stationary", "gust_rated", "--set", "wind.speed_m_s=45"], 2,
-     "not below V_e1 = 42 m/s of wind.wind_class = 'III'"),
-    (["stationary", "gust_rated", "--set", 'wind.turbulence_class="D"'], 2,
-     'wind.turbulence_class: "D" must be one of'),
-    (["simulate", "turbulent_rated", "--until", "700"], 2,
-     "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
     # issue 44: a start-up from rest needs a table from tsr 0; its release speed >= 0
     (["simulate", "rotor_example", "--elements", "2", "--set", "generator.release_rpm=60"], 2,
      "rotor.table: starts at tsr 1 with cp 0.034861: a start-up from rest"),
@@ -89,6 +91,22 @@ FAULTS = [
     (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
     (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
      "rotor: 'operate' needs a [rotor] section"),
+    # the Campbell diagram: its wind list, its envelope folder, a scene with no rotor
+    (["campbell", "rotor_example", "--wind", "6:3:1"], 2, "--wind: 6:3:1: must be LO:HI:STEP"),
+    (["campbell", "rotor_example", "--wind", "3:6:1", "--envelope", "nowhere"], 2,
+     "--envelope: nowhere: must be the output folder of a finished 'rawehelix envelope' run"),
+    (["campbell", "stationary_table2", "--elements", "2", "--wind", "3:6:1"], 2,
+     "stationary_table2: rotor: 'operate' needs a [rotor] section"),
+    (["campbell", "rotor_example", "--elements", "2", "--wind", "3:6:1", "--set",
+      'lifter.top="lifted"', "--set", "lifter.force_N=100"], 2,
+     "rotor_example: lifter: 'campbell' linearises about a fixed top end"),
+    # issue 44: the wind in time (tests/test_wind_series.py has every key and file fault)
+    (["stationary", "gust_rated", "--set", "wind.speed_m_s=45"], 2,
+     "not below V_e1 = 42 m/s of wind.wind_class = 'III'"),
+    (["stationary", "gust_rated", "--set", 'wind.turbulence_class="D"'], 2,
+     'wind.turbulence_class: "D" must be one of'),
+    (["simulate", "turbulent_rated", "--until", "700"], 2,
+     "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
 ]
 
 

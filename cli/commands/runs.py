@@ -1,5 +1,5 @@
-"""The single-run commands: stationary, modes, simulate, sweep, response, orbits, and
-section (closed forms, no solve)."""
+"""The single-run commands: stationary, modes, simulate, sweep, response, orbits,
+campbell, and section (closed forms, no solve)."""
 
 from __future__ import annotations
 
@@ -174,6 +174,29 @@ def _operate(rh, params, args, outdir, comm) -> int:
     return _written(comm, result, operate.report(result), outdir)
 
 
+def _campbell_arguments(p):
+    p.add_argument("--wind", required=True, metavar="LO:HI:STEP",
+                   help="wind speeds in m/s at the wind's reference height, LO to HI")
+    p.add_argument("--envelope", type=Path, default=None, metavar="DIR",
+                   help="an envelope's output directory: the band where the forced helix "
+                        "slackens (Sec. 5.3) on the diagram")
+
+
+def _campbell(rh, params, args, outdir, comm) -> int:
+    from rawehelix.studies import campbell, operate
+    from rawehelix.studies.store import outdir as outdir_check
+    winds = operate.parse_wind(args.wind)
+    envelope = campbell.read_envelope(args.envelope) if args.envelope is not None else None
+    campbell.refuse_moving_top(params)
+    operate.plan(params, winds, key="--wind", text=args.wind)  # numpy: refuses before any work
+    outdir_check.check(outdir, "campbell", points=len(winds))
+    result = rh.campbell(params, wind_m_s=winds, envelope=envelope, comm=comm)
+    if comm.rank == 0:
+        result.write(outdir)
+    say(comm, campbell.report(result) + f"\n  wrote {outdir}/")
+    return 0
+
+
 def _none(p):
     """No options of its own."""
 
@@ -193,6 +216,9 @@ COMMANDS = [
             _orbits_arguments, _orbits, kept="window*/p*.json"),
     Command("operate", "operating points of the rotor and generator over the wind speed: "
             "the power curve up to the helix's first limit", _operate_arguments, _operate),
+    Command("campbell", "Campbell diagram: the helix's modes about its operating points "
+            "against the rotor speed, the 1P, 2P, BP lines and their crossings",
+            _campbell_arguments, _campbell),
     Command("section", "EA, EI and GJ of the section's members (and the lab tests' values)",
             _none, _section),
 ]

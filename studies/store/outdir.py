@@ -27,7 +27,9 @@ OUTPUT_BYTES = {"stationary": 5 * MB, "modes": 20 * MB, "simulate": 200 * MB,
                 "sweep": 20 * MB, "response": 10 * MB, "orbits": 50 * MB,
                 "converge": 20 * MB, "extremes": 50 * MB, "labtest": 5 * MB,
                 "study": 10 * MB, "calibrate": 5 * MB, "section": 0.1 * MB,
-                "envelope": 10 * MB, "operate": 2 * MB}  # + its branches' stored points (extra_bytes)
+                "envelope": 10 * MB,  # + its branches' stored points (extra_bytes)
+                "operate": 2 * MB,
+                "campbell": 2 * MB}  # summary.json and campbell.png, + a point a wind
 BYTES_PER_POINT = 20e3  # a stored point (study, calibrate, orbits: JSON and arrays)
 
 
