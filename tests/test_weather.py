@@ -26,11 +26,11 @@ FIXED = {"ts_adapt_type": "none"}  # fixed steps: the ODE's comparison at each o
 
 
 def stiff(name, until_s, **wind):
-    """``name`` at N = 4 with GJ x 1000 (a rigid shaft), fixed 10 ms steps, outputs every
-    50 ms, its wind's event moved near the start (``wind``)."""
-    p = scene.load(name, elements=4).replace(
+    """``name`` at N = 2 with GJ x 1000 (a rigid shaft), fixed 20 ms steps, outputs every
+    100 ms, its wind's event moved near the start (``wind``)."""
+    p = scene.load(name, elements=2).replace(
         helix={"GJ_Nm2": 1.4e5}, wind=wind,
-        time={"dt_s": 0.01, "output_every_s": 0.05, "until_s": until_s})
+        time={"dt_s": 0.02, "output_every_s": 0.1, "until_s": until_s})
     return p, simulate.compute(p, until_s=until_s, options=FIXED, progress=False)
 
 
