@@ -106,7 +106,8 @@ class PiecewisePolynomial:
 
 @dataclass(frozen=True)
 class RotorTorque:
-    """Q(omega) of the rotor, normalised: power_n Cp(lam_per_omega omega) / omega;
+    """Q(omega) of the rotor, normalised: power_n Cp(lam_per_omega omega) / omega, written
+    power_n lam_per_omega Cp(lambda) / lambda (finite at rest: PiecewisePolynomial.over_x);
     ``power_n`` = 1/2 rho pi R^2 V_n^3 t_scale / (GJ / L0), ``lam_per_omega`` =
     R / (V_n t_scale), each a number or a Constant (the wind may change)."""
 

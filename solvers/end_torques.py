@@ -74,12 +74,17 @@ class Machine:
         return float(self.rotor.thrust(omega_rad_s, self.wind_n_m_s, self.air_density_kg_m3))
 
 
-def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
-    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py)."""
+def rotor_scales(machine: Machine, q) -> tuple[float, float]:
+    """(1/2 rho pi R^2 V_n^3 t_scale / (GJ / L0), R / (V_n t_scale)): the rotor's torque's
+    two numbers at the machine's wind, normalised (forms.RotorTorque)."""
     law, v = machine.rotor, machine.wind_n_m_s
     power = 0.5 * machine.air_density_kg_m3 * math.pi * law.radius_m**2 * v**3  # [W]
-    return forms.RotorTorque(cp_polynomial(law), power * q.t_scale / q.torque_scale,
-                             law.radius_m / (v * q.t_scale))
+    return power * q.t_scale / q.torque_scale, law.radius_m / (v * q.t_scale)
+
+
+def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
+    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py)."""
+    return forms.RotorTorque(cp_polynomial(machine.rotor), *rotor_scales(machine, q))
 
 
 def cp_polynomial(law) -> forms.PiecewisePolynomial:
@@ -194,4 +199,4 @@ def end_weights(mesh):
 
 
 __all__ = ["EndTorques", "LAWS", "Machine", "cp_polynomial", "end_weights", "generator_torque",
-           "machine_of", "rotor_inertia", "rotor_torque"]
+           "machine_of", "rotor_inertia", "rotor_scales", "rotor_torque"]

@@ -25,7 +25,7 @@ import dolfinx.fem
 
 from rawehelix.forms.wind import MovingWind
 from rawehelix.solvers import release
-from rawehelix.solvers.end_torques import EndTorques, Machine, rotor_torque
+from rawehelix.solvers.end_torques import EndTorques, Machine, rotor_scales
 
 
 class Weather:
@@ -64,8 +64,8 @@ class Weather:
         w.gust.value = gust / self.speed_scale
         w.fluctuation.value[:] = fluctuation / self.speed_scale
         if self._rotor is not None:
-            now = rotor_torque(self.machine.at(t_s), self.q)
-            self._rotor[0].value, self._rotor[1].value = now.power_n, now.lam_per_omega
+            power, lam = rotor_scales(self.machine.at(t_s), self.q)
+            self._rotor[0].value, self._rotor[1].value = power, lam
 
 
 def of(machine: Machine, q, mesh, steady) -> Weather | None:
