@@ -105,8 +105,9 @@ def test_a_failed_run_carries_the_block_up_to_its_last_good_state(monkeypatch):
     from rawehelix.solvers.dynamics import DynamicsSolver
     advance = DynamicsSolver.advance
 
-    def failing(self, until, on_output=None, output_every=None):
-        advance(self, 0.004 / self.q.t_scale, on_output=on_output, output_every=output_every)
+    def failing(self, until, on_output=None, output_every=None, on_step=None):
+        advance(self, 0.004 / self.q.t_scale, on_output=on_output, output_every=output_every,
+                on_step=on_step)
         raise SolverError("a test's failure")
 
     monkeypatch.setattr(DynamicsSolver, "advance", failing)
