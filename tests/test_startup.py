@@ -79,3 +79,16 @@ def test_the_startup_scene_reaches_its_operating_point():
     assert series.summary["energy"]["balance_of_work_in"] < 1e-3
     from test_docs import undocumented  # docs/reference/summary.md has the startup block
     assert undocumented(series.summary) == []
+
+
+def test_a_startup_cut_short_says_it_did_not_reach_the_point():
+    """The same scene stopped at 1 s: released (0.93 s) but not at the operating point;
+    the summary's reached_at_s is None and the report says so, with the members' line
+    naming the first limit (none met here)."""
+    series = simulate.compute(scene.load("startup", elements=2), until_s=1.0, progress=False)
+    block = series.summary["startup"]
+    text = simulate.report(series)
+    assert block["released_at_s"] == pytest.approx(0.93, abs=0.01)
+    assert block["reached_at_s"] is None
+    assert "did not reach the operating point 120.00 rpm by t = 1.000 s" in text
+    assert "first limit: none" in text
