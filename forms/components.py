@@ -81,6 +81,9 @@ class WindProfile(Protocol):
     def speed(self, r, c):
         """The wind's speed (normalised) at the centre line r."""
 
+    def air(self, r, c):
+        """-v_w at the centre line r, the vector Eq. (14)'s v_A adds to r_t."""
+
 
 #: the section law's protocol is written beside the laws it describes
 #: (forms/section_law.py::SectionComponent, the registry's UFL half)

@@ -65,25 +65,49 @@ class PiecewisePolynomial:
              for k, row in enumerate(self.coeffs)]
         return PiecewisePolynomial(tuple(x_scale * np.asarray(self.breaks)), tuple(c))
 
-    def __call__(self, x):
-        """The UFL expression at ``x`` (a UFL scalar)."""
-        b, c = self.breaks, self.coeffs
+    def _piece(self, i, x):
+        dx = x - self.breaks[i]
+        out = self.coeffs[0][i]
+        for row in self.coeffs[1:]:  # Horner
+            out = out * dx + row[i]
+        return out
 
-        def piece(i):
-            dx = x - b[i]
-            out = c[0][i]
-            for row in c[1:]:  # Horner
-                out = out * dx + row[i]
-            return out
+    def _chain(self, x, piece):
+        b = self.breaks
         expr = piece(len(b) - 2)
         for i in reversed(range(len(b) - 2)):
             expr = ufl.conditional(ufl.lt(x, b[i + 1]), piece(i), expr)
         return expr
 
+    def __call__(self, x):
+        """The UFL expression at ``x`` (a UFL scalar)."""
+        return self._chain(x, lambda i: self._piece(i, x))
+
+    @property
+    def through_origin(self) -> bool:
+        """Its first piece starts at x = 0 with the value 0: p(x) / x is a polynomial there."""
+        return self.breaks[0] == 0 and self.coeffs[-1][0] == 0
+
+    def over_x(self, x):
+        """p(x) / x in UFL: on a first piece through the origin the polynomial of one
+        degree less (finite at x = 0: a rotor at rest), elsewhere the quotient."""
+        if not self.through_origin:
+            return self(x) / x
+
+        def piece(i):
+            if i:
+                return self._piece(i, x) / x
+            out = self.coeffs[0][0]
+            for row in self.coeffs[1:-1]:  # Horner without the zero constant
+                out = out * x + row[0]
+            return out
+        return self._chain(x, piece)
+
 
 @dataclass(frozen=True)
 class RotorTorque:
-    """Q(omega) of the rotor, normalised: power_n Cp(lam_per_omega omega) / omega;
+    """Q(omega) of the rotor, normalised: power_n Cp(lam_per_omega omega) / omega, written
+    power_n lam_per_omega Cp(lambda) / lambda (finite at rest: PiecewisePolynomial.over_x);
     ``power_n`` = 1/2 rho pi R^2 V_n^3 t_scale / (GJ / L0), ``lam_per_omega`` =
     R / (V_n t_scale), each a number or a Constant (the wind may change)."""
 
@@ -93,7 +117,9 @@ class RotorTorque:
     given_in_time = False  # a law of the spin: Eq. (40)'s feedforward cannot know it
 
     def __call__(self, omega, time=None):
-        return self.power_n * self.cp(self.lam_per_omega * omega) / omega  # Q = P / Omega
+        # Q = P Cp / Omega = P (R / V_n) Cp(lambda) / lambda: finite at rest through a
+        # table from tsr 0 (Cq = Cp / lambda, the torque coefficient)
+        return self.power_n * self.lam_per_omega * self.cp.over_x(self.lam_per_omega * omega)
 
 
 @dataclass(frozen=True)
@@ -123,6 +149,7 @@ class GeneratorTorque:
     constant: float = 0.0
     table: PiecewisePolynomial | None = None  # torque against omega
     rated: float | None = None
+    engaged: Any = None  # 0..1, a start-up's release (a Constant); None: always on
 
     def __post_init__(self):
         if self.rated is not None and not self.rated > 0:
@@ -134,7 +161,7 @@ class GeneratorTorque:
             tau = tau + self.table(omega)
         if self.rated is not None:  # hold the power above it
             tau = ufl.conditional(ufl.gt(tau * omega, self.rated), self.rated / omega, tau)
-        return tau
+        return tau if self.engaged is None else self.engaged * tau
 
 
 def lumped_inertia(j, alpha_tt):

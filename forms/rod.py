@@ -75,7 +75,7 @@ def aerodynamic_force(r_t, c: Coefficients, r=None):
 
     |v_A| is smoothed by 1e-14 under the root so that its derivative exists at
     v_A = 0 (it is then zero, as the exact one-sided limits agree)."""
-    v_a = r_t + c.wind.speed(r, c) * I_E
+    v_a = r_t + c.wind.air(r, c)
     return -c.nu * ufl.sqrt(ufl.dot(v_a, v_a) + 1e-14) * v_a
 
 

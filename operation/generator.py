@@ -24,6 +24,10 @@ import math
 import numpy as np
 
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
+#: a released generator's torque ramps in linearly over this time (a soft start: the
+#: torque is continuous in time, so the steps and the energy account's trapezoids stay
+#: second order through the release) [s]
+RELEASE_RAMP_S = 0.5
 
 
 def _mppt(g, omega):
@@ -65,7 +69,8 @@ class GeneratorLaw:
 
     def __init__(self, law: str, mppt_gain_Nms2: float = 0.0, torque_Nm: float = 0.0,
                  table_rpm=(), table_torque_Nm=(), rated_power_W: float | None = None,
-                 target_rad_s: float = 0.0, integral_Nm: float = 0.0, damping_Nms: float = 0.0):
+                 target_rad_s: float = 0.0, integral_Nm: float = 0.0, damping_Nms: float = 0.0,
+                 release_rad_s: float | None = None):
         if law not in TORQUES:
             raise ValueError(f"generator law {law!r} must be one of {LAWS}")
         if rated_power_W is not None and not (rated_power_W > 0 and math.isfinite(rated_power_W)):
@@ -79,6 +84,9 @@ class GeneratorLaw:
         self.rated_power_W = rated_power_W
         self.target_rad_s, self.K1 = float(target_rad_s), float(integral_Nm)
         self.K2 = float(damping_Nms)
+        # a start-up's release speed (the torque is zero until the ground first spins at
+        # it, then ramps in over RELEASE_RAMP_S: solvers/release.py); None: on from the start
+        self.release_rad_s = release_rad_s
 
     def __repr__(self):
         return f"GeneratorLaw({self.law!r}, rated {self.rated_power_W} W)"
@@ -127,7 +135,8 @@ def _paper_of(g, params) -> GeneratorLaw | None:
 def _own_of(g, params) -> GeneratorLaw:
     return GeneratorLaw(g.law, mppt_gain_Nms2=g.mppt_gain_Nms2, torque_Nm=g.torque_Nm,
                         table_rpm=g.speeds_rpm or (), table_torque_Nm=g.torques_Nm or (),
-                        rated_power_W=g.rated_power_W)
+                        rated_power_W=g.rated_power_W,
+                        release_rad_s=None if g.release_rpm is None else g.release_rpm * RPM)
 
 
 #: how a scene's [generator] (and [controller]) builds each law

@@ -125,6 +125,12 @@ class WindHistory:
             raise ValueError("WindHistory.fluctuation_m_s must be (times, heights, 3)")
 
     @property
+    def steady(self) -> bool:
+        """The same wind at every time (V_ref and G constant, no fluctuation)."""
+        return bool(np.ptp(self.reference_m_s) == 0 and np.ptp(self.gust_m_s) == 0
+                    and not np.any(self.fluctuation_m_s))
+
+    @property
     def duration_s(self) -> float:
         return float(self.times_s[-1])
 
@@ -137,6 +143,13 @@ class WindHistory:
 
     def _series(self, x, i, w):
         return x[i] + w * (x[i + 1] - x[i]) if w else x[i]
+
+    def parts(self, t: float):
+        """(V_ref, G, u' v' w' at :attr:`heights_m` (m, 3)) at the time ``t`` [m/s]."""
+        i, w = self._at(t)
+        return (float(self._series(self.reference_m_s, i, w)),
+                float(self._series(self.gust_m_s, i, w)),
+                np.asarray(self._series(self.fluctuation_m_s, i, w), float))
 
     def speed(self, t: float, z_m):
         """(u, v, w) at the heights ``z_m`` (any shape) and the time ``t``: shape
@@ -292,6 +305,15 @@ def from_params(params) -> WindHistory:
     if w.hub_height_m is not None:
         profile = dataclasses.replace(profile, hub_height_m=w.hub_height_m)
     return HISTORIES[w.kind](params, profile)
+
+
+def moving(params) -> WindHistory | None:
+    """The scene's wind history when it changes in time; None when it is steady (the
+    [wind] section off, or a history whose samples are all one wind)."""
+    if not params.wind.active:
+        return None
+    history = from_params(params)
+    return None if history.steady else history
 
 
 #: the kinds, in the order a scene's reference lists them

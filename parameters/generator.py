@@ -15,8 +15,9 @@ from rawehelix.parameters.tables import numbers, read_beside, read_csv
 
 COLUMNS = ("rpm", "torque_Nm")  # the torque table's CSV columns
 #: the keys each law reads (any other given is refused)
-READS = {"paper": (), "mppt": ("mppt_gain_Nms2", "rated_power_W"),
-         "torque": ("torque_Nm", "table", "speeds_rpm", "torques_Nm", "rated_power_W")}
+READS = {"paper": (), "mppt": ("mppt_gain_Nms2", "rated_power_W", "release_rpm"),
+         "torque": ("torque_Nm", "table", "speeds_rpm", "torques_Nm", "rated_power_W",
+                    "release_rpm")}
 
 
 @dataclass(frozen=True)
@@ -35,6 +36,11 @@ class Generator:
     torques_Nm: tuple[float, ...] | None = None  # law "torque": the torque at each speed, >= 0 (inline) [N m]
     # above it the generator holds the power: tau = P_rated / Omega; absent: no cap [W]
     rated_power_W: float | None = None
+    # a start-up from rest (issue 44): the run starts from the untwisted helix at rest in
+    # the wind, the generator's torque zero until the ground end first spins at this
+    # speed, then ramped in over operation/generator.RELEASE_RAMP_S; absent: the run
+    # starts at the operating point with the generator on [rpm]
+    release_rpm: float | None = None
 
     def __post_init__(self):
         if self.law not in LAWS:
@@ -60,6 +66,10 @@ class Generator:
         _non_negative("generator", self, "torque_Nm")
         if self.rated_power_W is not None:
             _positive("generator", self, "rated_power_W")
+        if self.release_rpm is not None and not (isinstance(self.release_rpm, (int, float))
+                                                 and 0 <= self.release_rpm < math.inf):
+            raise ParameterError("generator.release_rpm", self.release_rpm,
+                                 "must be a finite number of rpm >= 0 (absent: no start-up)")
         if self.law == "torque":
             self._check_torque()
 

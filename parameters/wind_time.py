@@ -148,6 +148,15 @@ def check(params) -> None:
                                  "the file's hub speed in height")
 
 
+def synthesis_samples(params) -> int:
+    """The samples a run's turbulence synthesis makes at each of its points (0 for the
+    other kinds: their histories are a few thousand numbers)."""
+    w = params.wind
+    if not (w.active and w.kind == "turbulent"):
+        return 0
+    return int(w.duration_s / w.time_step_s) + 1
+
+
 def too_short(params, until_s: float, key: str):
     """(key, value, what) when the wind's series ends before a run to ``until_s``
     (``key``: time.until_s, or the command's --until), else None."""

@@ -40,6 +40,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
+from rawehelix.solvers import weather
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
@@ -141,7 +142,10 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                                  "(the first-order form sets its own end conditions)")
             self.machine = machine if machine is not None else machine_of(params)
             ends = EndTorques.of(self.q, self.machine)  # the rotor's and generator's (issue 43)
+            # the wind in time and a start-up's release (issue 44), each set at each time
+            self.weather, self.release, ends = weather.install(self.machine, self.q, self.rod, ends)
             self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
+            self.form.time_data += [x for x in (self.weather, self.release) if x is not None]
             if end_twist is not None:
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
@@ -374,6 +378,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             self._callback_error = NonFiniteState()
             raise self._callback_error
         self._remember(t)
+        if self.release is not None and not first:
+            self.release.latch(self)
         if self._on_step is not None and not first:
             self._on_step(self)
         eps = 1e-9 * max(1.0, t)

@@ -18,6 +18,7 @@ M g L0 / t_scale, energies by M g L0."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -26,7 +27,7 @@ import numpy as np
 import ufl
 
 from rawehelix.forms import end_torques as forms
-from rawehelix.operation import generator as generator_laws, rotor as rotor_laws, wind
+from rawehelix.operation import generator as generator_laws, rotor as rotor_laws, wind, wind_series
 from rawehelix.parameters import end_components
 
 
@@ -40,6 +41,10 @@ class Machine:
     wind_n_m_s: float = 0.0  # V_n, the wind along the rotor's axis at the hub [m/s]
     air_density_kg_m3: float = 1.225
     wind_hub_m_s: float = 0.0  # V, the wind's speed at the hub [m/s]
+    # the wind in time (operation/wind_series.WindHistory, issue 44); None: steady, the
+    # winds above at every time
+    history: Any = None
+    normal_factor: float = 1.0  # V_n / V: the rotor's axis against the wind (-i_E) [-]
 
     def __post_init__(self):
         if self.rotor is not None and not (self.wind_n_m_s > 0 and math.isfinite(self.wind_n_m_s)):
@@ -52,6 +57,15 @@ class Machine:
     def active(self) -> bool:
         return self.rotor is not None or self.generator is not None
 
+    def at(self, t_s: float) -> "Machine":
+        """The machine in the wind at the time ``t_s`` [s]: V at the hub and V_n = V
+        normal_factor (the along-wind component u of the history at the hub; its
+        lateral and vertical parts load the helix's drag only)."""
+        if self.history is None:
+            return self
+        v = float(self.history.hub(t_s)[0])
+        return dataclasses.replace(self, wind_hub_m_s=v, wind_n_m_s=v * self.normal_factor)
+
     def thrust_N(self, omega_rad_s: float) -> float:
         """The rotor's thrust at Omega [N] (0 without a rotor); its tip-speed ratio out of
         the table raises operation.rotor.OutOfTable, naming the wind and rotor speeds."""
@@ -60,12 +74,17 @@ class Machine:
         return float(self.rotor.thrust(omega_rad_s, self.wind_n_m_s, self.air_density_kg_m3))
 
 
-def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
-    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py)."""
+def rotor_scales(machine: Machine, q) -> tuple[float, float]:
+    """(1/2 rho pi R^2 V_n^3 t_scale / (GJ / L0), R / (V_n t_scale)): the rotor's torque's
+    two numbers at the machine's wind, normalised (forms.RotorTorque)."""
     law, v = machine.rotor, machine.wind_n_m_s
     power = 0.5 * machine.air_density_kg_m3 * math.pi * law.radius_m**2 * v**3  # [W]
-    return forms.RotorTorque(cp_polynomial(law), power * q.t_scale / q.torque_scale,
-                             law.radius_m / (v * q.t_scale))
+    return power * q.t_scale / q.torque_scale, law.radius_m / (v * q.t_scale)
+
+
+def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
+    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py)."""
+    return forms.RotorTorque(cp_polynomial(machine.rotor), *rotor_scales(machine, q))
 
 
 def cp_polynomial(law) -> forms.PiecewisePolynomial:
@@ -148,12 +167,14 @@ def machine_of(params) -> Machine:
     for component in end_components.torques(params):
         laws.update(LAWS[component.name](params))
     rotor = laws.get("rotor")
-    v_hub = wind.from_params(params).hub_speed
+    history = wind_series.moving(params)  # None: a steady wind
+    v_hub = wind.from_params(params).hub_speed if history is None else float(history.hub(0.0)[0])
     if rotor is None:
-        return Machine(generator=laws.get("generator"), wind_hub_m_s=v_hub)
+        return Machine(generator=laws.get("generator"), wind_hub_m_s=v_hub, history=history)
     top = params.normalised().top_position(0.0)
-    v_n = float(rotor.normal_speed(v_hub, top / np.linalg.norm(top)))
-    return Machine(rotor, laws.get("generator"), v_n, wind.air_density(params), v_hub)
+    factor = float(rotor.normal_speed(1.0, top / np.linalg.norm(top)))
+    return Machine(rotor, laws.get("generator"), v_hub * factor, wind.air_density(params), v_hub,
+                   history, factor)
 
 
 def _rotor_law(params) -> dict:
@@ -178,4 +199,4 @@ def end_weights(mesh):
 
 
 __all__ = ["EndTorques", "LAWS", "Machine", "cp_polynomial", "end_weights", "generator_torque",
-           "machine_of", "rotor_inertia", "rotor_torque"]
+           "machine_of", "rotor_inertia", "rotor_scales", "rotor_torque"]

@@ -8,6 +8,8 @@ settles back to after a gust.  Its time series gains :data:`COLUMNS`, its summar
 
 from __future__ import annotations
 
+import numpy as np
+
 from rawehelix.operation import generator
 from rawehelix.operation.rigid_shaft import operating_points
 from rawehelix.operation.rotor import RPM, OutOfTable  # RPM: rad/s per rpm
@@ -17,6 +19,9 @@ from rawehelix.studies.scene import SceneError
 
 #: the machine's columns of time_series.csv, after the helix's
 COLUMNS = ("rotor_rpm", "power_W", "thrust_N", "wind_hub_m_s")
+#: a start-up has reached the operating point once the rotor stays within this fraction
+#: of the point's speed to the end of the run [-]
+REACHED = 0.01
 
 
 def of(params) -> Machine:
@@ -45,8 +50,9 @@ def solver(params, machine: Machine, comm, options):
     """(DynamicsSolver, the summary's ``machine`` block): started at the operating
     point with a rotor; from the stationary state at rest without one."""
     from rawehelix.solvers.dynamics import DynamicsSolver
-    if machine.rotor is None:
-        return DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name), {}
+    if machine.rotor is None or starts_from_rest(params, machine):
+        return DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name), \
+            ({"start": "rest", "wind_hub_m_s": machine.wind_hub_m_s} if machine.rotor else {})
     point = start_point(params, machine)
     q = params.normalised()
     sv = DynamicsSolver.spinning(params, machine, point.omega_rad_s * q.t_scale,
@@ -57,11 +63,72 @@ def solver(params, machine: Machine, comm, options):
                 "wind_n_m_s": machine.wind_n_m_s, "tsr": point.tsr}
 
 
+def starts_from_rest(params, machine: Machine) -> bool:
+    """A start-up (generator.release_rpm given): from the untwisted helix at rest.  The
+    rotor at rest needs Q(0) finite, its table from tip-speed ratio 0 with Cp = 0 there
+    (Q = 1/2 rho pi R^3 V_n^2 Cp / lambda); SceneError (exit 2) otherwise."""
+    if machine.generator is None or machine.generator.release_rad_s is None:
+        return False
+    rotor = machine.rotor
+    if rotor is not None and not (rotor.table_tsr[0] == 0 and rotor.table_cp[0] == 0):
+        raise SceneError(params.name, "rotor.table",
+                         f"starts at tsr {rotor.table_tsr[0]:g} with cp {rotor.table_cp[0]:g}: a "
+                         f"start-up from rest (generator.release_rpm) needs its first row at "
+                         f"tsr 0 with cp 0 (the rotor's torque at rest is then 1/2 rho pi R^3 "
+                         f"V^2 dCp/dtsr(0)); add that row or remove generator.release_rpm")
+    return True
+
+
+def startup(machine: Machine, release, rows) -> dict:
+    """The summary's ``startup`` block: the release (solvers/release.py) and whether the
+    rotor reached the operating point of the last output's wind (:data:`REACHED`): the
+    first output time from which it stays there, else None.  ``rows`` the run's (its
+    machine columns after the helix's 8)."""
+    block = release.summary()
+    block["operating_rpm"] = block["reached_at_s"] = None
+    if not len(rows) or machine.rotor is None:
+        return block
+    now = machine.at(float(rows[-1, 0]))
+    points = [p for p in operating_points(now.rotor, now.generator, now.wind_n_m_s,
+                                          now.air_density_kg_m3) if p.stable]
+    if not points:
+        return block
+    rpm = max(points, key=lambda p: p.omega_rad_s).rotor_rpm
+    near = np.abs(rows[:, -len(COLUMNS)] / rpm - 1) < REACHED
+    away = np.flatnonzero(~near)
+    first = 0 if not len(away) else away[-1] + 1
+    block.update(operating_rpm=float(rpm),
+                 reached_at_s=float(rows[first, 0]) if first < len(rows) else None)
+    return block
+
+
+def startup_line(block: dict | None, simulated_s: float) -> str:
+    """The start-up's answer: released when, and the operating point reached when or
+    not by the run's end ('' without a start-up)."""
+    if not block:
+        return ""
+    at = block["released_at_s"]
+    released = (f"released at {block['release_rpm']:g} rpm at t = {at:.3f} s" if at is not None
+                else f"not released (the ground never reached {block['release_rpm']:g} rpm)")
+    point = block["operating_rpm"]
+    if point is None:
+        reached = "no stable operating point at the last wind"
+    elif block["reached_at_s"] is not None:
+        reached = (f"reached the operating point {point:.2f} rpm (within {REACHED:.0%}) at "
+                   f"t = {block['reached_at_s']:.3f} s")
+    else:
+        reached = (f"did not reach the operating point {point:.2f} rpm by t = {simulated_s:.3f} s "
+                   f"(a longer run: --until; the members' first limit below says what else "
+                   f"stopped it)")
+    return f"\n  start-up: generator {released}; {reached}"
+
+
 def row(machine: Machine, t_s: float, spin0_rpm: float, spin1_rpm: float,
         ground_torque_Nm: float) -> tuple:
-    """The :data:`COLUMNS` at an output time (SI)."""
+    """The :data:`COLUMNS` at an output time (SI), in the wind of that time."""
+    now = machine.at(t_s)
     return (spin1_rpm, ground_torque_Nm * spin0_rpm * RPM,
-            thrust(machine, spin1_rpm * RPM, t_s), machine.wind_hub_m_s)
+            thrust(now, spin1_rpm * RPM, t_s), now.wind_hub_m_s)
 
 
 def thrust(machine: Machine, omega_rad_s: float, t_s: float) -> float:
@@ -78,7 +145,9 @@ def check_step(machine: Machine, solver) -> None:
     """After each step: the rotor's tip-speed ratio inside its table (:func:`thrust`)."""
     if machine.rotor is not None:
         q = solver.q
-        thrust(machine, float(solver.probes.value("spin1")) / q.t_scale, float(q.time_s(solver.t)))
+        t_s = float(q.time_s(solver.t))
+        thrust(machine.at(t_s), float(solver.probes.value("spin1")) / q.t_scale, t_s)
 
 
-__all__ = ["COLUMNS", "check_step", "of", "row", "solver", "start_point", "thrust"]
+__all__ = ["COLUMNS", "check_step", "of", "row", "solver", "start_point", "starts_from_rest",
+           "startup", "startup_line", "thrust"]

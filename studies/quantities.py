@@ -120,6 +120,20 @@ def _settling(summary):
                   f"the spins did not settle within 2 % by t = {summary['simulated_s']:g} s")
 
 
+def _statistic(field: str, what: str):
+    """A field of a simulate run's ``statistics`` block (studies/simulate.py)."""
+    return lambda summary: _given(summary["statistics"].get(field), what)
+
+
+def _limit(field: str):
+    """The value of a simulate run's ``limits`` block entry ``field``."""
+    def pick(summary):
+        entry = (summary.get("limits") or {}).get(field)
+        return _given(None if entry is None else entry["value"],
+                      f"the run's limits block has no {field} (no member was checked)")
+    return pick
+
+
 def _resonance(summary):
     return _given(summary.get("resonance_Hz"), "no periodic point of the sweep has a T max")
 
@@ -198,6 +212,25 @@ QUANTITIES = {q.name: q for q in [
                                 ("decay_per_s", "1/s", "decay rate"))],
     Quantity("settling_time_s", "s", "spin_up", _settling,
              "time after which the spins stay within 2 % of the target (Sec. 5.2)"),
+    # a simulate run's statistics (issue 44: a seed study, --vary wind.seed=...)
+    Quantity("power_mean_W", "W", "spin_up",
+             _statistic("power_mean_W", "the scene has no generator: no power"),
+             "the generator's mean power over the run's outputs"),
+    Quantity("tension_s0_max_N", "N", "spin_up",
+             _statistic("tension_s0_max_N", "the run has no output"),
+             "the largest tension at the ground end s = 0 over the run"),
+    Quantity("tension_L0_max_N", "N", "spin_up",
+             _statistic("tension_L0_max_N", "the run has no output"),
+             "the largest tension at the top end s = L0 over the run"),
+    Quantity("member_force_min_N", "N", "spin_up", _limit("min_member_force_N"),
+             "the smallest tether (member) force over the run (the limits block)"),
+    Quantity("moment_ratio_max", "-", "spin_up", _limit("moment_ratio_max"),
+             "the largest moment ratio |M| / (N R) over the run (the limits block)"),
+    Quantity("twist_max_rad_m", "rad/m", "spin_up", _limit("twist_per_length_max"),
+             "the largest twist per length over the run (the limits block)"),
+    Quantity("slack_time_fraction", "-", "spin_up",
+             _statistic("slack_time_fraction", "the run's limits block sampled no time"),
+             "the fraction of the run's sampled times at which any tether is slack"),
     Quantity("resonance_Hz", "Hz", "sweep", _resonance,
              "f1 of the largest T max of the sweep over the scene's [sweep] list (Fig. 8)"),
     Quantity("fold_Hz", "Hz", "orbits", _fold,

@@ -71,6 +71,9 @@ BYTES_PER_OUTPUT = 500.0  # simulate: a row, its output time, the limits history
 BYTES_PER_FRAME = 1.5e3  # simulate: a frame's arrays' headers ...
 BYTES_PER_FRAME_NODE = 100.0  # ... and its fields at a node (11 float64 and headroom)
 SECONDS_PER_STEP = 1e-3  # the least a fixed time step costs (3.3 ms measured at N = 2)
+#: a turbulent wind's synthesis at its peak, a sample (pyconturb, 4 points: 241 MB for 1 h
+#: at 0.02 s, 180001 samples, measured by issue 44's wind, operation/turbulence.py)
+BYTES_PER_WIND_SAMPLE = 1.4e3
 BYTES_PER_SECTION_NODE = 100.0  # sweep: a section sample of the limits block at a node
 POINTS_PER_HZ = 25  # a branch's points a Hz of f1 (docs/envelope, N = 4: 13-23 a Hz)
 MAX_BRANCH_POINTS = 400  # orbits' --max-points default (and the envelope's branches')
@@ -177,6 +180,12 @@ def check_quantities(params: Parameters, wanted, copies: int = 1):
     from rawehelix.studies import quantities
     for stage in {quantities.parse(name)[0].stage.partition("@")[0] for name in wanted}:
         check(params, stage, copies)
+        STAGE_CHECKS.get(stage, lambda p, c: None)(params, copies)
+
+
+#: a study stage's own check beyond its solver's memory: a simulate run a point keeps
+#: its outputs, frames and wind (check_simulate), ``copies`` at once
+STAGE_CHECKS = {"spin_up": lambda params, copies: check_simulate(params, copies=copies)}
 
 
 def _refuse(key: str, value, what: str, need: float, have: float, advice: str):
@@ -195,10 +204,13 @@ def _nodes(params: Parameters) -> int:
     return disc.degree * disc.elements + 1
 
 
-def check_simulate(params: Parameters, until_s: float | None = None, key: str = "--until"):
+def check_simulate(params: Parameters, until_s: float | None = None, key: str = "--until",
+                   copies: int = 1):
     """Refuse a simulation whose outputs (``time.output_every_s``), frames
-    (``time.fields_every_s``) or time steps (``time.dt_s``) up to ``until_s``
-    (None: ``time.until_s``, then ``key`` is that) pass the memory or the wall limit."""
+    (``time.fields_every_s``), turbulence synthesis (``wind.duration_s`` /
+    ``wind.time_step_s``) or time steps (``time.dt_s``) up to ``until_s`` (None:
+    ``time.until_s``, then ``key`` is that) pass the memory or the wall limit;
+    ``copies`` runs at once (a study's ranks)."""
     tm = params.time
     if until_s is None:
         until_s, key = tm.until_s, "time.until_s"
@@ -206,15 +218,20 @@ def check_simulate(params: Parameters, until_s: float | None = None, key: str = 
     if short:
         raise SceneError(*short)
     outputs, frames = until_s / tm.output_every_s, until_s / tm.fields_every_s
+    samples = wind_time.synthesis_samples(params)
     kept = (BYTES_PER_OUTPUT * outputs,
-            frames * (BYTES_PER_FRAME + BYTES_PER_FRAME_NODE * _nodes(params)))
-    need, have = estimate_bytes(params, "simulate") + sum(kept), machine_bytes()
+            frames * (BYTES_PER_FRAME + BYTES_PER_FRAME_NODE * _nodes(params)),
+            BYTES_PER_WIND_SAMPLE * samples)
+    need, have = copies * (estimate_bytes(params, "simulate") + sum(kept)), machine_bytes()
     if need > have:
-        by = ("time.output_every_s", f"{outputs:.3g} output steps of {tm.output_every_s:g} s") \
-            if kept[0] >= kept[1] else \
-            ("time.fields_every_s", f"{frames:.3g} frames of the fields every {tm.fields_every_s:g} s")
-        _refuse(key, f"{until_s:g} s", by[1], need, have,
-                f"a shorter {key} or a longer {by[0]} (--set {by[0]}=...)")
+        at_once = f" ({copies} runs at once: fewer ranks)" if copies > 1 else ""
+        causes = {"time.output_every_s": f"{outputs:.3g} output steps of {tm.output_every_s:g} s",
+                  "time.fields_every_s": f"{frames:.3g} frames of the fields every "
+                                         f"{tm.fields_every_s:g} s",
+                  "wind.time_step_s": f"{samples:.3g} samples of turbulence"}
+        by = list(causes)[int(max(range(3), key=lambda i: kept[i]))]  # the largest part
+        _refuse(key, f"{until_s:g} s", causes[by] + at_once, need, have,
+                f"a shorter {key} or a longer {by} (--set {by}=...)")
     _refuse_wall(key, f"{until_s:g} s", f"{until_s / tm.dt_s:.3g} time steps of time.dt_s = "
                  f"{tm.dt_s:g} s at {SECONDS_PER_STEP * 1e3:g} ms each",
                  until_s / tm.dt_s * SECONDS_PER_STEP, f"a shorter {key}")

@@ -286,6 +286,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
 
     def result(complete: bool, error: str | None = None) -> TimeSeries:
         rows = np.array(rec.rows) if rec.rows else np.zeros((0, len(columns)))
+        slack = comm.bcast(tracker.slack_time_fraction() if comm.rank == 0 else None, root=0)
         series = TimeSeries(params, rows, list(rec.frames), _state_file(solver), dict(summary),
                             comm.rank, start, np.array(tracker.history).reshape(-1, 3), columns)
         s = series.summary
@@ -299,6 +300,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                   "limits": comm.bcast(tracker.block() if comm.rank == 0 else None, root=0)})
         if account is not None:  # work in = generator + dissipated + stored (issue 43)
             s["energy"] = account.summary(q)
+        if solver.release is not None:  # a start-up from rest (issue 44)
+            s["startup"] = machine.startup(ends, solver.release, rows)
         if len(rows):
             s["final"] = {"spin_rpm": {"s0": rows[-1, 1], "mid": rows[-1, 2], "L0": rows[-1, 3]},
                           "ground_torque_Nm": rows[-1, 4], "tension_s0_N": rows[-1, 5],
@@ -306,6 +309,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
             s["tension_range_N"] = [float(rows[:, 5:7].min()), float(rows[:, 5:7].max())]
             if ends.active:  # the machine's columns (studies/machine.py)
                 s["final"].update(zip(machine.COLUMNS, map(float, rows[-1, len(COLUMNS):])))
+            s["statistics"] = statistics(rows, columns, slack)
             s["real_time_factor"] = s["simulated_s"] / max(s["solve_s"], 1e-12)
         return series
 
@@ -351,6 +355,18 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     return series
 
 
+def statistics(rows, columns, slack: float | None) -> dict:
+    """The run's statistics over its outputs (a seed study's quantities, issue 44): the
+    mean generator power (with a machine), the largest tension at each end, and
+    ``slack``, the fraction of the limits block's times at which any member was slack
+    (structure_limits.Tracker.slack_time_fraction)."""
+    col = {name: i for i, name in enumerate(columns)}
+    power = rows[:, col["power_W"]] if "power_W" in col else None
+    return {"power_mean_W": None if power is None else float(np.mean(power)),
+            "tension_s0_max_N": float(rows[:, 5].max()), "tension_L0_max_N": float(rows[:, 6].max()),
+            "slack_time_fraction": slack}
+
+
 def report(result: TimeSeries) -> str:
     """The lines a user reads after a run."""
     s = result.summary
@@ -367,5 +383,6 @@ def report(result: TimeSeries) -> str:
     if f and "power_W" in f:
         lines.append(f"  rotor {f['rotor_rpm']:.3f} rpm, generator power {f['power_W']:.2f} W, "
                      f"thrust {f['thrust_N']:.2f} N at a hub wind of {f['wind_hub_m_s']:.3g} m/s")
-    lines[-1] += structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy"))
+    lines[-1] += (machine.startup_line(s.get("startup"), s["simulated_s"])
+                  + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy")))
     return "\n".join(lines)

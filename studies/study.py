@@ -60,7 +60,7 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
-from rawehelix.studies import pool, quantities, scene
+from rawehelix.studies import pool, quantities, scene, seeds
 # the design and its analysis; parse_vary, design and variance_indices are the study's too
 from rawehelix.studies.store import writers
 from rawehelix.studies.sampling import (SAMPLES, SEED, Variable, design, design_size,  # noqa: F401
@@ -197,6 +197,15 @@ class StudyResult:
         writers.write_text(outdir / "study.csv", self.csv_text())
         writers.write_json(outdir / "summary.json", self.summary)
         scatter_png(outdir / "study.png", self)
+        rows = self.summary.get("seeds")
+        if rows:  # a seed study (issue 44): the statistics over seeds against the key
+            from rawehelix.studies.present.seeds_figure import seeds_png
+            x_key = seeds.WIND_KEY if seeds.WIND_KEY in rows[0]["keys"] else next(
+                iter(rows[0]["keys"]), None)
+            if x_key is not None:  # a key besides the seed (the scene's wind at least)
+                seeds_png(outdir / "seeds.png", rows, self.wanted, x_key,
+                          self.summary.get("operating_curve"), seeds.CURVE_FIELDS,
+                          f"{self.title}: over {self.summary['seed_count']} seeds")
         tornado_png(outdir / "tornado.png", self.summary["sensitivities"],
                     f"{self.title}: d ln Q / d ln p at the base point "
                     f"(h = {self.summary['fd_step']:g})")
@@ -318,6 +327,15 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
                "point_timeout_s": point_timeout,
                "computed_now": out["computed"], "ranks": comm.size, "loops": loops,
                "wall_s": time.perf_counter() - start}
+    from rawehelix.operation.wind import reference_speed
+    rows = seeds.statistics(records, variables, wanted, reference_speed(params))
+    if rows is not None:  # a seed study (issue 44): statistics over the seeds
+        summary["seeds"] = rows
+        summary["seed_count"] = len({r["overrides"][seeds.SEED_KEY] for r in records.values()
+                                     if r["kind"] == "design"})
+        speeds = seeds.winds(rows)
+        summary["operating_curve"] = (seeds.operating_curve(params, speeds, comm) if speeds
+                                      and params.rotor.active else None)
     return StudyResult(params.name, params.title or params.name, variables, wanted, sample,
                        records, summary)
 
@@ -331,6 +349,11 @@ def report(result: StudyResult) -> str:
         shown = ", ".join(f"{k} {v:+.3f}" for k, v in row.items() if v is not None)
         if shown:
             lines.append(f"  d ln {name} / d ln p: {shown}")
+    for row in s.get("seeds") or []:  # a seed study: the statistics over the seeds
+        at = ", ".join(f"{k} = {v:g}" for k, v in row["keys"].items())
+        shown = "; ".join(f"{name} {q['mean']:.4g} +- {q['std'] or 0:.3g} (max {q['max']:.4g})"
+                          for name, q in row["quantities"].items() if q["mean"] is not None)
+        lines.append(f"  over {s['seed_count']} seeds at {at or 'the base'}: {shown}")
     for pid, errors in list(s["failed"].items())[:5]:
         lines.append(f"  failed {pid}: {'; '.join(errors.values())}")
     return "\n".join(lines)

@@ -27,6 +27,10 @@ LONG: dict[str, str] = {
     "studies/present/render.py": "off-screen pyvista pictures of the helix; one file because, once "
                          "DOLFINx is loaded, each picture is drawn in a fresh interpreter that "
                          "loads this file alone (a VTK/DOLFINx library clash)",
+    "solvers/dynamics.py": "the PETSc TS driver (options, stepping, output times, failures); "
+                           "the states it takes and returns and what it reports of them are "
+                           "dynamics_states.py and dynamics_outputs.py, the time data it "
+                           "installs (the wind, a release) solvers/weather.py",
 }
 
 

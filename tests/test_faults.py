@@ -82,6 +82,11 @@ FAULTS = [
       "--set", "generator.torque_Nm=500", "--set", "generator.mppt_gain_Nms2=0"], 2,
      "wind.speed_m_s: 6.6131 m/s (V_n = 4.676 m/s along the rotor's axis) gives the rotor no "
      "stable operating point"),
+    # issue 44: a start-up from rest needs a table from tsr 0; its release speed >= 0
+    (["simulate", "rotor_example", "--elements", "2", "--set", "generator.release_rpm=60"], 2,
+     "rotor.table: starts at tsr 1 with cp 0.034861: a start-up from rest"),
+    (["simulate", "startup", "--elements", "2", "--set", "generator.release_rpm=-1"], 2,
+     "generator.release_rpm: -1.0 must be a finite number of rpm >= 0"),
     # issue 43: operate's wind speeds and a scene without a rotor
     (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
     (["operate", "stationary_table2", "--wind", "4:16:1"], 2,

@@ -55,6 +55,7 @@ class Tracker:
         self._first = None
         self._by_kind = dict.fromkeys(CRITERIA)
         self.history: list[tuple] = []  # (t [s], min, max member force [N]) per add()
+        self.slack_history: list[bool] = []  # any member slack anywhere, per add()
         self.sampled_every_s = None  # set by a caller that adds every k-th output only
 
     def thresholds(self) -> dict:
@@ -109,6 +110,7 @@ class Tracker:
         if self._max is None or f[i].max() > self._max["value"]:
             self._max = _at(f[i].max(), s_m[i], t_s)
         fraction = slack.mean(axis=-1)
+        self.slack_history.append(bool((fraction > 0).any()))
         self._slack = max(self._slack, float(fraction.max()))
         ratio, tension = self.moment_ratio(N, M)
         i = int(np.argmax(ratio))
@@ -165,6 +167,11 @@ class Tracker:
             return None
         s, _, kind = min(hits)
         return {"kind": kind, "s_m": s, "t_s": None if t_s is None else float(t_s)}
+
+    def slack_time_fraction(self) -> float | None:
+        """The fraction of the times added at which any member was slack anywhere
+        (None: nothing added)."""
+        return float(np.mean(self.slack_history)) if self.slack_history else None
 
     def block(self) -> dict:
         """The ``limits`` block (module docstring); None values where nothing was added."""
