@@ -21,7 +21,14 @@ SNES stationary solve (as solvers/tension_target.py wraps its secant around it):
     a_1 = g(a_0), then the secant on g(a) - a,
 
 stopped when |g(a_k) - a_k| <= AXIS_TOL, after at most MAX_SOLVES stationary solves
-(the issue's cost); the point reports that defect.  da/dQ is the top tangent's turn per torque, ~1e-6 per N m on the
+(the issue's cost); the point reports that defect.
+
+Its stability is the full linearisation's (solvers/spin_modes.py ``stability``): the
+rod's K, C, M about the solved state spinning at Omega, with the rotor's spin inertia
+and -dQ/dOmega at the top, the generator's dtau/dOmega (or Eq. 40's k1, k2) at the
+ground; one eigenproblem on the stationary solver's rod.  The rigid shaft's slope
+d(Q - tau_gen - L)/dOmega is kept as ``slope_Nm_s`` (its verdict ``rigid_shaft_stable``):
+with Eq. (40) holding the speed the two differ (docs/explanation/campbell.md).  da/dQ is the top tangent's turn per torque, ~1e-6 per N m on the
 paper's helix, so a_1 is within AXIS_TOL of a_0 after the first point and one solve
 suffices; the first point takes two.  Each solve checks its converged reason
 (solvers/snes.py) and its tension (SlackError).
@@ -34,6 +41,8 @@ import time
 
 import numpy as np
 
+from rawehelix.solvers.spin_modes import (EndLoads, RelativeEquilibrium, SpinModalSolver,
+                                          stability)
 from rawehelix.solvers.torque_balance import Drive, stable
 
 #: the stationary solves an operating point may take (the issue's cost)
@@ -83,7 +92,7 @@ class OperatingPoint:
     loss_Nm: float
     thrust_N: float
     slope_Nm_s: float  # d(Q - tau_gen - L)/dOmega
-    stable: bool
+    stable: bool  # the full linearisation's verdict (module docstring)
     twist_rad: float | None  # alpha(L0) - alpha(0)
     tension_N: np.ndarray | None  # T(s) [N]
     s_tension_m: np.ndarray | None
@@ -91,6 +100,12 @@ class OperatingPoint:
     axis_defect: float  # |a_last - a_used|: the fixed point's residual
     limits: dict | None = None  # the limits block (studies/analysis/structure_limits.py)
     wall_s: float = 0.0
+    max_real_part_per_s: float | None = None  # max Re lambda of the linearisation [1/s]
+
+    @property
+    def rigid_shaft_stable(self) -> bool:
+        """The rigid shaft's verdict, d(Q - tau_gen - L)/dOmega < 0."""
+        return stable(self.slope_Nm_s)
 
     @property
     def power_W(self) -> float:
@@ -111,6 +126,25 @@ class OperatingPointSolver:
         self.scene_at, self.drive, self.hub_speed = scene_at, drive, hub_speed
         self.comm, self.limits = comm, limits
         self.a = None  # the last point's axis factor
+        self.stationary = self.modal = None  # one rod for every wind (:meth:`_solvers_at`)
+
+    def _solvers_at(self, params):
+        """The stationary and the modal solver of ``params`` on one rod: the scene at
+        another wind differs only in the helix's drag, a constant of the forms
+        (RodDiscretisation.set_wind), so the forms are built once; a scene that changes
+        more gets new solvers."""
+        from rawehelix.solvers.stationary import StationarySolver
+        if self.stationary is not None:
+            try:
+                self.stationary.rod.set_wind(params)
+                self.stationary.params = params
+                return self.stationary
+            except ValueError:
+                pass  # another scene: its own rod
+        self.stationary = StationarySolver(params, self.comm, scene=params.name, planar=False)
+        self.modal = SpinModalSolver(params, self.comm, scene=params.name,
+                                     rod=self.stationary.rod)
+        return self.stationary
 
     def axis(self, tangent) -> float:
         """a = V_n / V_hub for the unit top tangent (the rotor's ``normal_speed``)."""
@@ -124,11 +158,10 @@ class OperatingPointSolver:
         """The operating point at the wind V [m/s] on the branch whose root of the balance
         at V_n ``root(v_n)`` gives (Omega [rad/s]; OutsideTable where the branch has
         none).  SolverError if a stationary solve fails (SlackError: a slack helix)."""
-        from rawehelix.solvers.stationary import StationarySolver
         start = time.perf_counter()
         params = self.scene_at(V)
         q = params.normalised()
-        solver = StationarySolver(params, self.comm, scene=params.name, planar=False)
+        solver = self._solvers_at(params)
         v_hub = float(self.hub_speed(V))
         a = self.a if self.a is not None else self.first_axis_factor(params)
         tried = []  # (a, g(a)): the fixed point's secant
@@ -154,14 +187,18 @@ class OperatingPointSolver:
         block = self.limits(params, solver) if self.limits else None  # collective
         loss = self.drive.loss_Nm(omega)
         slope = self.drive.slope_Nm_s(omega, v_n)
+        loads = EndLoads.of_laws(self.drive.rotor, self.drive.generator, omega, v_n,
+                                 self.drive.rho_kg_m3, params.controller)
+        verdict, growth = stability(RelativeEquilibrium(result.state, omega, loads),
+                                    self.modal)  # collective
         out = OperatingPoint(
             wind_m_s=float(V), hub_wind_m_s=v_hub, v_n_m_s=float(v_n), omega_rad_s=float(omega),
             tsr=float(self.drive.rotor.tsr_of(omega, v_n)), torque_top_Nm=Q,
             torque_ground_Nm=Q - loss, loss_Nm=loss,
             thrust_N=float(self.drive.rotor.thrust(omega, v_n, self.drive.rho_kg_m3)),
-            slope_Nm_s=float(slope), stable=stable(slope), twist_rad=twist,
+            slope_Nm_s=float(slope), stable=verdict, twist_rad=twist,
             tension_N=None, s_tension_m=None, stationary_solves=solves, axis_defect=defect,
-            limits=block)
+            limits=block, max_real_part_per_s=float(growth))
         if self.comm.rank == 0:
             out.tension_N = q.tension_N(result.tension)
             out.s_tension_m = q.length_m(result.s_tension)

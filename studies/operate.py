@@ -8,7 +8,9 @@ curve up to the helix's first limit (issue 43, part 2).
 2. At each wind speed of ``--wind`` (ascending), every branch that reaches it gives an
    operating point: the relative equilibrium on the FE rod (solvers/operating_point.py,
    at most 3 stationary solves), with its ``limits`` (studies/analysis/
-   structure_limits.py).  The curve stops at the first wind speed where a point reaches
+   structure_limits.py) and its ``stable`` from the linearisation about it
+   (solvers/spin_modes.py: the rotor's inertia, -dQ/dOmega, dtau/dOmega, Eq. 40's k1, k2;
+   ``details[]`` keep the rigid shaft's verdict and max Re lambda).  The curve stops at the first wind speed where a point reaches
    a limit of the helix (slack, saturated moment, torsional collapse, breaking; a
    stationary solve that finds the helix slack is the slack limit), and says which;
    or where the rotor's table ends.
@@ -343,7 +345,8 @@ def _detail(p, branch: int) -> dict:
             "v_n_m_s": p.v_n_m_s, "loss_Nm": p.loss_Nm, "slope_Nm_s": p.slope_Nm_s,
             "member_force_min_N": fmin, "first_limit": lim.get("first_limit"),
             "stationary_solves": p.stationary_solves, "axis_defect": p.axis_defect,
-            "wall_s": p.wall_s}
+            "max_real_part_per_s": p.max_real_part_per_s,
+            "rigid_shaft_stable": p.rigid_shaft_stable, "wall_s": p.wall_s}
 
 
 def report(result: Operate) -> str:

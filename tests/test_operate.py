@@ -169,3 +169,29 @@ def test_the_figure_names_the_branches_the_fold_and_the_first_limit(tmp_path, mo
                for line in top.lines)  # the first limit's wind speed
     assert any("first limit: slack" in t.get_text() for t in top.texts)
     assert (tmp_path / "p.png").stat().st_size > 10_000
+
+
+def test_stable_is_the_linearisations_not_the_rigid_shafts():
+    """The paper's law (k1 = k2 = 0.5, 120 rpm): the rigid shaft's slope dQ/dOmega - K2
+    stays negative at 9 and 11 m/s, but the rotor's 0.3 Hz mode on the helix's twist
+    grows at 11 m/s (docs/explanation/campbell.md): operate's ``stable`` says so, and its
+    growth rate is the two-inertia model's (numpy, tests/test_campbell.py) within 0.06 /s
+    (measured at N = 4: -0.66 / -0.65 at 9 m/s, +0.20 / +0.22 at 11 m/s)."""
+    from rawehelix.solvers.spin_modes import rod_polar_inertia_kgm2
+    from tests.test_campbell import two_inertias
+    params = rh.load_scene("rotor_example", elements=4, overrides={
+        "generator.law": "paper", "generator.mppt_gain_Nms2": 0.0, "controller.k1": 0.5,
+        "controller.k2": 0.5, "controller.target_rpm": 120.0})
+    result = operate.compute(params, [9.0, 11.0], comm=MPI.COMM_SELF)
+    s = result.summary
+    assert [p["stable"] for p in s["points"]] == [True, False]
+    assert [d["rigid_shaft_stable"] for d in s["details"]] == [True, True]
+    q = params.normalised()
+    J_rod, k = rod_polar_inertia_kgm2(q), q.torque_scale
+    K1, K2 = 0.5 * q.torque_scale, 0.5 * q.torque_scale * q.t_scale  # Eq. (40) in SI
+    rotor = rotor_of(params)
+    for p, d in zip(result.points, s["details"]):
+        dQ = rotor.dtorque_domega(p.omega_rad_s, p.v_n_m_s, 1.225)
+        lumped = two_inertias(params.rotor.spin_inertia_kgm2 + J_rod / 2, J_rod / 2, k, K1,
+                              K2, dQ)
+        assert d["max_real_part_per_s"] == pytest.approx(lumped, abs=0.06), p.wind_m_s
