@@ -6,7 +6,9 @@ still: r_t = 0 and alpha_t = Omega uniform, so the inertia and the damping terms
 Eqs. (30)-(31) vanish and the centre line and phi are the stationary state (Sec. 5.1)
 under the end torques: the rotor's Q(Omega, V_n) at the top along the end tangent
 (Eq. 39), the ground's twist held (alpha(0) = 0, a Dirichlet end: its reaction is the
-generator's torque).  Omega is the unknown that closes the torque balance
+generator's torque), and with ``[spin_drag]`` the spinning tethers' distributed torque
+-c Omega|Omega| along s (StationarySolver.set_spin), so that the ground's torque is
+Q - c L0 Omega|Omega|.  Omega is the unknown that closes the torque balance
 (solvers/rigid_shaft_branch.py): without the helix's distributed loss the twist moment
 is constant along s, so Omega solves the rigid-shaft equation Q(Omega, V_n) = tau_gen
 (Omega) + L(Omega) exactly, and the rod enters only through V_n, the wind along the
@@ -171,6 +173,7 @@ class OperatingPointSolver:
             Q = self.drive.rotor_torque(omega, v_n)
             m = Q / q.torque_scale  # (39), normalised by GJ / L0
             solver.set_end_torques(ground=m, top=m)  # alpha(0) held: m0 is its reaction
+            solver.set_spin(omega * q.t_scale)  # the spin drag's distributed loss, if any
             result = solver.solve()
             tangent = None
             if self.comm.rank == 0:

@@ -166,6 +166,7 @@ class PointSolvers:
         self._at(params)
         m = torque_Nm / self.stationary.rod.q.torque_scale
         self.stationary.set_end_torques(ground=m, top=m)
+        self.stationary.set_spin(omega_rad_s * self.stationary.rod.q.t_scale)  # spin drag
         state = self.stationary.solve().state
         self.modal.linearise_at(RelativeEquilibrium(state, omega_rad_s, loads))
         return self.modal, self.modal.solve(per_family=self.per_family, keep_vectors=False,

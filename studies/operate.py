@@ -140,9 +140,11 @@ def fixed_top(params: Parameters) -> None:
 
 
 def drive_of(params: Parameters) -> Drive:
-    """The rotor's and the generator's laws of the scene (operation/); SceneError where
-    the scene has none."""
+    """The rotor's and the generator's laws of the scene (operation/) and the helix's
+    spin-drag loss (``[spin_drag]``, parameters/spin_drag.py; None when off); SceneError
+    where the scene has no rotor or generator."""
     from rawehelix.operation import generator, rotor, wind
+    from rawehelix.parameters.spin_drag import loss_of
     r, g = rotor.from_params(params), generator.from_params(params)
     if r is None:
         raise SceneError(params.name, "rotor", "'operate' needs a [rotor] section (radius_m, "
@@ -150,7 +152,7 @@ def drive_of(params: Parameters) -> Drive:
     if g is None:
         raise SceneError(params.name, "generator", "'operate' needs a [generator] section "
                          "(law = \"paper\", \"mppt\" or \"torque\")")
-    return Drive(r, g, wind.air_density(params))
+    return Drive(r, g, wind.air_density(params), loss=loss_of(params))
 
 
 def at_wind(params: Parameters, V: float) -> Parameters:

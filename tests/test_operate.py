@@ -195,3 +195,24 @@ def test_stable_is_the_linearisations_not_the_rigid_shafts():
         lumped = two_inertias(params.rotor.spin_inertia_kgm2 + J_rod / 2, J_rod / 2, k, K1,
                               K2, dQ)
         assert d["max_real_part_per_s"] == pytest.approx(lumped, abs=0.06), p.wind_m_s
+
+
+def test_the_spin_drag_takes_its_loss_between_the_rotor_and_the_ground():
+    """``[spin_drag]`` on (a thick tether, d = 2 cm), gravity and drag off (a straight
+    solid helix): the ground's torque is Q - c L0 Omega|Omega| (parameters/spin_drag.py's
+    loss), the point still balances Q = tau_gen + loss, and the twist end to end is the
+    closed form of a linearly varying torque (tests/test_spin_drag.py), to 1e-9."""
+    from rawehelix.parameters import spin_drag
+    from tests.test_spin_drag import linear_torque_twist
+    params = rh.load_scene("rotor_example", elements=4, overrides={
+        "spin_drag.tether_diameter_m": 0.02, "model.gravity": False, "model.drag": False})
+    point, = operate.compute(params, [6.0], comm=MPI.COMM_SELF).points
+    omega, Q = point.omega_rad_s, point.torque_top_Nm
+    loss = float(spin_drag.loss_of(params).torque(omega))
+    assert loss > 0.03 * Q  # seen, not lost in the tolerance
+    assert point.torque_ground_Nm == pytest.approx(Q - loss, rel=1e-12)
+    tau = GeneratorLaw("mppt", mppt_gain_Nms2=params.generator.mppt_gain_Nms2).torque(omega)
+    assert Q == pytest.approx(tau + loss, rel=1e-9)
+    L0, GJ = params.helix.length_m, params.helix.GJ_Nm2
+    closed = linear_torque_twist(L0, Q, spin_drag.coefficient(params), omega, L0, GJ)
+    assert point.twist_rad == pytest.approx(closed, rel=1e-9)
