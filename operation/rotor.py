@@ -27,6 +27,9 @@ RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
 #: about V cos 45 deg at the paper's elevation); "wind", facing the wind (V_n = V)
 NORMAL = {"tangent": lambda t: abs(float(t[0])), "wind": lambda t: 1.0}
 AXES = tuple(NORMAL)
+#: the rotor's axis -> its thrust's direction (x, y, z): None, along the helix's end
+#: tangent (a follower force on a lifted top); "wind", along the wind (-i_E, downwind)
+THRUST_ALONG = {"tangent": None, "wind": (-1.0, 0.0, 0.0)}
 
 
 class OutOfTable(ValueError):
@@ -165,6 +168,11 @@ class RotorLaw:
         """Q Omega = 1/2 rho pi R^2 V_n^3 Cp(lambda) [W]."""
         lam = self._lam(omega, v_n)
         return 0.5 * rho * self.area_m2 * np.asarray(v_n, float) ** 3 * self._cp(lam)
+
+    def thrust_direction(self):
+        """The thrust's unit vector (x, y, z), or None where it follows the helix's end
+        tangent (:data:`THRUST_ALONG`)."""
+        return THRUST_ALONG[self.axis]
 
     def normal_speed(self, v_hub, tangent=None):
         """V_n [m/s]: the wind's component along the rotor's axis, the wind V_hub along

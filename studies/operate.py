@@ -44,6 +44,8 @@ log = logging.getLogger("rawehelix")
 #: the window of V_n traced, beyond the chord's share of --wind (the top tangent turns
 #: from the chord by the sag's angle: a few degrees on the paper's helix)
 WINDOW_MARGIN = 0.15
+#: ... for a lifted top, whose end tangent turns from the lifter's pull with the thrust
+LIFTED_WINDOW_MARGIN = 0.5
 #: the most wind speeds a run takes (each a few stationary solves and a record)
 MAX_WINDS = 2000
 #: the keys of each point of summary.json (the issue's)
@@ -123,20 +125,15 @@ def elastic_twist(params: Parameters) -> None:
                          "--set torsion_hysteresis.rho=1")
 
 
-def fixed_top(params: Parameters) -> None:
-    """SceneError where the top end is not held at [ends]' position: a relative
-    equilibrium needs the top still (Eq. 70's circle moves it), and the lifted top's
-    equilibrium is not this solver's (its top is held at the chord's end)."""
+def still_top(params: Parameters) -> None:
+    """SceneError where the top end circles: a relative equilibrium needs the top still
+    (Eq. 70's circle moves it).  A fixed or lifted top is solved
+    (solvers/operating_tops.py)."""
     if params.ends.circle_radius_m > 0:
         raise SceneError(params.name, "ends.circle_radius_m",
                          f"{params.ends.circle_radius_m:g} > 0: the circle of Eq. (70) moves "
                          "the top end, so the helix has no relative equilibrium for 'operate': "
                          "run with --set ends.circle_radius_m=0")
-    if params.lifter.active:
-        raise SceneError(params.name, "lifter.top",
-                         f"{params.lifter.top!r}: 'operate' solves the operating points with "
-                         "the top end held at [ends]' position; set lifter.top = \"fixed\" "
-                         "(--set 'lifter.top=\"fixed\"')")
 
 
 def drive_of(params: Parameters) -> Drive:
@@ -222,14 +219,19 @@ def plan(params: Parameters, winds, key: str = "wind_m_s", text: str | None = No
     from rawehelix.solvers.operating_point import chord_axis_factor
     fe_scheme(params)
     elastic_twist(params)
-    fixed_top(params)
+    still_top(params)
     drive = drive_of(params)
+    if params.lifter.active:  # a lifter that cannot hold the helix up at rest
+        from rawehelix.solvers import lifted
+        lifted.check_holds(params, lifted.top_load(params))
     q = params.normalised()
     hub = hub_speed(params)
-    a0 = chord_axis_factor(drive, q)
+    a0 = chord_axis_factor(drive, params)
+    # a lifted top's tangent turns with the thrust, by more than a sag's angle
+    margin = LIFTED_WINDOW_MARGIN if params.lifter.active else WINDOW_MARGIN
     problem = RigidShaftProblem(drive, q.t_scale, q.torque_scale)
-    traced = trace(problem, a0 * hub(winds[0]) * (1 - WINDOW_MARGIN),
-                   min(1.0, a0 * (1 + WINDOW_MARGIN)) * hub(winds[-1]))
+    traced = trace(problem, a0 * hub(winds[0]) * (1 - margin),
+                   min(1.0, a0 * (1 + margin)) * hub(winds[-1]))
     out = Plan(drive, traced, a0, hub)
     missing = out.uncovered(winds)
     if missing:
@@ -348,7 +350,11 @@ def _detail(p, branch: int) -> dict:
             "member_force_min_N": fmin, "first_limit": lim.get("first_limit"),
             "stationary_solves": p.stationary_solves, "axis_defect": p.axis_defect,
             "max_real_part_per_s": p.max_real_part_per_s,
-            "rigid_shaft_stable": p.rigid_shaft_stable, "wall_s": p.wall_s}
+            "rigid_shaft_stable": p.rigid_shaft_stable, "stability_from": p.stability_from,
+            "top_m": None if p.top_m is None else [float(x) for x in p.top_m],
+            "tension_ground_N": None if p.tension_N is None else float(
+                p.tension_N[int(np.argmin(p.s_tension_m))]),
+            "wall_s": p.wall_s}
 
 
 def report(result: Operate) -> str:

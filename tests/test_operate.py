@@ -134,8 +134,8 @@ def test_bad_wind_exits_2_in_one_line_and_writes_nothing(tmp_path, wind, says):
 @pytest.mark.parametrize("changes, says", [
     ({"ends": {"circle_radius_m": 0.1, "circle_frequency_Hz": 1.0}},
      "ends.circle_radius_m: 0.1 > 0: the circle of Eq. (70) moves the top end"),
-    ({"lifter": {"top": "lifted", "force_N": 500.0}},
-     "lifter.top: 'lifted': 'operate' solves the operating points with the top end held"),
+    ({"lifter": {"top": "lifted", "force_N": 10.0}},
+     "lifter.force_N: the lifter cannot hold the helix up"),
     ({"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 0.5}},
      "torsion_hysteresis.rho: 0.5 < 1 (hysteretic torsion)"),
     ({"discretisation": {"scheme": "spline"}},
@@ -216,3 +216,32 @@ def test_the_spin_drag_takes_its_loss_between_the_rotor_and_the_ground():
     L0, GJ = params.helix.length_m, params.helix.GJ_Nm2
     closed = linear_torque_twist(L0, Q, spin_drag.coefficient(params), omega, L0, GJ)
     assert point.twist_rad == pytest.approx(closed, rel=1e-9)
+
+
+def lifted_scene(N=2, **changes):
+    """rotor_example with its top lifted by 300 N at 50 deg (MPPT)."""
+    return rh.load_scene("rotor_example", elements=N).replace(
+        lifter={"top": "lifted", "force_N": 300.0, "elevation_deg": 50.0}, **changes)
+
+
+def test_a_lifted_top_takes_the_thrust_into_the_tension():
+    """``lifter.top = "lifted"``: each point is the lifted stationary state under the
+    rotor's torque and its thrust along the solved end tangent (solvers/lifted.py), so
+    the tension at the ground rises with the thrust; the point's top is where a lifted
+    stationary solve from the chord under the same thrust and torque puts it (1e-8 m),
+    V_n is the wind along that solved end tangent, and the verdict is the rigid shaft's."""
+    from rawehelix.solvers import lifted
+    params = lifted_scene()
+    result = operate.compute(params, [5.0, 8.0], comm=MPI.COMM_SELF)
+    (low, high), details = result.points, result.summary["details"]
+    assert high.thrust_N > low.thrust_N + 50
+    ground = [d["tension_ground_N"] for d in details]
+    # the ground's tension takes the extra thrust (within the lifter's turn and the drag)
+    assert ground[1] - ground[0] == pytest.approx(high.thrust_N - low.thrust_N, rel=0.2)
+    for p, d in zip(result.points, details):
+        assert d["stability_from"] == "rigid shaft" and p.stable == p.rigid_shaft_stable
+        at = operate.at_wind(params, p.wind_m_s)
+        _, alone = lifted.stationary(at, comm=MPI.COMM_SELF, top_torque_Nm=p.torque_top_Nm,
+                                     omega_rad_s=p.omega_rad_s, tangent_thrust_N=p.thrust_N)
+        assert d["top_m"] == pytest.approx(alone.top_m, abs=1e-8)
+        assert p.v_n_m_s == pytest.approx(p.hub_wind_m_s * abs(alone.end_tangent[0]), rel=1e-8)
