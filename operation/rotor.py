@@ -30,6 +30,9 @@ AXES = tuple(NORMAL)
 #: the rotor's axis -> its thrust's direction (x, y, z): None, along the helix's end
 #: tangent (a follower force on a lifted top); "wind", along the wind (-i_E, downwind)
 THRUST_ALONG = {"tangent": None, "wind": (-1.0, 0.0, 0.0)}
+#: the share of a table's end ratio by which the spins searched stay inside it, so that
+#: the round-off of Omega R / V_n does not step outside the table
+ROUND_OFF = 1e-12
 
 
 class OutOfTable(ValueError):
@@ -146,6 +149,13 @@ class RotorLaw:
         return self._ct(self._inside(tsr))
 
     # -- at a wind and rotor speed -----------------------------------------------
+    def inner_tsr(self) -> np.ndarray:
+        """The table's tip-speed ratios with its two ends moved :data:`ROUND_OFF`
+        inside: spins built on them (lambda V_n / R) give back ratios inside the table
+        despite the round-off of Omega R / V_n."""
+        lam = np.asarray(self.table_tsr, dtype=float)
+        return np.clip(lam, lam[0] * (1 + ROUND_OFF), lam[-1] * (1 - ROUND_OFF))
+
     def tsr_of(self, omega, v_n):
         """lambda = Omega R / V_n [-] (Omega [rad/s], V_n [m/s] > 0)."""
         return np.asarray(omega, float) * self.radius_m / np.asarray(v_n, float)
