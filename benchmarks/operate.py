@@ -1,10 +1,10 @@
 """`rawehelix operate`'s cost, as ratios (issue 43's targets):
 
 1. an operating point against a stationary solve of the same helix under the same
-   torque: the points' stationary solves (at most 3 each) and their time over one
-   solve's;
-2. the power curve of 25 wind speeds (3 to 9 m/s, below the first limit) with the
-   rigid mode's stability at N = 8, rotor_example (MPPT), CPU and wall time in this
+   torque: the points' stationary solves (at most 3 each) and their time (with the
+   point's eigenproblem and limits) over one solve's, its solver built;
+2. the power curve of 25 wind speeds (3 to 9 m/s, below the first limit) with each
+   point's stability from the linearisation (an eigenproblem a point) at N = 8, rotor_example (MPPT), CPU and wall time in this
    process after a run that compiles the forms; the target is under a minute on one core.
 
     .venv/bin/python benchmarks/operate.py [--elements 8] [--repeats 3]

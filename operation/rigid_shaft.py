@@ -71,14 +71,13 @@ def operating_points(rotor, generator, v, rho, loss=None) -> list[OperatingPoint
     v = float(v)
     if not v > 0:
         raise ValueError(f"the wind along the rotor's axis must be > 0 m/s, got {v!r}")
-    lo, hi = rotor.tsr_range
-    lo = max(lo, 1e-12 * hi)  # Q = A Cp / Omega: Omega > 0
     if generator is not None and generator.holds_speed is not None:
         omegas = [generator.holds_speed]
-    else:
+    else:  # the table's rows, its ends a hair inside (round-off in Omega R / V_n)
+        rows = rotor.inner_tsr()
+        rows = np.unique(np.maximum(rows, 1e-12 * rows[-1]))  # Q = A Cp / Omega: Omega > 0
         omegas = _roots(lambda w: _net(rotor, generator, loss, w, v, rho),
-                        np.unique(np.concatenate([[lo], rotor.table_tsr[rotor.table_tsr > lo]]))
-                        * v / rotor.radius_m)
+                        rows * v / rotor.radius_m)
     return [_point(rotor, generator, loss, w, v, rho) for w in omegas]
 
 

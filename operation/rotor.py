@@ -27,6 +27,12 @@ RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
 #: about V cos 45 deg at the paper's elevation); "wind", facing the wind (V_n = V)
 NORMAL = {"tangent": lambda t: abs(float(t[0])), "wind": lambda t: 1.0}
 AXES = tuple(NORMAL)
+#: the rotor's axis -> its thrust's direction (x, y, z): None, along the helix's end
+#: tangent (a follower force on a lifted top); "wind", along the wind (-i_E, downwind)
+THRUST_ALONG = {"tangent": None, "wind": (-1.0, 0.0, 0.0)}
+#: the share of a table's end ratio by which the spins searched stay inside it, so that
+#: the round-off of Omega R / V_n does not step outside the table
+ROUND_OFF = 1e-12
 
 
 class OutOfTable(ValueError):
@@ -143,6 +149,13 @@ class RotorLaw:
         return self._ct(self._inside(tsr))
 
     # -- at a wind and rotor speed -----------------------------------------------
+    def inner_tsr(self) -> np.ndarray:
+        """The table's tip-speed ratios with its two ends moved :data:`ROUND_OFF`
+        inside: spins built on them (lambda V_n / R) give back ratios inside the table
+        despite the round-off of Omega R / V_n."""
+        lam = np.asarray(self.table_tsr, dtype=float)
+        return np.clip(lam, lam[0] * (1 + ROUND_OFF), lam[-1] * (1 - ROUND_OFF))
+
     def tsr_of(self, omega, v_n):
         """lambda = Omega R / V_n [-] (Omega [rad/s], V_n [m/s] > 0)."""
         return np.asarray(omega, float) * self.radius_m / np.asarray(v_n, float)
@@ -165,6 +178,11 @@ class RotorLaw:
         """Q Omega = 1/2 rho pi R^2 V_n^3 Cp(lambda) [W]."""
         lam = self._lam(omega, v_n)
         return 0.5 * rho * self.area_m2 * np.asarray(v_n, float) ** 3 * self._cp(lam)
+
+    def thrust_direction(self):
+        """The thrust's unit vector (x, y, z), or None where it follows the helix's end
+        tangent (:data:`THRUST_ALONG`)."""
+        return THRUST_ALONG[self.axis]
 
     def normal_speed(self, v_hub, tangent=None):
         """V_n [m/s]: the wind's component along the rotor's axis, the wind V_hub along

@@ -26,9 +26,6 @@ from rawehelix.operation.rotor import OutOfTable
 
 #: the roots are bracketed on this many spins between two adjacent rows of the table
 SAMPLES = 64
-#: ... a hair inside the table's ends (relative), so that round-off in Omega R / V_n
-#: does not step outside it
-ROUND_OFF = 1e-12
 #: the scalar Newton at fixed V_n stops at |G| below this (normalised torque)
 TOL = 1e-12
 
@@ -106,9 +103,9 @@ class Drive:
         return sorted(out)
 
     def _table_tsr(self) -> np.ndarray:
-        """The table's tip-speed ratios, its ends moved ROUND_OFF inside."""
-        lam = np.asarray(self.rotor.table_tsr, dtype=float)
-        return np.clip(lam, lam[0] * (1 + ROUND_OFF), lam[-1] * (1 - ROUND_OFF))
+        """The table's tip-speed ratios, its ends moved a hair inside
+        (operation/rotor.py's ROUND_OFF)."""
+        return self.rotor.inner_tsr()
 
     def omega_range(self, v_n: float) -> tuple[float, float]:
         """The spins [rad/s] whose tip-speed ratios the table has at V_n (a hair inside)."""

@@ -168,7 +168,8 @@ class _Formulation:
             ufl.conditional(top, 0.5 * c.beta * j * fields.alpha_t**2, 0.0) * ds)
         self.power_in = dolfinx.fem.form(c.beta * self.m_in * fields.alpha_t * ds)
         self.power_generator = dolfinx.fem.form(c.beta * self.m0 * fields.alpha_t * ds)
-        drag = rod.body_force(fields.r_t, c, fields.r) - c.gravity * rod.K_E  # (14): gravity is in U
+        # (14) at each point's height (a wind profile reads r): gravity is in U
+        drag = rod.body_force(fields.r_t, c, fields.r) - c.gravity * rod.K_E
         self.power_drag = dolfinx.fem.form(ufl.inner(drag, fields.r_t) * dx)
 
     def set_time(self, t: float):

@@ -28,9 +28,9 @@ from mpi4py import MPI
 
 from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters, end_components
+from rawehelix.solvers.operating_tops import FixedTop
 from rawehelix.solvers.spin_modes import (EndLoads, RelativeEquilibrium, SpinModalSolver,
                                           damping_ratio, frequency_Hz)
-from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.studies import campbell_lines, operate
 
 PER_FAMILY = 2  # modes of each family followed across the operating points
@@ -139,37 +139,29 @@ def mode_entries(solver: SpinModalSolver, modes, per_family: int) -> list[dict]:
 
 
 class PointSolvers:
-    """One stationary and one modal solver on one rod for a run's operating points: the
-    scene at another wind speed differs only in the helix's drag, a constant of the
-    forms (RodDiscretisation.set_wind), so the forms are built once (they were 85 % of a
-    point's cost, measured at N = 8); a scene that changes more gets new solvers."""
+    """One stationary and one modal solver on one rod for a run's operating points
+    (solvers/operating_tops.py's FixedTop, as operate's): the scene at another wind speed
+    differs only in the helix's drag, a constant of the forms (RodDiscretisation.set_wind),
+    so the forms are built once (they were 85 % of a point's cost, measured at N = 8); a
+    scene that changes more gets new solvers."""
 
     def __init__(self, comm, scene: str, per_family: int = PER_FAMILY):
-        self.comm, self.scene, self.per_family = comm, scene, per_family
-        self.stationary = self.modal = None
+        self.scene, self.per_family = scene, per_family
+        self.top = FixedTop(comm)
 
-    def _at(self, params: Parameters):
-        if self.stationary is not None:
-            try:
-                self.stationary.rod.set_wind(params)
-                return
-            except ValueError:
-                pass  # another scene: its own rod
-        self.stationary = StationarySolver(params, self.comm, scene=self.scene)
-        self.modal = SpinModalSolver(params, self.comm, scene=self.scene,
-                                     rod=self.stationary.rod)
+    @property
+    def stationary(self):
+        return self.top.stationary
 
     def modes(self, params: Parameters, omega_rad_s: float, torque_Nm: float, loads: EndLoads):
         """(solver, modes) about the relative equilibrium of spin ``omega_rad_s`` [rad/s]
-        under the end torque ``torque_Nm`` [N m] (both ends, Eqs. 38-39) with the end
-        ``loads``."""
-        self._at(params)
-        m = torque_Nm / self.stationary.rod.q.torque_scale
-        self.stationary.set_end_torques(ground=m, top=m)
-        state = self.stationary.solve().state
-        self.modal.linearise_at(RelativeEquilibrium(state, omega_rad_s, loads))
-        return self.modal, self.modal.solve(per_family=self.per_family, keep_vectors=False,
-                                            require_families=False)
+        under the end torque ``torque_Nm`` [N m] (both ends, Eqs. 38-39; the spin drag's
+        loss along s, if any) with the end ``loads``."""
+        state = self.top.state(params, omega_rad_s, torque_Nm, thrust_N=0.0)
+        modal = self.top.modal
+        modal.linearise_at(RelativeEquilibrium(state.result.state, omega_rad_s, loads))
+        return modal, modal.solve(per_family=self.per_family, keep_vectors=False,
+                                  require_families=False)
 
 
 def scene_value(params: Parameters, envelope: dict | None):

@@ -8,7 +8,9 @@ curve up to the helix's first limit (issue 43, part 2).
 2. At each wind speed of ``--wind`` (ascending), every branch that reaches it gives an
    operating point: the relative equilibrium on the FE rod (solvers/operating_point.py,
    at most 3 stationary solves), with its ``limits`` (studies/analysis/
-   structure_limits.py).  The curve stops at the first wind speed where a point reaches
+   structure_limits.py) and its ``stable`` from the linearisation about it
+   (solvers/spin_modes.py: the rotor's inertia, -dQ/dOmega, dtau/dOmega, Eq. 40's k1, k2;
+   ``details[]`` keep the rigid shaft's verdict and max Re lambda).  The curve stops at the first wind speed where a point reaches
    a limit of the helix (slack, saturated moment, torsional collapse, breaking; a
    stationary solve that finds the helix slack is the slack limit), and says which;
    or where the rotor's table ends.
@@ -42,6 +44,8 @@ log = logging.getLogger("rawehelix")
 #: the window of V_n traced, beyond the chord's share of --wind (the top tangent turns
 #: from the chord by the sag's angle: a few degrees on the paper's helix)
 WINDOW_MARGIN = 0.15
+#: ... for a lifted top, whose end tangent turns from the lifter's pull with the thrust
+LIFTED_WINDOW_MARGIN = 0.5
 #: the most wind speeds a run takes (each a few stationary solves and a record)
 MAX_WINDS = 2000
 #: the keys of each point of summary.json (the issue's)
@@ -121,26 +125,23 @@ def elastic_twist(params: Parameters) -> None:
                          "--set torsion_hysteresis.rho=1")
 
 
-def fixed_top(params: Parameters) -> None:
-    """SceneError where the top end is not held at [ends]' position: a relative
-    equilibrium needs the top still (Eq. 70's circle moves it), and the lifted top's
-    equilibrium is not this solver's (its top is held at the chord's end)."""
+def still_top(params: Parameters) -> None:
+    """SceneError where the top end circles: a relative equilibrium needs the top still
+    (Eq. 70's circle moves it).  A fixed or lifted top is solved
+    (solvers/operating_tops.py)."""
     if params.ends.circle_radius_m > 0:
         raise SceneError(params.name, "ends.circle_radius_m",
                          f"{params.ends.circle_radius_m:g} > 0: the circle of Eq. (70) moves "
                          "the top end, so the helix has no relative equilibrium for 'operate': "
                          "run with --set ends.circle_radius_m=0")
-    if params.lifter.active:
-        raise SceneError(params.name, "lifter.top",
-                         f"{params.lifter.top!r}: 'operate' solves the operating points with "
-                         "the top end held at [ends]' position; set lifter.top = \"fixed\" "
-                         "(--set 'lifter.top=\"fixed\"')")
 
 
 def drive_of(params: Parameters) -> Drive:
-    """The rotor's and the generator's laws of the scene (operation/); SceneError where
-    the scene has none."""
+    """The rotor's and the generator's laws of the scene (operation/) and the helix's
+    spin-drag loss (``[spin_drag]``, parameters/spin_drag.py; None when off); SceneError
+    where the scene has no rotor or generator."""
     from rawehelix.operation import generator, rotor, wind
+    from rawehelix.parameters.spin_drag import loss_of
     r, g = rotor.from_params(params), generator.from_params(params)
     if r is None:
         raise SceneError(params.name, "rotor", "'operate' needs a [rotor] section (radius_m, "
@@ -148,7 +149,7 @@ def drive_of(params: Parameters) -> Drive:
     if g is None:
         raise SceneError(params.name, "generator", "'operate' needs a [generator] section "
                          "(law = \"paper\", \"mppt\" or \"torque\")")
-    return Drive(r, g, wind.air_density(params))
+    return Drive(r, g, wind.air_density(params), loss=loss_of(params))
 
 
 def at_wind(params: Parameters, V: float) -> Parameters:
@@ -218,14 +219,19 @@ def plan(params: Parameters, winds, key: str = "wind_m_s", text: str | None = No
     from rawehelix.solvers.operating_point import chord_axis_factor
     fe_scheme(params)
     elastic_twist(params)
-    fixed_top(params)
+    still_top(params)
     drive = drive_of(params)
+    if params.lifter.active:  # a lifter that cannot hold the helix up at rest
+        from rawehelix.solvers import lifted
+        lifted.check_holds(params, lifted.top_load(params))
     q = params.normalised()
     hub = hub_speed(params)
-    a0 = chord_axis_factor(drive, q)
+    a0 = chord_axis_factor(drive, params)
+    # a lifted top's tangent turns with the thrust, by more than a sag's angle
+    margin = LIFTED_WINDOW_MARGIN if params.lifter.active else WINDOW_MARGIN
     problem = RigidShaftProblem(drive, q.t_scale, q.torque_scale)
-    traced = trace(problem, a0 * hub(winds[0]) * (1 - WINDOW_MARGIN),
-                   min(1.0, a0 * (1 + WINDOW_MARGIN)) * hub(winds[-1]))
+    traced = trace(problem, a0 * hub(winds[0]) * (1 - margin),
+                   min(1.0, a0 * (1 + margin)) * hub(winds[-1]))
     out = Plan(drive, traced, a0, hub)
     missing = out.uncovered(winds)
     if missing:
@@ -343,6 +349,11 @@ def _detail(p, branch: int) -> dict:
             "v_n_m_s": p.v_n_m_s, "loss_Nm": p.loss_Nm, "slope_Nm_s": p.slope_Nm_s,
             "member_force_min_N": fmin, "first_limit": lim.get("first_limit"),
             "stationary_solves": p.stationary_solves, "axis_defect": p.axis_defect,
+            "max_real_part_per_s": p.max_real_part_per_s,
+            "rigid_shaft_stable": p.rigid_shaft_stable, "stability_from": p.stability_from,
+            "top_m": None if p.top_m is None else [float(x) for x in p.top_m],
+            "tension_ground_N": None if p.tension_N is None else float(
+                p.tension_N[int(np.argmin(p.s_tension_m))]),
             "wall_s": p.wall_s}
 
 

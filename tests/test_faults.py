@@ -91,6 +91,9 @@ FAULTS = [
     (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
     (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
      "rotor: 'operate' needs a [rotor] section"),
+    (["operate", "rotor_example", "--elements", "2", "--wind", "4:6:1", "--set",
+      'lifter.top="lifted"', "--set", "lifter.force_N=10"], 2,
+     "lifter.force_N: the lifter cannot hold the helix up"),
     # the Campbell diagram: its wind list, its envelope folder, a scene with no rotor
     (["campbell", "rotor_example", "--wind", "6:3:1"], 2, "--wind: 6:3:1: must be LO:HI:STEP"),
     (["campbell", "rotor_example", "--wind", "3:6:1", "--envelope", "nowhere"], 2,

@@ -134,8 +134,8 @@ def test_bad_wind_exits_2_in_one_line_and_writes_nothing(tmp_path, wind, says):
 @pytest.mark.parametrize("changes, says", [
     ({"ends": {"circle_radius_m": 0.1, "circle_frequency_Hz": 1.0}},
      "ends.circle_radius_m: 0.1 > 0: the circle of Eq. (70) moves the top end"),
-    ({"lifter": {"top": "lifted", "force_N": 500.0}},
-     "lifter.top: 'lifted': 'operate' solves the operating points with the top end held"),
+    ({"lifter": {"top": "lifted", "force_N": 10.0}},
+     "lifter.force_N: the lifter cannot hold the helix up"),
     ({"torsion_hysteresis": {"rho": 0.5, "beta_m_n": 0.5}},
      "torsion_hysteresis.rho: 0.5 < 1 (hysteretic torsion)"),
     ({"discretisation": {"scheme": "spline"}},
@@ -169,3 +169,79 @@ def test_the_figure_names_the_branches_the_fold_and_the_first_limit(tmp_path, mo
                for line in top.lines)  # the first limit's wind speed
     assert any("first limit: slack" in t.get_text() for t in top.texts)
     assert (tmp_path / "p.png").stat().st_size > 10_000
+
+
+def test_stable_is_the_linearisations_not_the_rigid_shafts():
+    """The paper's law (k1 = k2 = 0.5, 120 rpm): the rigid shaft's slope dQ/dOmega - K2
+    stays negative at 9 and 11 m/s, but the rotor's 0.3 Hz mode on the helix's twist
+    grows at 11 m/s (docs/explanation/campbell.md): operate's ``stable`` says so, and its
+    growth rate is the two-inertia model's (numpy, tests/test_campbell.py) within 0.06 /s
+    (measured at N = 4: -0.66 / -0.65 at 9 m/s, +0.20 / +0.22 at 11 m/s)."""
+    from rawehelix.solvers.spin_modes import rod_polar_inertia_kgm2
+    from tests.test_campbell import two_inertias
+    params = rh.load_scene("rotor_example", elements=4, overrides={
+        "generator.law": "paper", "generator.mppt_gain_Nms2": 0.0, "controller.k1": 0.5,
+        "controller.k2": 0.5, "controller.target_rpm": 120.0})
+    result = operate.compute(params, [9.0, 11.0], comm=MPI.COMM_SELF)
+    s = result.summary
+    assert [p["stable"] for p in s["points"]] == [True, False]
+    assert [d["rigid_shaft_stable"] for d in s["details"]] == [True, True]
+    q = params.normalised()
+    J_rod, k = rod_polar_inertia_kgm2(q), q.torque_scale
+    K1, K2 = 0.5 * q.torque_scale, 0.5 * q.torque_scale * q.t_scale  # Eq. (40) in SI
+    rotor = rotor_of(params)
+    for p, d in zip(result.points, s["details"]):
+        dQ = rotor.dtorque_domega(p.omega_rad_s, p.v_n_m_s, 1.225)
+        lumped = two_inertias(params.rotor.spin_inertia_kgm2 + J_rod / 2, J_rod / 2, k, K1,
+                              K2, dQ)
+        assert d["max_real_part_per_s"] == pytest.approx(lumped, abs=0.06), p.wind_m_s
+
+
+def test_the_spin_drag_takes_its_loss_between_the_rotor_and_the_ground():
+    """``[spin_drag]`` on (a thick tether, d = 2 cm), gravity and drag off (a straight
+    solid helix): the ground's torque is Q - c L0 Omega|Omega| (parameters/spin_drag.py's
+    loss), the point still balances Q = tau_gen + loss, and the twist end to end is the
+    closed form of a linearly varying torque (tests/test_spin_drag.py), to 1e-9."""
+    from rawehelix.parameters import spin_drag
+    from tests.test_spin_drag import linear_torque_twist
+    params = rh.load_scene("rotor_example", elements=4, overrides={
+        "spin_drag.tether_diameter_m": 0.02, "model.gravity": False, "model.drag": False})
+    point, = operate.compute(params, [6.0], comm=MPI.COMM_SELF).points
+    omega, Q = point.omega_rad_s, point.torque_top_Nm
+    loss = float(spin_drag.loss_of(params).torque(omega))
+    assert loss > 0.03 * Q  # seen, not lost in the tolerance
+    assert point.torque_ground_Nm == pytest.approx(Q - loss, rel=1e-12)
+    tau = GeneratorLaw("mppt", mppt_gain_Nms2=params.generator.mppt_gain_Nms2).torque(omega)
+    assert Q == pytest.approx(tau + loss, rel=1e-9)
+    L0, GJ = params.helix.length_m, params.helix.GJ_Nm2
+    closed = linear_torque_twist(L0, Q, spin_drag.coefficient(params), omega, L0, GJ)
+    assert point.twist_rad == pytest.approx(closed, rel=1e-9)
+
+
+def lifted_scene(N=2, **changes):
+    """rotor_example with its top lifted by 300 N at 50 deg (MPPT)."""
+    return rh.load_scene("rotor_example", elements=N).replace(
+        lifter={"top": "lifted", "force_N": 300.0, "elevation_deg": 50.0}, **changes)
+
+
+def test_a_lifted_top_takes_the_thrust_into_the_tension():
+    """``lifter.top = "lifted"``: each point is the lifted stationary state under the
+    rotor's torque and its thrust along the solved end tangent (solvers/lifted.py), so
+    the tension at the ground rises with the thrust; the point's top is where a lifted
+    stationary solve from the chord under the same thrust and torque puts it (1e-8 m),
+    V_n is the wind along that solved end tangent, and the verdict is the rigid shaft's."""
+    from rawehelix.solvers import lifted
+    params = lifted_scene()
+    result = operate.compute(params, [5.0, 8.0], comm=MPI.COMM_SELF)
+    (low, high), details = result.points, result.summary["details"]
+    assert high.thrust_N > low.thrust_N + 50
+    ground = [d["tension_ground_N"] for d in details]
+    # the ground's tension takes the extra thrust (within the lifter's turn and the drag)
+    assert ground[1] - ground[0] == pytest.approx(high.thrust_N - low.thrust_N, rel=0.2)
+    for p, d in zip(result.points, details):
+        assert d["stability_from"] == "rigid shaft" and p.stable == p.rigid_shaft_stable
+        at = operate.at_wind(params, p.wind_m_s)
+        _, alone = lifted.stationary(at, comm=MPI.COMM_SELF, top_torque_Nm=p.torque_top_Nm,
+                                     omega_rad_s=p.omega_rad_s, tangent_thrust_N=p.thrust_N)
+        assert d["top_m"] == pytest.approx(alone.top_m, abs=1e-8)
+        assert p.v_n_m_s == pytest.approx(p.hub_wind_m_s * abs(alone.end_tangent[0]), rel=1e-8)

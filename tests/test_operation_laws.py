@@ -226,3 +226,25 @@ def test_the_scene_without_the_machine_has_no_laws():
     assert from_params(p) is None and gen_law.from_params(p) is None
     assert wind_law.from_params(p).speed_m_s == p.environment.wind_speed_m_s
     assert wind_law.air_density(p) == p.environment.air_density_kg_m3
+
+
+def test_the_tables_top_row_is_not_left_by_round_off():
+    """A table tsr = linspace(0.5, 10, 96), R = 0.8 m, at V_n = 3.44893 m/s: the grid's
+    first spin 0.5 V_n / R gave back a ratio 1 ulp below 0.5 and raised OutOfTable
+    ("tip-speed ratio 0.5 ... outside"; the same at the top row for other R, V_n).  The
+    roots are found, and agree with scipy's roots of Q = k Omega^2 on the table."""
+    lam = np.linspace(0.5, 10.0, 96)
+    cp = 0.45 * np.sin(np.pi * (lam - 0.5) / 9.5) ** 2 + 0.01
+    R = 0.8
+    law = RotorLaw(lam, cp, 0.8 * lam / (1 + lam), radius_m=R)
+    v, rho = 3.44893, 1.225
+    k = 0.002  # [N m s^2]: near the optimal gain of this R
+    points = rigid_shaft.operating_points(law, gen_law.GeneratorLaw("mppt", mppt_gain_Nms2=k),
+                                          v, rho)
+    Cp = PchipInterpolator(lam, cp)
+    f = lambda x: 0.5 * rho * math.pi * R**2 * v**3 * Cp(x) / (x * v / R) - k * (x * v / R) ** 2  # noqa: E731
+    x = np.linspace(0.5, 10.0, 20001)
+    g = f(x)
+    roots = [brentq(f, x[i], x[i + 1], xtol=1e-15)
+             for i in np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:]))]
+    assert roots and [p.tsr for p in points] == pytest.approx(roots, rel=1e-9)

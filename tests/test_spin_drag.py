@@ -26,6 +26,13 @@ def _spinning(d=0.004, N=4, **changes):
                      **changes)
 
 
+def linear_torque_twist(s, Q, c, omega, L0, GJ):
+    """alpha(s) [rad] of a straight solid helix with the ground's twist held, the torque Q
+    [N m] at the top and the spin drag's -c Omega|Omega| per length: M(s) = Q - c W|W|
+    (L0 - s), so alpha(s) = [Q s - c W|W| (L0 s - s^2/2)] / GJ (SI)."""
+    return (Q * s - c * omega * abs(omega) * (L0 * s - s**2 / 2)) / GJ
+
+
 def test_off_by_default_and_its_coefficient():
     p = scene.load("stationary_table2")
     assert not p.model.spin_drag.active and p.normalised().spin_drag == 0.0
@@ -54,7 +61,7 @@ def test_twist_of_a_spinning_helix_is_the_linear_torque_closed_form(rpm):
     s, alpha = fields.gather(rod.w.sub(rod.model.index("twist")).collapse())
     s = q.length_m(s)
     c = spin_drag.coefficient(p)
-    closed = (Q * s - c * omega * abs(omega) * (L0 * s - s**2 / 2)) / GJ
+    closed = linear_torque_twist(s, Q, c, omega, L0, GJ)
     assert np.max(np.abs(alpha[:, 0] - closed)) < 1e-9 * np.max(np.abs(closed))
     loss = spin_drag.loss_torque(omega, p)
     assert abs(loss) > 0.05 * abs(Q)  # the loss is seen, not lost in the tolerance
