@@ -19,6 +19,7 @@ from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
 from rawehelix.registry import Registry
 from rawehelix.solvers.harmonic_balance import scope
+from rawehelix.solvers.harmonic_balance.stability import GUARDED
 
 
 class OrbitMethod:
@@ -76,6 +77,10 @@ class HarmonicBalanceMethod(OrbitMethod):
     help = "harmonic balance ('hb': H chosen by accuracy, Hill's method for the multipliers)"
     steps_in_time = False
     reported = True
+    #: when a continued point gets a full Hill solve (solvers/harmonic_balance/stability.py):
+    #: the guarded step gave the same folds and the same verdict at all 135 points of the
+    #: Fig. 8 curve at N = 8 as Hill at every point (benchmarks/results.md, item 15)
+    stability = GUARDED
 
     def choose(self, params: Parameters) -> tuple[str, str]:
         if scope.cannot(params):
@@ -86,7 +91,7 @@ class HarmonicBalanceMethod(OrbitMethod):
 
     def problem(self, params: Parameters):
         from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
-        return HarmonicBalance(params)
+        return HarmonicBalance(params, stability=self.stability)
 
     def state_size(self, params: Parameters) -> int:
         return scope.state_size(params)
