@@ -57,6 +57,7 @@ import numpy as np
 from rawehelix import fits
 
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
+import hb_stability as hb_stability_bench  # benchmarks/hb_stability.py
 import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
@@ -654,11 +655,13 @@ def markdown(r: dict) -> str:
                      f"{c['ratio']:.2f} | {TARGETS['curve']} |")
     if r.get("hb"):
         lines += hb_bench.markdown(r["hb"])
+    if r.get("hb_stability"):
+        lines += hb_stability_bench.markdown(r["hb_stability"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb")
+            "orbits", "curve", "hb", "hb_stability")
 
 
 def main():
@@ -693,7 +696,8 @@ def main():
                      ("study", lambda: study_bench.bench_study(repeats)),
                      ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
                      ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
-                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of))):
+                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of)),
+                     ("hb_stability", lambda: hb_stability_bench.bench_sizes())):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -30,7 +30,7 @@ import numpy as np
 from rawehelix.periodic_orbits.bifurcations import REAL_TOL
 from rawehelix.registry import Registry
 
-STRIDE = 10  # points: a carried point is at most this many points after a Hill solve
+STRIDE = 15  # points: a carried point is at most this many points after a Hill solve
 FOLD_GUARD = 0.05  # |mu - 1| of a real positive multiplier below which Hill is due
 EDGE = 2e-3  # 1 - |mu| off the positive real axis below which Hill is due
 
