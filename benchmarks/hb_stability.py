@@ -17,7 +17,8 @@ import numpy as np
 
 
 def _curve(N: int, step) -> tuple[float, dict, list]:
-    """(CPU [s], summary, the branch's orbits) of the curve with stability step ``step``."""
+    """(CPU [s], summary, the branch's orbits) of the curve with stability step ``step``;
+    the summary's ``hill_cpu_s``: each Hill solve's CPU [s]."""
     import rawehelix as rh
     from rawehelix.solvers.harmonic_balance import problem as hb
     from rawehelix.studies import orbit_method
@@ -46,8 +47,8 @@ def _curve(N: int, step) -> tuple[float, dict, list]:
         hb.HarmonicBalance.finish, hb.HarmonicBalance.hill = finish, hill
         orbit_method.HB.stability = was
     by_f1 = {o.f1_Hz: o for o in seen}
-    result.summary["hill_cpu_s"] = hill_cpu
-    return cpu, result.summary, [by_f1[p["f1_Hz"]] for p in result.summary["branch"]]
+    summary = {**result.summary, "hill_cpu_s": hill_cpu}
+    return cpu, summary, [by_f1[p["f1_Hz"]] for p in summary["branch"]]
 
 
 def _stats(v):
