@@ -125,7 +125,9 @@ PROTOTYPES = (
     "the one kept | kept (the tangent's sign) |",
     "| 15. (a) the guarded Hill offline on today's multipliers, N = 8 "
     "(`hb_stability_floors/policy.py`) | stride 5/10/15/20: 29/16/12/10 Hill solves of 135, "
-    "0 verdicts differing at each | stride 15 kept |",
+    "0 verdicts differing at each; at N = 16 (`today.py 16` dump) stride 15 gives 77 of 137: "
+    "there the largest multiplier off the positive real axis reaches 0.9984 (0.9937 at N = 8), "
+    "inside EDGE = 0.002 of the circle, so Hill is due at most points | stride 15 kept |",
     "| 15. (b) monodromy by Magnus-4 (2 Gauss points, dense expm of 188 x 188) from the HB "
     "samples, N = 8 (`hb_stability_floors/magnus.py`) | 32 / 64 / 128 steps: 2.5 / 4.7 / 9.1 s "
     "a point (expm alone 68 ms); max |mu| 1.28994 / 1.28925 / 1.28920 against Hill's 1.28920 "
