@@ -63,6 +63,7 @@ from rawehelix import fits
 import campbell as campbell_bench  # benchmarks/campbell.py
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
 import operate as operate_bench  # benchmarks/operate.py
+import hb_stability as hb_stability_bench  # benchmarks/hb_stability.py
 import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
@@ -673,11 +674,13 @@ def markdown(r: dict) -> str:
             f"{w['median']:.3f} ({w['min']:.3f}-{w['max']:.3f}), CPU {c['median']:.3f} "
             f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
+    if r.get("hb_stability"):
+        lines += hb_stability_bench.markdown(r["hb_stability"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb", "operate", "campbell")
+            "orbits", "curve", "hb", "operate", "campbell", "hb_stability")
 
 
 def main():
@@ -714,7 +717,8 @@ def main():
                      ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
                      ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of)),
                      ("operate", lambda: operate_bench.bench_operate(8, repeats)),
-                     ("campbell", lambda: campbell_bench.bench_campbell(8, repeats))):
+                     ("campbell", lambda: campbell_bench.bench_campbell(8, repeats)),
+                     ("hb_stability", lambda: hb_stability_bench.bench_sizes())):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -115,6 +115,7 @@ def locate(branch, a: Orbit, b: Orbit, st, kind: str, count_a: int, steps,
                               f"{kind} between {a.f1_Hz:.5f} and {b.f1_Hz:.5f} Hz")
         X, f1, its, res, _, _ = got
         o = branch.problem.finish(X, f1, its, res, time.perf_counter(), steps)
+        branch.problem.stability(o, event=True)
         return o.f1_Hz, o.multipliers, o
 
     lo, hi, f_lo, f_hi, o, probes = bisect_crossing(probe, st.ds, count_a, kind)

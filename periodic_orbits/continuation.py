@@ -290,13 +290,18 @@ class Branch:
         if first is not None:
             self.start(first, direction)
         lo, hi = sorted((self.points[0].f1_Hz, f1_stop))
-        n = self.points[0].X.size
         last = self.points[-1]
         def done(f1):  # out of the window, or at its end (where a natural step lands)
             return not (lo <= f1 <= hi) or abs(f1 - f1_stop) <= STOP_TOL * f1_stop
 
         if len(self.points) > 1 and done(last.f1_Hz):
             return self.points  # a resumed branch that had already left the window
+        with self.problem.deferred_stability(last):
+            self._steps(f1_stop, max_points, done, progress, on_point)
+        return self.points
+
+    def _steps(self, f1_stop, max_points, done, progress, on_point):
+        """:meth:`trace`'s steps, until ``done(f1)`` or ``max_points``."""
         while len(self.points) < max_points:
             prev, st = self.points[-1], self.state
             start = time.perf_counter()
@@ -333,6 +338,9 @@ class Branch:
             # the new point's tangent with the steps it was found with (a natural step:
             # its own at its f1); the events between the two with the last point's
             tau_new, A, gf = self._tangent(orbit, st.tau, orbit.steps)
+            # the multipliers, where the problem defers them: a fold is df1/ds through zero
+            self.problem.stability(orbit, event=bool(np.sign(st.tau[-1]) != np.sign(tau_new[-1]))
+                                   or done(f1))
             events = self._detect(prev, orbit, st, tau_new, steps)
             ds = st.ds
             if its <= 5 or natural:  # an easy corrector (a chord step and a refresh or two),
@@ -355,7 +363,6 @@ class Branch:
                 progress(orbit)
             if done(f1):
                 break
-        return self.points
 
     # -- events -------------------------------------------------------------------------
     def _detect(self, a: Orbit, b: Orbit, st: State, tau_b, steps) -> list[dict]:

@@ -45,6 +45,7 @@ No FE code (numpy only): the spline reference implements it.
 from __future__ import annotations
 
 import abc
+import contextlib
 import dataclasses
 from typing import Callable
 
@@ -271,6 +272,17 @@ class PeriodicOrbitProblem(abc.ABC):
         """The orbit through the solution X at f1, with its Floquet multipliers,
         its samples' extremes and its Jacobian (``start``: perf_counter at the
         Newton's start, for the wall time)."""
+
+    def deferred_stability(self, last: Orbit):
+        """A context in which :meth:`finish` may give an orbit the multipliers of an
+        earlier one, until :meth:`stability` says otherwise (a continuation's trace from
+        its branch's ``last`` point); default: none (every finish computes them)."""
+        return contextlib.nullcontext()
+
+    def stability(self, orbit: Orbit, event: bool) -> None:
+        """The orbit's multipliers brought up to date once the continuation has accepted
+        it (``event``: a fold just passed, the window's end or a bisection's probe);
+        default: nothing (:meth:`finish` computed them)."""
 
     @abc.abstractmethod
     def multipliers(self, X, f1_Hz: float, resolution: int | None = None) -> np.ndarray:

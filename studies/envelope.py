@@ -152,7 +152,8 @@ def _tick(params, key, value, f1_window, method, outdir, progress, f1_step_Hz):
     lo, hi = f1_window
     branch = orbits.compute(p, hi, lo, comm=MPI.COMM_SELF, method=method, superharmonics=(),
                             outdir=None if outdir is None else Path(outdir),
-                            progress=progress, f1_step_Hz=f1_step_Hz)
+                            progress=progress, f1_step_Hz=f1_step_Hz,
+                            every_point=True)  # its PD / NS bands: every point's own Hill
     points = branch.orbits
     m = orbits.problem(p, branch.method)
     limits = branch_limits.OrbitLimits(m, p)
@@ -276,7 +277,7 @@ def compute(params: Parameters, vary: Variable, f1_lo: float, f1_hi: float,
         bifurcations_at = [pieces[k][2][1] for k in range(len(values))]
         used, reason = pieces[0][3], pieces[0][4]
         problem_at = envelope_curves.Problems(
-            lambda v: orbits.problem(params_at(params, vary.key, v), used))
+            lambda v: orbits.problem(params_at(params, vary.key, v), used, every_point=True))
         clock = time.perf_counter()
         curves = envelope_curves.fold_curves(problem_at, vary.key, values, ticks, folds_at,
                                              substeps)

@@ -19,6 +19,7 @@ from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
 from rawehelix.registry import Registry
 from rawehelix.solvers.harmonic_balance import scope
+from rawehelix.solvers.harmonic_balance.stability import EVERY_POINT, GUARDED
 
 
 class OrbitMethod:
@@ -39,9 +40,10 @@ class OrbitMethod:
         the command-line way out where this method cannot run the scene."""
         return self.name, "as asked"
 
-    def problem(self, params: Parameters):
+    def problem(self, params: Parameters, every_point: bool = False):
         """The periodic-orbit problem of this method on this rank (a
-        :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`)."""
+        :class:`~rawehelix.periodic_orbits.problem.PeriodicOrbitProblem`); ``every_point``:
+        each point of a branch gets its own multipliers (no step that carries them)."""
         raise NotImplementedError
 
     def state_size(self, params: Parameters) -> int:
@@ -66,7 +68,7 @@ class Shooting(OrbitMethod):
     def store_header(self) -> dict:  # the stores written before the methods had none
         return {}
 
-    def problem(self, params: Parameters):
+    def problem(self, params: Parameters, every_point: bool = False):
         from rawehelix.studies import schemes
         return schemes.of(params).period_map(params)
 
@@ -76,6 +78,12 @@ class HarmonicBalanceMethod(OrbitMethod):
     help = "harmonic balance ('hb': H chosen by accuracy, Hill's method for the multipliers)"
     steps_in_time = False
     reported = True
+    #: when a continued point gets a full Hill solve (solvers/harmonic_balance/stability.py):
+    #: the guarded step gave the same folds and the same verdict at all 135 points of the
+    #: Fig. 8 curve at N = 8 as Hill at every point (benchmarks/results.md, item 15); the
+    #: envelope asks for every point (``every_point``): its PD / NS curves start on its
+    #: branches' bands, 0.25 Hz wide on the tensegrity (tests/test_envelope.py)
+    stability = GUARDED
 
     def choose(self, params: Parameters) -> tuple[str, str]:
         if scope.cannot(params):
@@ -84,9 +92,9 @@ class HarmonicBalanceMethod(OrbitMethod):
         why = scope.wrong_tool(params)
         return self.name, f"as asked; warning: {why}" if why else "as asked"
 
-    def problem(self, params: Parameters):
+    def problem(self, params: Parameters, every_point: bool = False):
         from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
-        return HarmonicBalance(params)
+        return HarmonicBalance(params, stability=EVERY_POINT if every_point else self.stability)
 
     def state_size(self, params: Parameters) -> int:
         return scope.state_size(params)
@@ -114,8 +122,8 @@ class Auto(OrbitMethod):
             return HB.name, f"auto: harmonic balance, which runs here; warning: {why}"
         return HB.name, "auto: harmonic balance, as every law of the scene is smooth"
 
-    def problem(self, params: Parameters):
-        return get(self.choose(params)[0]).problem(params)
+    def problem(self, params: Parameters, every_point: bool = False):
+        return get(self.choose(params)[0]).problem(params, every_point)
 
     def state_size(self, params: Parameters) -> int:  # sized for harmonic balance's
         return HB.state_size(params)

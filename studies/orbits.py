@@ -179,13 +179,15 @@ def windows(f1_start_Hz: float, f1_stop_Hz: float, ranks: int) -> list[list[floa
     return [[float(edges[k]), float(edges[k + 1])] for k in range(ranks)]
 
 
-def problem(params: Parameters, method: str = orbit_method.default_for("orbits")):
+def problem(params: Parameters, method: str = orbit_method.default_for("orbits"),
+            every_point: bool = False):
     """The scene's periodic-orbit problem of ``method`` on this rank, from the methods'
     registry (studies/orbit_method.py: shooting on its scheme's period map, the FE
     generalised-alpha map or the paper's spline-Galerkin flow, or harmonic balance);
-    a turning ring refused."""
+    a turning ring refused.  ``every_point``: the multipliers of every point of a
+    branch its own (harmonic balance: Hill at every point, not the guarded step)."""
     refuse_turning_ring(params)
-    return orbit_method.get(method).problem(params)
+    return orbit_method.get(method).problem(params, every_point)
 
 
 def refuse_turning_ring(params: Parameters) -> None:
@@ -232,14 +234,15 @@ def branch(m, tension_step: float | None = None, sites=(), f1_step_Hz=None, **op
 
 
 def _trace_window(params, window, tension_step, max_points, store, progress, stop,
-                  superharmonics=(), method=orbit_method.default_for("orbits"), f1_step_Hz=None):
+                  superharmonics=(), method=orbit_method.default_for("orbits"), f1_step_Hz=None,
+                  every_point=False):
     """One window on this rank: (entries, folds, bifurcations, peaks, its sites)."""
     from rawehelix.periodic_orbits.resonances import sites_for
     from rawehelix.solvers.snes import SolverError
 
     start_f1, stop_f1 = window
     lo, hi = sorted(window)
-    m = problem(params, method)
+    m = problem(params, method, every_point)
     sites, about = (), {"sites": []}
     if superharmonics:
         try:
@@ -282,13 +285,14 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
             progress=None, outdir=None, tension_step: float | None = None,
             max_points: int = 400, superharmonics=None,
             method: str = orbit_method.default_for("orbits"),
-            f1_step_Hz: float | None = None) -> OrbitsResult:
+            f1_step_Hz: float | None = None, every_point: bool = False) -> OrbitsResult:
     """The branch from f1_start to f1_stop (either order), one window per rank
     of ``comm``; with ``outdir``, stored point by point and resumed from it.
     ``superharmonics``: the orders k of the k:1 sites the step closes in on
     (default SUPERHARMONIC_ORDERS; () for none); ``method``: "shooting", "hb" or
     "auto" (studies/orbit_method.py); ``f1_step_Hz``: the most a step moves f1 (None: as
-    the step control takes it)."""
+    the step control takes it); ``every_point``: every point's multipliers its own
+    (:func:`problem`)."""
     from rawehelix.periodic_orbits.resonances import SUPERHARMONIC_ORDERS, TENSION_STEP
     from rawehelix.solvers.snes import SolverError
 
@@ -330,7 +334,7 @@ def compute(params: Parameters, f1_start_Hz: float, f1_stop_Hz: float, comm=MPI.
     error, sent, piece = None, [], None
     try:
         piece = _trace_window(params, cuts[comm.rank], tension_step, max_points, store,
-                              progress, stop, superharmonics, method, f1_step_Hz)
+                              progress, stop, superharmonics, method, f1_step_Hz, every_point)
     except _Stopped:
         error = (False, f"rank {comm.rank}: stopped")
     except Exception as err:  # noqa: BLE001 - reported on every rank below

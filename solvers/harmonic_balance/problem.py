@@ -33,6 +33,7 @@ harmonics, which the accuracy test shows (docs/explanation/harmonic_balance.md).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 
@@ -43,6 +44,7 @@ from rawehelix.parameters import Parameters
 from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.harmonic_balance import harmonics, hill, newton
+from rawehelix.solvers.harmonic_balance.stability import EVERY_POINT, StabilityStep
 from rawehelix.solvers.harmonic_balance.newton import Diverged
 from rawehelix.solvers.harmonic_balance.scope import H_MAX, H_START, cannot
 from rawehelix.solvers.harmonic_balance.sparse_lu import LU
@@ -63,7 +65,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
 
     def __init__(self, params: Parameters, H: int | None = None, comm=MPI.COMM_SELF,
                  solver: DynamicsSolver | None = None, tail_tol: float = TAIL_TOL,
-                 H_max: int = H_MAX, oversample: int = 1):
+                 H_max: int = H_MAX, oversample: int = 1,
+                 stability: StabilityStep = EVERY_POINT):
         if comm.size > 1:
             raise SolverError("orbits --method hb runs on one rank; run separate frequency "
                               "windows on separate ranks")
@@ -85,6 +88,11 @@ class HarmonicBalance(PeriodicOrbitProblem):
         except RuntimeError:
             self._linear_tension = False
         self._cache = {}  # H -> (Basis, BlockPattern); (f1, H) -> g^ at the bc dofs
+        self.stability_step = stability  # when a continued point gets a Hill solve (.stability)
+        self._deferring = False  # inside a trace that calls stability() (deferred_stability)
+        self._last_hill = None  # (multipliers, f1 [Hz]) of the last Hill solve
+        self._since = 0  # accepted points since it
+        self._pending = None  # (X, f1, H, tangents) of the last carried finish
         self.X_stationary = self.embed(op.X_stationary[:self.n], self.H)
 
     # -- the layout ------------------------------------------------------------------
@@ -320,18 +328,64 @@ class HarmonicBalance(PeriodicOrbitProblem):
         H = self._H(X, resolution)
         basis = self.basis(H)
         G, tension, tangents = self.sampled(X, f1_Hz, resolution=H)
-        J, floquet = self._jacobian(tangents, f1_Hz, H), self.hill(f1_Hz, H, tangents)
+        J = self._jacobian(tangents, f1_Hz, H)
         T = self.q.tension_N(tension)
-        return Orbit(f1_Hz=f1_Hz, X=X, delta=self.q_base.spin_target * 2 * math.pi /
-                     self.omega(f1_Hz), tension_max_N=float(T.max()),
-                     tension_min_N=float(T.min()), multipliers=floquet.multipliers,
-                     newton_iterations=iterations, residual=float(residual), steps=H,
-                     wall_s=time.perf_counter() - start, G=G, jacobian=J,
-                     accuracy={"H": H, "samples": basis.N,
-                               "tail": basis.tail(self.coefficients(X, H)),
-                               "stability": floquet.method + f"; the exponents near 0, "
-                               f"i w / 2 and the {SHIFTS} least damped of the averaged "
-                               f"system, not the whole spectrum"})
+        orbit = Orbit(f1_Hz=f1_Hz, X=X, delta=self.q_base.spin_target * 2 * math.pi /
+                      self.omega(f1_Hz), tension_max_N=float(T.max()),
+                      tension_min_N=float(T.min()), multipliers=np.zeros(0),
+                      newton_iterations=iterations, residual=float(residual), steps=H,
+                      wall_s=time.perf_counter() - start, G=G, jacobian=J,
+                      accuracy={"H": H, "samples": basis.N,
+                                "tail": basis.tail(self.coefficients(X, H))})
+        if self._deferring and self._last_hill is not None:  # stability() decides
+            self._carry(orbit)
+            self._pending = (X, f1_Hz, H, tangents)
+        else:
+            self._floquet(orbit, tangents)
+        return orbit
+
+    def _floquet(self, orbit: Orbit, tangents) -> None:
+        """The orbit's multipliers by Hill's method from its tangents."""
+        floquet = self.hill(orbit.f1_Hz, orbit.steps, tangents)
+        orbit.multipliers = floquet.multipliers
+        orbit.accuracy["stability"] = (floquet.method + f"; the exponents near 0, i w / 2 and "
+                                       f"the {SHIFTS} least damped of the averaged system, "
+                                       f"not the whole spectrum")
+        orbit.accuracy.pop("hill_f1_Hz", None)
+        self._last_hill, self._since = (floquet.multipliers, orbit.f1_Hz), 0
+
+    def _carry(self, orbit: Orbit) -> None:
+        """The last Hill solve's multipliers, said so (the guarded stability step)."""
+        mu, f1 = self._last_hill
+        orbit.multipliers = mu.copy()
+        orbit.accuracy["stability"] = (f"carried from the Hill solve at f1 = {f1:.6g} Hz (no "
+                                       f"fold since; guarded stability step, "
+                                       f"docs/explanation/harmonic_balance.md)")
+        orbit.accuracy["hill_f1_Hz"] = f1
+
+    @contextlib.contextmanager
+    def deferred_stability(self, last: Orbit):
+        """Inside a trace, finish carries the last Hill's multipliers and
+        :meth:`stability` runs Hill where the stability step says it is due."""
+        if not self.stability_step.carries:
+            yield
+            return
+        self._deferring, self._last_hill, self._since = True, (last.multipliers, last.f1_Hz), 0
+        try:
+            yield
+        finally:
+            self._deferring, self._pending = False, None
+
+    def stability(self, orbit: Orbit, event: bool) -> None:
+        if not (self._deferring and "hill_f1_Hz" in orbit.accuracy):
+            return
+        self._since += 1
+        if not self.stability_step.due(self._last_hill[0], self._since, event):
+            return
+        X, f1, H, tangents = self._pending or (None, None, None, None)
+        if X is not orbit.X or f1 != orbit.f1_Hz or H != orbit.steps:
+            tangents = self.sampled(orbit.X, orbit.f1_Hz, resolution=orbit.steps)[2]
+        self._floquet(orbit, tangents)
 
     def hill(self, f1_Hz: float, H: int, tangents):
         """Hill's exponents from the tangents at the AFT's samples (:meth:`sampled`)."""
