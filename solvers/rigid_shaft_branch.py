@@ -23,6 +23,7 @@ spin inertia): 1 at a fold, < 1 where the point is stable.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import time
@@ -142,6 +143,13 @@ class RigidShaftProblem:
 
     def settle(self, X, G):
         return X
+
+    def deferred_stability(self, last):
+        """Every point's multiplier is computed at its finish (a scalar): nothing deferred."""
+        return contextlib.nullcontext()
+
+    def stability(self, point, event: bool) -> None:
+        """Nothing to bring up to date (:meth:`deferred_stability`)."""
 
     def multipliers(self, X, f1_Hz: float, resolution=None) -> np.ndarray:
         slope = self._slope(X, f1_Hz)

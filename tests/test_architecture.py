@@ -31,6 +31,11 @@ LONG: dict[str, str] = {
                            "the states it takes and returns and what it reports of them are "
                            "dynamics_states.py and dynamics_outputs.py, the time data it "
                            "installs (the wind, a release) solvers/weather.py",
+    "solvers/harmonic_balance/problem.py": "HarmonicBalance, the periodic-orbit problem by "
+                                           "harmonic balance (its residual, Jacobian, Newton, "
+                                           "and where the guarded stability step hooks in); "
+                                           "the Fourier algebra is harmonics.py, Hill's method "
+                                           "hill.py, the guard's rules stability.py",
 }
 
 

@@ -170,7 +170,7 @@ def _operate(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies import operate
     winds = operate.parse_wind(args.wind)
     operate.plan(params, winds, key="--wind", text=args.wind)  # numpy: refuses before any work
-    outdir_check.check(outdir, "operate", points=len(winds))
+    outdir_check.check(outdir, needs.get("operate"), points=len(winds))
     result = rh.operate(params, winds, comm=comm)
     return _written(comm, result, operate.report(result), outdir)
 
@@ -190,7 +190,7 @@ def _campbell(rh, params, args, outdir, comm) -> int:
     envelope = campbell.read_envelope(args.envelope) if args.envelope is not None else None
     campbell.refuse_moving_top(params)
     operate.plan(params, winds, key="--wind", text=args.wind)  # numpy: refuses before any work
-    outdir_check.check(outdir, "campbell", points=len(winds))
+    outdir_check.check(outdir, needs.get("campbell"), points=len(winds))
     result = rh.campbell(params, wind_m_s=winds, envelope=envelope, comm=comm)
     if comm.rank == 0:
         result.write(outdir)
