@@ -37,7 +37,7 @@ from mpi4py import MPI
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, schemes
+from rawehelix.studies import limits, network_simulate, schemes
 from rawehelix.studies.analysis import metrics, structure_limits
 from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
@@ -248,6 +248,10 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
         raise SceneError(params.name, "discretisation.scheme", refusal)
     if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
         raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
+    own = schemes.of(params).time_series(params, until_s if until_s is not None
+                                         else params.time.until_s)
+    if own is not None:  # a scheme with its own time integration (the network)
+        return own
     limits.check_bending_resolution(params, "simulate")
     # a fixed step must resolve the forcing and the modes a moving end excites
     adapt = (options or {}).get("ts_adapt_type")
@@ -337,5 +341,5 @@ def report(result: TimeSeries) -> str:
                      f"{f['spin_rpm']['L0']:.3f} rpm (s = 0, L0/2, L0), ground torque "
                      f"{f['ground_torque_Nm']:.3f} Nm, T(0) = {f['tension_s0_N']:.2f} N"
                      + (f"; settled (2 %) at {settle:.3f} s" if settle is not None else ""))
-    lines[-1] += structure_limits.line(s.get("limits"))
+    lines[-1] += structure_limits.line(s.get("limits")) + network_simulate.line(s)
     return "\n".join(lines)

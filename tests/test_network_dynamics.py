@@ -126,3 +126,59 @@ def test_the_spin_up_balances_the_end_torques():
     assert momentum(mo) == pytest.approx(impulse, rel=1e-6)
     target = p.controller.target_rpm * 2 * math.pi / 60
     assert integ.spin(mo) == pytest.approx(target, rel=1e-2)
+
+
+def test_a_step_past_the_stability_bound_fails_with_advice():
+    """Three times the splitting's stability bound: the motion diverges and the error
+    names time.dt_s."""
+    from rawehelix.references.network import NetworkError
+    net = Network.from_parameters(table2(drag=False))
+    st = solve(net)
+    push = np.zeros((net.count, 6))
+    push[1:-1, 2] = 1e-3
+    mo = dy.at_rest(en.moved(net, st.state, push.ravel()))
+    integ = dy.Integrator(net, dy.Drive(), 3 * dy.stable_step(net, st.state))
+    with pytest.raises(NetworkError, match="lower time.dt_s"):
+        for _ in range(2000):
+            integ.step(mo)
+
+
+def test_simulate_through_the_scheme_registry_starts_from_the_stationary_network():
+    """``simulate --scheme network`` (studies/simulate.py through the registry): the
+    first row's bay forces are the stationary network's T at the ground and the top
+    (StationaryNetwork.tension_N, 1e-9), at rest; the spins then rise under the
+    torque ramp, the top's first."""
+    from rawehelix.studies import simulate
+    p = scene.load("nominal_operation").replace(
+        section=SECTION, model={"kinematics": "extensible"},
+        discretisation={"scheme": "network"})
+    series = simulate.compute(p, until_s=0.3)
+    T = solve(Network.from_parameters(p, end_torque_Nm=0.0)).tension_N()
+    assert series.tension_s0_N[0] == pytest.approx(T[0], rel=1e-9)
+    assert series.tension_s1_N[0] == pytest.approx(T[-1], rel=1e-9)
+    assert np.all(series.spin_rpm[0] == 0)
+    assert len(series.t_s) == round(0.3 / p.time.output_every_s) + 1
+    final = series.spin_rpm[-1]
+    assert final[2] > final[1] > final[0] > 0  # the torque enters at the top
+    assert series.summary["network"]["rings"] == 5
+    assert "network: 5 rings" in simulate.report(series)
+
+
+def test_the_sweeps_backend_resumes_from_its_packed_state_exactly():
+    """The sweep's backend (references/network/forced.py) on Sec. 5.3's circle at 3 Hz:
+    advancing 0.2 s in one go or stopping, packing, unpacking and continuing gives the
+    same motion and the same T(0) (to 1e-12: the restart puts the top on its circle at
+    the stored time, not the time summed step by step)."""
+    from rawehelix.references.network.forced import NetworkBackend
+    p = scene.load("mobile_end").replace(section=SECTION, model={"kinematics": "extensible"})
+    ts = p.normalised().t_scale
+    b = NetworkBackend(p)
+    start = b.stationary()
+    b.set_frequency(3.0, 0.0)
+    whole, T_whole = b.advance(start, 0.0, 0.2 / ts, np.array([0.1 / ts, 0.2 / ts]))
+    half, T1 = b.advance(start, 0.0, 0.1 / ts, np.array([0.1 / ts]))
+    again, T2 = b.advance(NetworkBackend.unpack(NetworkBackend.pack(half)), 0.1 / ts, 0.2 / ts,
+                          np.array([0.2 / ts]))
+    assert np.max(np.abs(again.state.X - whole.state.X)) < 1e-12
+    assert np.r_[T1, T2] == pytest.approx(T_whole, rel=1e-12)
+    assert abs(T_whole[0] - T_whole[1]) > 1e-6  # the circle moves it

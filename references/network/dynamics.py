@@ -83,14 +83,14 @@ class Drive:
             raise ValueError("Drive: give the top's position and velocity together")
 
     @classmethod
-    def from_parameters(cls, params, f1_Hz: float | None = None) -> "Drive":
+    def from_parameters(cls, params, f1_Hz: float | None = None, t_start_s: float = 0.0) -> "Drive":
         """A scene's ends as the FE runs them: the torque ramp of Eq. (69) at the top,
         the controller of Eq. (40) at the ground when it is active (else the ground's
         turn held), the top on the circle of Eq. (70) when it moves (at ``f1_Hz``
-        when given, phase 0 at t = 0)."""
+        when given, at phase 0 at ``t_start_s``, as a sweep restarts it)."""
         q = params.normalised()
         if f1_Hz is not None:
-            q = q.at_frequency(f1_Hz)
+            q = q.at_frequency(f1_Hz, t_start_s / q.t_scale)
         L0, ts, Mt = q.L0, q.t_scale, q.torque_scale  # [m], [s], GJ / L0 [N m]
         top = {}
         if q.moving_end:
@@ -250,9 +250,10 @@ class Integrator:
     def step(self, mo: Motion, h: float | None = None) -> Motion:
         """One step of h (default dt_s) in place; returns mo."""
         h = self.dt if h is None else h
-        self._kick(mo, h / 2, implicit=False)
-        self._drift(mo, h)
-        self._kick(mo, h / 2, implicit=True)
+        with np.errstate(all="ignore"):  # a diverging motion is caught below
+            self._kick(mo, h / 2, implicit=False)
+            self._drift(mo, h)
+            self._kick(mo, h / 2, implicit=True)
         self.steps += 1
         if not (np.all(np.isfinite(mo.state.X)) and np.all(np.isfinite(mo.L))):
             raise NetworkError(
@@ -298,6 +299,17 @@ class Integrator:
     def drag_power_W(self, mo: Motion) -> float:
         """The drag's power beyond its value at rest (which the potential holds) [W]."""
         return float(np.sum((self._drag(mo.V) - self.drag0)[1:-1] * mo.V[1:-1]))
+
+
+def bay_tension_N(net: Network, s: en.State, bay: int = 0) -> float:
+    """A bay's axial force [N] (0: at the ground, -1: at the top): its tethers' and bar's
+    forces along the line of its ring centres (the continuum's T there)."""
+    b = bay % (net.count - 1)
+    d = en.tether_chords(net, s)[2][b]
+    ub = s.X[b + 1] - s.X[b]
+    ub = ub / np.linalg.norm(ub)
+    u = d / np.linalg.norm(d, axis=-1)[:, None]
+    return float(en.tether_forces(net, s)[b] @ (u @ ub) + en.bar_forces(net, s)[b])
 
 
 def at_rest(start: en.State, t: float = 0.0, drive: Drive | None = None) -> Motion:
