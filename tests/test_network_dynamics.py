@@ -182,3 +182,24 @@ def test_the_sweeps_backend_resumes_from_its_packed_state_exactly():
     assert np.max(np.abs(again.state.X - whole.state.X)) < 1e-12
     assert np.r_[T1, T2] == pytest.approx(T_whole, rel=1e-12)
     assert abs(T_whole[0] - T_whole[1]) > 1e-6  # the circle moves it
+
+
+def test_the_members_twist_inertia_puts_the_continuums_torsional_modes_at_the_hoops():
+    """section.twist_inertia = "members" without rings: the helix's mass at the
+    tethers' radius, J' = (M / L0) R^2 per unit length (the network's default hoop),
+    instead of Eq. (27)'s 2 (M / L0) EI / EA (19.5x larger here).  The FE continuum's
+    torsional modes (Table 2, fixed ends, gamma off) are then the twist wave's
+    k / (2 L0) sqrt(GJ / J') (5e-4 at N = 4, p = 3), and the default scene's delta is
+    unchanged."""
+    from mpi4py import MPI
+    from rawehelix.studies import modes as fe_modes
+    base = scene.load("stationary_table2", elements=4, degree=3)
+    p = base.replace(section={"twist_inertia": "members"})
+    h = p.helix
+    J = h.mass_kg / h.length_m * h.radius_m ** 2  # [kg m]
+    assert p.normalised().delta / base.normalised().delta == pytest.approx(
+        2 * h.EI_Nm2 / (h.EA_N * h.radius_m ** 2), rel=1e-12)
+    found = fe_modes.compute(p, comm=MPI.COMM_SELF)
+    f = sorted(m.frequency_Hz for m in found if m.family == "torsional" and m.period_s)[:2]
+    k = np.arange(1, 3)
+    assert f == pytest.approx(k / (2 * h.length_m) * math.sqrt(h.GJ_Nm2 / J), rel=5e-4)
