@@ -39,6 +39,9 @@ sections and keeps the others' last results.
     sweep (``rawehelix sweep --f1 0.5:15:0.5``) at the same N and dt, each a
     whole command in turn, CPU time of the command (``--curve-repeats`` runs,
     default 1: about 15 min a run at N = 8).
+15. ``network``: the network reference against the FE continuum at equal accuracy
+    (benchmarks/network.py): a Sec. 5.2 spin-up second and a sweep point at 3 Hz,
+    CPU time, ratios of medians.
 """
 
 from __future__ import annotations
@@ -57,6 +60,7 @@ import numpy as np
 from rawehelix import fits
 
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
+import network as network_bench  # benchmarks/network.py
 import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
@@ -654,11 +658,13 @@ def markdown(r: dict) -> str:
                      f"{c['ratio']:.2f} | {TARGETS['curve']} |")
     if r.get("hb"):
         lines += hb_bench.markdown(r["hb"])
+    if r.get("network"):
+        lines += network_bench.markdown(r["network"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb")
+            "orbits", "curve", "hb", "network")
 
 
 def main():
@@ -693,7 +699,8 @@ def main():
                      ("study", lambda: study_bench.bench_study(repeats)),
                      ("orbits", lambda: bench_orbits((4,) if args.quick else (4, 8))),
                      ("curve", lambda: bench_curve(4 if args.quick else 8, args.curve_repeats)),
-                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of))):
+                     ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of)),
+                     ("network", lambda: network_bench.bench_network(stats, repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()
