@@ -35,7 +35,8 @@ hoop's, m R^2 and m R^2 / 2.  The tethers are massless.
 a bay's share on its tethers: a uniform dead load along each tether, which is
 exactly one on the ring centres (the n attachment points sum to the centre), so
 each ring carries l of it (the end rings l / 2).  Both follow the model's
-gravity and drag switches.
+gravity and drag switches.  In time (:mod:`.dynamics`) the drag follows each ring's
+velocity, -c_i |v_A| v_A with v_A = v - wind (``drag_kg_m``, ``wind_m_s``).
 
 **Ends** (Eq. 66): the ground ring at 0 in its reference frame; the top ring at the
 elongated chord (1 + eps0) L0 (cos Gamma0 (-i_E) + sin Gamma0 (-k_E)) (on the circle of
