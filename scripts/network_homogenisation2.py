@@ -5,6 +5,7 @@ several ring spacings.  Prints the tables of docs/explanation/network.md.
 
     .venv/bin/python scripts/network_homogenisation2.py torque [--rings 5,9,17,33,65]
     .venv/bin/python scripts/network_homogenisation2.py spinup --fe DIR [--rings 5,9,17]
+    .venv/bin/python scripts/network_homogenisation2.py forced [--rings 5,9] [--f1 2,4,6]
 
 ``spinup`` reads the FE run's time_series.csv from DIR, made by
 ``rawehelix simulate nominal_operation --until 5 -o DIR`` with the SECTION keys below
@@ -120,13 +121,43 @@ def spinup(rings_list, fe_dir, times=(1.0, 2.0, 5.0)):
                   f"{100 * (T5 / fe_at[times[-1]][1] - 1):+.3f} % | {wall:.1f} |", flush=True)
 
 
+def forced(rings_list, f1_list, fe_elements=8):
+    """Sec. 5.3's sweep points (mobile_end, the fitted section, lead-in 2 s): T max and
+    T min at s = 0 over the recorded periods, network against the FE at N = fe_elements."""
+    from mpi4py import MPI
+    from rawehelix.studies import sweep
+    base = scene.load("mobile_end", elements=fe_elements, degree=3).replace(
+        model={"kinematics": "extensible"}, section=SECTION, sweep={"lead_in_s": 2.0})
+
+    def points(p):
+        r = sweep.compute(p, f1_list, comm=MPI.COMM_SELF, track=False, log=lambda m: None)
+        return {x["f1_Hz"]: x for x in r.points}
+
+    fe = points(base)
+    print(f"continuum (FE N = {fe_elements}, p = 3): " + ", ".join(
+        f"{f:g} Hz: T {fe[f]['tension_min_N']:.2f}-{fe[f]['tension_max_N']:.2f} N" for f in f1_list))
+    print("| rings | l [m] | " + " | ".join(f"T max at {f:g} Hz [N] | gap | T min | gap" for f in f1_list)
+          + " |")
+    print("|---" * (2 + 4 * len(f1_list)) + "|")
+    for rings in rings_list:
+        net = points(base.replace(discretisation={"scheme": "network"}, section={"rings": rings}))
+        cells = " | ".join(
+            f"{net[f]['tension_max_N']:.2f} | {100 * (net[f]['tension_max_N'] / fe[f]['tension_max_N'] - 1):+.2f} % | "
+            f"{net[f]['tension_min_N']:.2f} | {100 * (net[f]['tension_min_N'] / fe[f]['tension_min_N'] - 1):+.2f} %"
+            for f in f1_list)
+        print(f"| {rings} | {base.helix.length_m / (rings - 1):.4g} | {cells} |", flush=True)
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("part", choices=("torque", "spinup"))
+    ap.add_argument("part", choices=("torque", "spinup", "forced"))
+    ap.add_argument("--f1", default="2,4,6")
     ap.add_argument("--rings", default=None)
     ap.add_argument("--fe", default=None)
     a = ap.parse_args()
     if a.part == "torque":
         torque([int(x) for x in (a.rings or "5,9,17,33,65").split(",")])
+    elif a.part == "forced":
+        forced([int(x) for x in (a.rings or "5,9").split(",")], [float(x) for x in a.f1.split(",")])
     else:
         spinup([int(x) for x in (a.rings or "5,9,17").split(",")], a.fe)
