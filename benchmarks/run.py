@@ -43,6 +43,9 @@ sections and keeps the others' last results.
     sweep (``rawehelix sweep --f1 0.5:15:0.5``) at the same N and dt, each a
     whole command in turn, CPU time of the command (``--curve-repeats`` runs,
     default 1: about 15 min a run at N = 8).
+15. ``network``: the network reference against the FE continuum at equal accuracy
+    (benchmarks/network.py): a Sec. 5.2 spin-up second and a sweep point at 3 Hz,
+    CPU time, ratios of medians.
 """
 
 from __future__ import annotations
@@ -64,6 +67,7 @@ import campbell as campbell_bench  # benchmarks/campbell.py
 import harmonic_balance as hb_bench  # benchmarks/harmonic_balance.py
 import operate as operate_bench  # benchmarks/operate.py
 import hb_stability as hb_stability_bench  # benchmarks/hb_stability.py
+import network as network_bench  # benchmarks/network.py
 import study as study_bench  # benchmarks/study.py
 
 HERE = Path(__file__).parent
@@ -676,11 +680,13 @@ def markdown(r: dict) -> str:
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
     if r.get("hb_stability"):
         lines += hb_stability_bench.markdown(r["hb_stability"])
+    if r.get("network"):
+        lines += network_bench.markdown(r["network"])
     return "\n".join(lines) + "\n"
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb", "operate", "campbell", "hb_stability")
+            "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network")
 
 
 def main():
@@ -718,7 +724,8 @@ def main():
                      ("hb", lambda: hb_bench.bench_hb(RAWEHELIX, stats, _cpu_of)),
                      ("operate", lambda: operate_bench.bench_operate(8, repeats)),
                      ("campbell", lambda: campbell_bench.bench_campbell(8, repeats)),
-                     ("hb_stability", lambda: hb_stability_bench.bench_sizes())):
+                     ("hb_stability", lambda: hb_stability_bench.bench_sizes()),
+                     ("network", lambda: network_bench.bench_network(stats, repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

@@ -2,8 +2,8 @@
 
     rawehelix stationary SCENE [-o DIR] [--elements N] [--degree p] [--scheme fe|network] [PETSc options]
     rawehelix modes SCENE [--scheme fe|spline|network] [--elements N] [--degree p] [--count k] [-o DIR]
-    rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [PETSc options]
-    rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme ...] [--elements N]
+    rawehelix simulate SCENE [-o DIR] [--until T] [--no-gif] [--elements N] [--degree p] [--scheme fe|network] [PETSc options]
+    rawehelix sweep SCENE [--f1 START:STOP:STEP] [--series] [-o DIR] [--scheme fe|spline|network] [--elements N]
     rawehelix response SCENE [--f1 START:STOP:STEP] [--elements N] [--degree p] [-o DIR]
     rawehelix section SCENE [--set KEY=VALUE] [-o DIR]
     rawehelix converge SCENE --quantity Q [-o DIR]

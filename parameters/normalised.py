@@ -84,7 +84,7 @@ class Normalised(EndForcing):
             sigma=sigma, mu=mu, beta=beta,
             # the air's density and the reference wind: [wind]'s when it gives them
             nu=wind.air_density(p) * h.drag_length_m * L0**2 * h.drag_coefficient / (2 * M),
-            delta=beta * sigma / (2 * mu),  # (27)
+            delta=_delta(p, beta, sigma, mu),  # (27), or the members' twist inertia
             v_w0=wind.reference_speed(p) / np.sqrt(g * L0),
             # eps0: nan until the elongation of ends.tension_N is found (Parameters.normalised)
             eps0=math.nan if e.elongation is None else e.elongation,
@@ -115,3 +115,14 @@ class Normalised(EndForcing):
 
     def spin_rpm(self, alpha_t):
         return np.asarray(alpha_t) / self.t_scale / RPM
+
+
+def _delta(p, beta, sigma, mu):
+    """delta = GJ / (g L0 J'), J' the twist inertia per unit length: the solid's
+    2 (M / L0) EI / EA (Eq. 27: beta sigma / (2 mu)), or the section's mass
+    distribution (section.twist_inertia = "members", Section.inertia_per_length)."""
+    J = p.model.section.inertia_per_length(p.helix)
+    if J is None:
+        return beta * sigma / (2 * mu)  # (27)
+    h = p.helix
+    return np.float64(h.GJ_Nm2) / (np.float64(p.environment.g_m_s2) * h.length_m * J[0])

@@ -105,14 +105,15 @@ class SplineCore(SchemeCore):
 
 class NetworkCore(SchemeCore):
     """The ring-and-tether network (references/network): a model of its own, run beside
-    the FE continuum; a stationary solve and modes, no time integration yet."""
+    the FE continuum; a stationary solve, modes, and its own time integration
+    (simulate, sweep); no period map (orbits) nor harmonic balance."""
 
     name, has_degree, fixed_time_step, fe_assembled = "network", False, False, False
     beside_continuum = True
-    commands = ("stationary", "modes", "section")
-    integrator = "none (the network has a stationary solve and modes only)"
-    harmonic_balance_refusal = ("the network reference has no time integration yet: use "
-                                "--scheme fe or spline")
+    commands = ("stationary", "modes", "section", "simulate", "sweep")
+    integrator = "Strang splitting of the rigid rings (references/network/dynamics.py)"
+    harmonic_balance_refusal = ("the network reference has no harmonic balance: use "
+                                "--scheme fe, or 'sweep' with --scheme network")
     #: the dense eigenproblem's K, M, their eigenvectors and eigh's work: bytes per dof^2
     BYTES_PER_DOF2 = 40.0
 

@@ -30,6 +30,8 @@ TORSIONS = ("helix", "members")
 #: the ring's phase against the bending plane (members.py): "worst", a member on the
 #: bending plane (the envelope of every phase); "turning", the phase the directors give
 RINGS = ("worst", "turning")
+#: the continuum's twist inertia: Eq. 27's solid, or the section's mass distribution
+TWIST_INERTIAS = ("solid", "members")
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,11 @@ class Section:
     # a ring's moment of inertia about a diameter (network reference) [kg m^2]; None: a
     # hoop's, ring mass x R^2 / 2
     ring_diametral_inertia_kgm2: float | None = None
+    # the continuum's twist inertia (and the shearable rod's rotary inertia): "solid",
+    # the paper's homogeneous solid, 2 rho I = 2 (M / L0) EI / EA (Eq. 27's delta); or
+    # "members", from the section's mass distribution: each ring's inertia (the ring_*
+    # keys) per unit length and the rest of helix.mass_kg at the tethers' radius R
+    twist_inertia: str = "solid"
 
     def __post_init__(self):
         if section_laws.refusal(self.law):
@@ -73,6 +80,9 @@ class Section:
                                  "must be an integer >= 3 (a ring of tethers)")
         if self.torsion not in TORSIONS:
             raise ParameterError("section.torsion", self.torsion, f"must be one of {list(TORSIONS)}")
+        if self.twist_inertia not in TWIST_INERTIAS:
+            raise ParameterError("section.twist_inertia", self.twist_inertia,
+                                 f"must be one of {list(TWIST_INERTIAS)}")
         if self.ring not in RINGS:
             raise ParameterError("section.ring", self.ring, f"must be one of {list(RINGS)}")
         members = section_laws.get(self.law).members  # the law's resultants are its members'
@@ -149,6 +159,34 @@ class Section:
         raise ParameterError("section.rings", None,
                              "--scheme network needs the rings: set section.rings (>= 3, both "
                              "end rings included) or section.ring_spacing_m")
+
+    def inertia_per_length(self, helix) -> tuple[float, float] | None:
+        """(polar, diametral) inertia of the section per unit length [kg m] from its mass
+        distribution (twist_inertia = "members"): the rings' ring_polar_inertia_kgm2 and
+        ring_diametral_inertia_kgm2 (default a hoop's, m R^2 and m R^2 / 2) over the
+        spacing, and the helix's mass the rings do not carry at the tethers' radius R
+        (a thin tube: (M' R^2, M' R^2 / 2)); None: the solid's (Eq. 27)."""
+        if self.twist_inertia == "solid":
+            return None
+        R, mu = self.radius_m or helix.radius_m, helix.mass_kg / helix.length_m  # [m], [kg/m]
+        l = self.spacing(helix)
+        if l is None:  # no rings given: all the mass at the tethers' radius
+            if self.ring_mass_kg is not None or self.ring_polar_inertia_kgm2 is not None \
+                    or self.ring_diametral_inertia_kgm2 is not None:
+                raise ParameterError("section.twist_inertia", self.twist_inertia,
+                                     "with ring masses or inertias needs their spacing: set "
+                                     "section.rings or section.ring_spacing_m")
+            return mu * R * R, mu * R * R / 2
+        m = self.ring_mass_kg if self.ring_mass_kg is not None else mu * l
+        rest = mu - m / l  # the tethers' mass per unit length [kg/m]
+        if rest < -1e-12 * mu:
+            raise ParameterError("section.ring_mass_kg", self.ring_mass_kg,
+                                 f"weighs more than helix.mass_kg per ring spacing ({mu * l:.4g} "
+                                 "kg) for section.twist_inertia = 'members': lower it")
+        rest = max(rest, 0.0)
+        Jp = self.ring_polar_inertia_kgm2 or m * R * R
+        Jd = self.ring_diametral_inertia_kgm2 or m * R * R / 2
+        return Jp / l + rest * R * R, Jd / l + rest * R * R / 2
 
     def describe(self) -> str:
         return (f"section: {self.law}, torsion by the {self.torsion}, {self.tethers} tethers, "

@@ -34,8 +34,11 @@ def normalise(p, scales: dict) -> dict:  # (the members' GA is a field: forms/se
     perpendicular-axis theorem of a planar section, I_d = J / 2."""
     h, M, g, L0 = p.helix, scales["M"], scales["g"], scales["L0"]
     rotary = (p.model.kinematics == "shearable" and p.model.rotary_inertia)
+    J = p.model.section.inertia_per_length(h)  # section.twist_inertia = "members"
+    # its diametral inertia per unit length [kg m] over (M / L0) L0^2
+    Jd = h.EI_Nm2 / (h.EA_N * L0 ** 2) if J is None else J[1] / (M * L0)
     return {"shear_stiffness": 0.0 if h.GA_N is None else h.GA_N / (M * g),
-            "rotary_inertia": h.EI_Nm2 / (h.EA_N * L0 ** 2) if rotary else 0.0}
+            "rotary_inertia": Jd if rotary else 0.0}
 
 
 #: what the shearable rod is not built with (models/shearable.py): key -> why

@@ -7,8 +7,9 @@ name.
 * ``spline``: the paper's spline-Galerkin reference (Sec. 3), integrated by
   Radau with adaptive steps (:mod:`rawehelix.references.spline_galerkin`);
 * ``network``: the tensegrity as rigid rings and tension-only tethers
-  (:mod:`rawehelix.references.network`), its stationary state and modes; ``stationary``
-  prints it beside the FE continuum (:meth:`Scheme.stationary_beside`).
+  (:mod:`rawehelix.references.network`), its stationary state, modes and its own time
+  integration (simulate, sweep); ``stationary`` prints it beside the FE continuum
+  (:meth:`Scheme.stationary_beside`).
 
 A :class:`Scheme` gives what the studies need of a scheme: the stationary
 tension, the spectrum of the linearised stationary state, the forced
@@ -65,6 +66,11 @@ class Scheme(SchemeCore):
     def size_label(self, info: dict) -> str:
         """The discretisation's size in a modes report's header, ``info`` the run's."""
         return f"N = {info['elements']} ("
+
+    def time_series(self, params: Parameters, until_s: float):
+        """``rawehelix simulate``'s TimeSeries by the scheme's own integrator, or None:
+        the FE's dynamics solver runs it (studies/simulate.py)."""
+        return None
 
     def stationary_tension_N(self, params: Parameters) -> float:
         """The stationary tension at s = 0 [N] (Sec. 5.1), on this rank."""
@@ -221,8 +227,6 @@ class Spline(SplineCore, Scheme):
 
 
 class Network(NetworkCore, Scheme):
-    simulate_refusal = ("'simulate' has no network scheme yet (the network reference has a "
-                        "stationary solve and modes): use --scheme fe")
 
     @staticmethod
     def _refused(params, command: str):
@@ -272,8 +276,13 @@ class Network(NetworkCore, Scheme):
                               "model": "network of rigid rings and tension-only tethers "
                                        "(references/network)"})
 
+    def time_series(self, params, until_s):
+        from rawehelix.studies import network_simulate
+        return network_simulate.compute(params, until_s)
+
     def forced_backend(self, params, comm=MPI.COMM_SELF, accurate=False, ts_type=None):
-        self._refused(params, "a forced response")
+        from rawehelix.references.network.forced import NetworkBackend
+        return NetworkBackend(params)
 
     def period_map(self, params):
         self._refused(params, "orbits")

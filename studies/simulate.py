@@ -38,7 +38,7 @@ from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.energy_account import EnergyAccount
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, machine, schemes
+from rawehelix.studies import limits, machine, network_simulate, schemes
 from rawehelix.studies.analysis import metrics, structure_limits
 from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
@@ -251,6 +251,10 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
         raise SceneError(params.name, "discretisation.scheme", refusal)
     if until_s is not None and not (until_s > 0 and np.isfinite(until_s)):
         raise SceneError(params.name, "until", f"{until_s!r}: must be a number of seconds > 0")
+    own = schemes.of(params).time_series(params, until_s if until_s is not None
+                                         else params.time.until_s)
+    if own is not None:  # a scheme with its own time integration (the network)
+        return own
     limits.check_bending_resolution(params, "simulate")
     # a fixed step must resolve the forcing and the modes a moving end excites
     adapt = (options or {}).get("ts_adapt_type")
@@ -384,5 +388,6 @@ def report(result: TimeSeries) -> str:
         lines.append(f"  rotor {f['rotor_rpm']:.3f} rpm, generator power {f['power_W']:.2f} W, "
                      f"thrust {f['thrust_N']:.2f} N at a hub wind of {f['wind_hub_m_s']:.3g} m/s")
     lines[-1] += (machine.startup_line(s.get("startup"), s["simulated_s"])
-                  + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy")))
+                  + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy"))
+                  + network_simulate.line(s))
     return "\n".join(lines)

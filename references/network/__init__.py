@@ -5,7 +5,10 @@ third reference, independent of the continuum's homogenised section.
   bars, masses, loads, ends);
 * :mod:`.energy`: its potential energy, gradient and analytic sparse Hessian;
 * :mod:`.stationary`: Newton with a backtracking line search on the energy;
-* :mod:`.modes`: the stiffness and lumped mass at a stationary state, scipy's eigh.
+* :mod:`.modes`: the stiffness and lumped mass at a stationary state, scipy's eigh;
+* :mod:`.dynamics`: the rings in time, a symplectic Strang splitting, the ends of
+  Eqs. (40), (69) and (70);
+* :mod:`.forced`: the sweep's backend (solvers/periodic.py's protocol).
 
 numpy and scipy only: the import contract (.importlinter) forbids the FE path.
 """

@@ -39,10 +39,18 @@ class State:
 
 def _skew(p: np.ndarray) -> np.ndarray:
     """[p]x of (..., 3) as (..., 3, 3)."""
-    z = np.zeros(p.shape[:-1])
-    return np.stack([np.stack([z, -p[..., 2], p[..., 1]], -1),
-                     np.stack([p[..., 2], z, -p[..., 0]], -1),
-                     np.stack([-p[..., 1], p[..., 0], z], -1)], -2)
+    out = np.zeros(p.shape + (3,))
+    out[..., 0, 1], out[..., 0, 2] = -p[..., 2], p[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = p[..., 2], -p[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -p[..., 1], p[..., 0]
+    return out
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b over the last axis (np.cross without its overhead)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
 
 
 def tether_chords(net, s: State):
@@ -81,13 +89,16 @@ def energy(net, s: State) -> float:
     return E
 
 
-def _line_terms(d: np.ndarray, EA: float, l0: float, tension_only: bool):
-    """(g = dE/dd (..., 3), H = d2E/dd2 (..., 3, 3)) of elastic lines of chords d."""
+def _line_terms(d: np.ndarray, EA: float, l0: float, tension_only: bool, hessian: bool = True):
+    """(g = dE/dd (..., 3), H = d2E/dd2 (..., 3, 3), None without ``hessian``) of
+    elastic lines of chords d."""
     L = np.linalg.norm(d, axis=-1)
     f = EA * (L - l0) / l0
     if tension_only:
         f = np.maximum(f, 0.0)
     u = d / L[..., None]
+    if not hessian:
+        return f[..., None] * u, None
     uu = u[..., :, None] * u[..., None, :]
     k_el = np.where(f > 0, EA / l0, 0.0) if tension_only else np.full(L.shape, EA / l0)
     H = k_el[..., None, None] * uu + (f / L)[..., None, None] * (np.eye(3) - uu)
@@ -107,31 +118,58 @@ def _rotation_term(g: np.ndarray, p: np.ndarray) -> np.ndarray:
         * np.eye(3)
 
 
-def gradient_hessian(net, s: State) -> tuple[np.ndarray, sp.csr_matrix]:
-    """(dE/dq (6 rings,), d2E/dq2 sparse (6 rings, 6 rings)) in the chart, every ring's
-    dofs (dx, w) included (the ends' are removed by :func:`free_basis`)."""
-    N = net.count
+def _bay_terms(net, s: State, hessian: bool):
+    """(dE/d(q_b, q_(b+1)) (bays, 12), its Hessian (bays, 12, 12) or None): each bay's
+    tethers' and bar's share."""
     pa, pb, d = tether_chords(net, s)
-    g, Hd = _line_terms(d, net.k_N, net.l0_m, tension_only=True)  # (bays, n, 3), (.., 3, 3)
-    Ga, Gb = _point_jacobian(pa), _point_jacobian(pb)
-    G = np.concatenate([-Ga, Gb], axis=-1)  # dd/d(q_b, q_(b+1)) (bays, n, 3, 12)
-    K = np.einsum("bmia,bmij,bmjc->bac", G, Hd, G)  # (bays, 12, 12)
-    K[:, 3:6, 3:6] += _rotation_term(-g, pa).sum(axis=1)
-    K[:, 9:12, 9:12] += _rotation_term(g, pb).sum(axis=1)
-    grad_e = np.einsum("bmia,bmi->ba", G, g)  # (bays, 12)
+    g, Hd = _line_terms(d, net.k_N, net.l0_m, tension_only=True, hessian=hessian)
+    # G^T g with G = [I, -[p]x]: (g, p x g) on each end of a chord
+    grad_e = np.concatenate([-g.sum(axis=1), -_cross(pa, g).sum(axis=1), g.sum(axis=1),
+                             _cross(pb, g).sum(axis=1)], axis=-1)  # (bays, 12)
+    K = None
+    if hessian:
+        Ga, Gb = _point_jacobian(pa), _point_jacobian(pb)
+        G = np.concatenate([-Ga, Gb], axis=-1)  # dd/d(q_b, q_(b+1)) (bays, n, 3, 12)
+        K = np.einsum("bmia,bmij,bmjc->bac", G, Hd, G)  # (bays, 12, 12)
+        K[:, 3:6, 3:6] += _rotation_term(-g, pa).sum(axis=1)
+        K[:, 9:12, 9:12] += _rotation_term(g, pb).sum(axis=1)
     if net.bar_EA_N > 0:
-        gb, Hb = _line_terms(s.X[1:] - s.X[:-1], net.bar_EA_N, net.bar_l0_m, tension_only=False)
-        for (i, si), (j, sj) in [((0, -1), (0, -1)), ((0, -1), (6, 1)), ((6, 1), (0, -1)),
-                                 ((6, 1), (6, 1))]:
-            K[:, i:i + 3, j:j + 3] += si * sj * Hb
+        gb, Hb = _line_terms(s.X[1:] - s.X[:-1], net.bar_EA_N, net.bar_l0_m,
+                             tension_only=False, hessian=hessian)
+        if hessian:
+            for (i, si), (j, sj) in [((0, -1), (0, -1)), ((0, -1), (6, 1)), ((6, 1), (0, -1)),
+                                     ((6, 1), (6, 1))]:
+                K[:, i:i + 3, j:j + 3] += si * sj * Hb
         grad_e[:, 0:3] -= gb
         grad_e[:, 6:9] += gb
+    return grad_e, K
+
+
+def _assembled_gradient(net, s: State, grad_e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(dE/dq (6 rings,), the bays' dof indices (bays, 12)) from the bays' shares,
+    with the dead loads' and the end torque's work."""
+    N = net.count
     grad = np.zeros(DOFS * N)
     idx = DOFS * np.arange(N - 1)[:, None] + np.arange(12)[None, :]  # (bays, 12)
     np.add.at(grad, idx, grad_e)
     grad[np.arange(DOFS * N).reshape(N, DOFS)[:, :3].ravel()] -= net.loads_N.ravel()
     if net.end_torque_Nm is not None:
         grad[DOFS * (N - 1) + 3:DOFS * N] -= net.end_torque_Nm * net.frame[:, 2]
+    return grad, idx
+
+
+def gradient(net, s: State) -> np.ndarray:
+    """dE/dq (6 rings,) in the chart: minus each ring's force [N] and moment [N m]
+    (the time integration's forces, without the Hessian's cost)."""
+    return _assembled_gradient(net, s, _bay_terms(net, s, hessian=False)[0])[0]
+
+
+def gradient_hessian(net, s: State) -> tuple[np.ndarray, sp.csr_matrix]:
+    """(dE/dq (6 rings,), d2E/dq2 sparse (6 rings, 6 rings)) in the chart, every ring's
+    dofs (dx, w) included (the ends' are removed by :func:`free_basis`)."""
+    N = net.count
+    grad_e, K = _bay_terms(net, s, hessian=True)
+    grad, idx = _assembled_gradient(net, s, grad_e)
     rows = np.broadcast_to(idx[:, :, None], K.shape).ravel()
     cols = np.broadcast_to(idx[:, None, :], K.shape).ravel()
     H = sp.coo_matrix((K.ravel(), (rows, cols)), shape=(DOFS * N, DOFS * N)).tocsr()

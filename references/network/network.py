@@ -35,7 +35,8 @@ hoop's, m R^2 and m R^2 / 2.  The tethers are massless.
 a bay's share on its tethers: a uniform dead load along each tether, which is
 exactly one on the ring centres (the n attachment points sum to the centre), so
 each ring carries l of it (the end rings l / 2).  Both follow the model's
-gravity and drag switches.
+gravity and drag switches.  In time (:mod:`.dynamics`) the drag follows each ring's
+velocity, -c_i |v_A| v_A with v_A = v - wind (``drag_kg_m``, ``wind_m_s``).
 
 **Ends** (Eq. 66): the ground ring at 0 in its reference frame; the top ring at the
 elongated chord (1 + eps0) L0 (cos Gamma0 (-i_E) + sin Gamma0 (-k_E)) (on the circle of
@@ -46,6 +47,7 @@ value of Eq. 69), the top ring's rotation about e3 free and loaded by that torqu
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -98,6 +100,10 @@ class Network:
     end_twist_rad: float = 0.0  # the top ring's turn about e3 beyond the lay [rad]
     end_torque_Nm: float | None = None  # None: top rotation fixed; else its torque about e3 [N m]
     spacing_m: float = field(default=0.0)  # l, the unstretched spacing [m] (information)
+    #: each ring's drag c_i [kg/m], its force -c_i |v_A| v_A at the apparent wind
+    #: v_A = x_t - wind (Eq. 28 over its length of helix); None: no drag in time
+    drag_kg_m: np.ndarray | None = None
+    wind_m_s: np.ndarray = field(default_factory=lambda: np.zeros(3))  # the air's velocity [m/s]
 
     def __post_init__(self):
         if self.n < 3 or len(self.rings) < 2:
@@ -125,7 +131,7 @@ class Network:
         e2 /= np.linalg.norm(e2)
         return np.column_stack([np.cross(e2, e3), e2, e3])
 
-    @property
+    @functools.cached_property
     def attachments(self) -> np.ndarray:
         """rho_m (n, 3) in a ring's own frame."""
         phi = 2 * np.pi * np.arange(self.n) / self.n
@@ -180,12 +186,13 @@ class Network:
         ring_list = tuple(Ring(m, sec.ring_polar_inertia_kgm2 or m * R * R,
                                sec.ring_diametral_inertia_kgm2 or m * R * R / 2) for m in masses)
         g = env.g_m_s2 * float(model.gravity)
-        q = (float(model.drag) * env.air_density_kg_m3 * h.drag_length_m * h.drag_coefficient / 2
-             * env.wind_speed_m_s * abs(env.wind_speed_m_s))  # Eq. (14) [N/m], along -i_E
+        c = float(model.drag) * env.air_density_kg_m3 * h.drag_length_m * h.drag_coefficient / 2
+        q = c * env.wind_speed_m_s * abs(env.wind_speed_m_s)  # Eq. (14) [N/m], along -i_E
         loads = np.outer(masses * g, [0.0, 0.0, 1.0]) + np.outer(share * q, [-1.0, 0.0, 0.0])
         if end_torque_Nm is None and params.torque.top_Nm != 0:
             end_torque_Nm = params.torque.top_Nm
         return cls(n=n, radius_m=R, k_N=k, l0_m=l_t / (1 + P0 / k), chord_m=chord, lay_rad=lay,
                    rings=ring_list, loads_N=loads, bar_EA_N=bar_EA, bar_l0_m=bar_l0,
-                   end_twist_rad=end_twist_rad, end_torque_Nm=end_torque_Nm, spacing_m=l)
+                   end_twist_rad=end_twist_rad, end_torque_Nm=end_torque_Nm, spacing_m=l,
+                   drag_kg_m=c * share, wind_m_s=np.array([-env.wind_speed_m_s, 0.0, 0.0]))
 
