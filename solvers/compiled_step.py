@@ -1,0 +1,269 @@
+"""TSALPHA2's steps by chord Newton, compiled (issue 46): solvers/chord.py's loop
+(:meth:`~rawehelix.solvers.generalised_alpha.AlphaStepper.solve_stage`, its
+predictor, Hairer's test, the LU refresh rule and its failures) in numba's
+nopython mode, on F and J assembled by the FFCx kernels
+(:mod:`~rawehelix.solvers.compiled_forms`) and a dense LU with partial pivoting.
+
+The time data (the forms' constants and the Dirichlet values g at each step's
+stage time) come from the formulation's own ``set_time`` (Python, once per step,
+before the compiled loop): the loop only reads them.  So the numbers are
+ChordAlpha's to the Newton tolerance (tests/test_speed.py compares them); one
+rank, dense (3 n <= generalised_alpha.MAX_STATE).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from rawehelix.solvers import generalised_alpha as ga
+from rawehelix.solvers.chord import ChordAlpha
+from rawehelix.solvers.compiled_forms import CompiledForms, _assemble_matrix, _assemble_vector
+from rawehelix.solvers.snes import SolverError
+
+# the compiled loop's outcomes (its return code)
+OK, NON_FINITE, DIVERGES, NO_CONVERGENCE = 0, 1, 2, 3
+
+
+@numba.njit(cache=False)
+def _lu_factor(A, piv):
+    """A <- its LU factors in place (partial pivoting, LAPACK's getrf in plain loops)."""
+    n = A.shape[0]
+    for k in range(n):
+        p, big = k, abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                p, big = i, abs(A[i, k])
+        piv[k] = p
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        d = A[k, k]
+        for i in range(k + 1, n):
+            A[i, k] /= d
+            f = A[i, k]
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+
+
+@numba.njit(cache=False)
+def _lu_solve(LU, piv, b, x):
+    n = LU.shape[0]
+    for i in range(n):
+        x[i] = b[i]
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
+    for i in range(n):  # L (unit diagonal)
+        s = x[i]
+        for j in range(i):
+            s -= LU[i, j] * x[j]
+        x[i] = s
+    for i in range(n - 1, -1, -1):  # U
+        s = x[i]
+        for j in range(i + 1, n):
+            s -= LU[i, j] * x[j]
+        x[i] = s / LU[i, i]
+
+
+@numba.njit(cache=False)
+def _residual(b, X, consts, pieces):
+    b[:] = 0.0
+    for p in pieces:
+        _assemble_vector(b, p[0], X, consts, p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+
+
+@numba.njit(cache=False)
+def _jacobian(A, X, consts, pieces, bc):
+    A[:, :] = 0.0
+    for p in pieces:
+        _assemble_matrix(A, p[0], X, consts, p[1], p[2], p[3], p[4], p[5], p[6], p[7])
+    for i in bc:
+        A[i, :] = 0.0
+        A[:, i] = 0.0
+        A[i, i] = 1.0
+
+
+@numba.njit(cache=False)
+def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, Fp, Jp,
+           LU, piv, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
+    """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
+    (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
+    Dirichlet values.  Returns (code, step, size, theta) and counts iterations and
+    factorisations in ``counters``."""
+    am, af, g_, b_ = scheme[0], scheme[1], scheme[2], scheme[3]
+    n = u.shape[0]
+    X = np.empty(3 * n)
+    R, dz, z = np.empty(n), np.empty(n), np.empty(n)
+    cj = np.empty(cJ.shape[0])
+    for k in range(G.shape[0]):
+        # predictor (AlphaStepper.predict): extrapolation, or constant acceleration
+        if nhist[0] < order + 1:
+            for i in range(n):
+                z[i] = u[i] + af * (h * v[i] + 0.5 * h * h * a[i])
+        elif order == 2:
+            for i in range(n):
+                z[i] = 3.0 * hist[0, i] - 3.0 * hist[1, i] + hist[2, i]
+        else:
+            for i in range(n):
+                z[i] = hist[0, i]
+        for j in range(bc.shape[0]):
+            z[bc[j]] = G[k, j]
+        zmax = 0.0
+        for i in range(n):
+            zmax = max(zmax, abs(z[i]))
+        noise = 1e-14 * max(1.0, zmax)  # generalised_alpha.ROUNDOFF
+        # newmark's V_a, A_a of z
+        for i in range(n):
+            u1 = (z[i] - (1 - af) * u[i]) / af
+            a1 = (u1 - u[i] - h * v[i] - h * h * (0.5 - b_) * a[i]) / (b_ * h * h)
+            v1 = v[i] + h * ((1 - g_) * a[i] + g_ * a1)
+            X[n + i] = v[i] + af * (v1 - v[i])
+            X[2 * n + i] = a[i] + am * (a1 - a[i])
+        fresh, last, size, theta = False, -1.0, 0.0, -1.0
+        done = False
+        for it in range(max_it):
+            for i in range(n):
+                X[i] = z[i]
+            if not has_lu[0]:
+                for j in range(cF.shape[1]):
+                    cj[shift_slots[2 + j]] = cF[k, j]
+                cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
+                _jacobian(LU, X, cj, Jp, bc)
+                _lu_factor(LU, piv)
+                has_lu[0] = True
+                counters[1] += 1
+                fresh, last = True, -1.0
+            _residual(R, X, cF[k], Fp)
+            for j in range(bc.shape[0]):
+                R[bc[j]] = 0.0
+            _lu_solve(LU, piv, R, dz)
+            size = 0.0
+            for i in range(n):
+                size = max(size, abs(dz[i]))
+            if not size < math.inf:
+                return NON_FINITE, k, size, theta
+            at_floor = size <= noise
+            theta = -1.0 if (at_floor or last < 0.0) else size / last
+            if theta >= 1.0:
+                if size <= 100.0 * noise:  # generalised_alpha.STALL: converged at R's floor
+                    done = True
+                    break
+                if fresh:
+                    return DIVERGES, k, size, theta
+                has_lu[0] = False
+                continue
+            for i in range(n):
+                z[i] -= dz[i]
+                X[n + i] -= sv * dz[i]
+                X[2 * n + i] -= sa * dz[i]
+            counters[0] += 1
+            if at_floor:
+                done = True
+                break
+            if theta >= 0.0:
+                eta = theta / (1.0 - theta)
+                if eta * size <= tol:
+                    if theta > rate:
+                        has_lu[0] = False
+                    done = True
+                    break
+                if theta > rate:
+                    has_lu[0] = False
+                    fresh = False
+                    continue
+            last = size
+        if not done:
+            return NO_CONVERGENCE, k, size, theta
+        for i in range(n):
+            u[i] = u[i] + (z[i] - u[i]) / af
+            v[i] = v[i] + (X[n + i] - v[i]) / af
+            a[i] = a[i] + (X[2 * n + i] - a[i]) / am
+        for j in range(hist.shape[0] - 1, 0, -1):
+            hist[j, :] = hist[j - 1, :]
+        hist[0, :] = z
+        nhist[0] = min(nhist[0] + 1, hist.shape[0])
+        counters[2] += 1
+        r2 = 0.0
+        for c in range(3):
+            d = 0.0
+            for i in range(n):
+                d += D[c, i] * u[i]
+            r2 += d * d
+        tension[k] = sigma * (math.sqrt(r2) - 1.0)
+    return OK, G.shape[0], 0.0, 0.0
+
+
+class CompiledChordAlpha(ChordAlpha):
+    """ChordAlpha whose steps (not its start) run compiled: same scheme, predictor,
+    chord Newton and tests, on the FFCx kernels (module docstring)."""
+
+    def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
+                 rate: float = 0.03, max_it: int = 8, order: int = 2):
+        if order not in (0, 2):
+            raise SolverError(f"compiled steps: predictor order {order} (0 or 2)")
+        super().__init__(params, rho_inf, solver, tol, rate, max_it, order)
+        op = self.op
+        self.forms = CompiledForms(op)
+        self._Fp, self._Jp = self.forms.pieces()
+        sv_slot, sa_slot, rest = self.forms._shift_slots
+        self._slots = np.concatenate([[sv_slot, sa_slot], rest]).astype(np.int64)
+        self._bc = np.asarray(op.bc_dofs, dtype=np.int64)
+        n = op.n
+        self._LU, self._piv = np.zeros((n, n)), np.zeros(n, np.int64)
+        self._has_lu, self._lu_h = np.zeros(1, np.bool_), None
+        self._counters = np.zeros(3, np.int64)
+
+    # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
+    iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
+    factorisations = property(lambda self: self.alpha.factorisations + int(self._counters[1]))
+    steps = property(lambda self: self.alpha.steps + int(self._counters[2]))
+
+    def time_data(self, times):
+        """(constants of F, Dirichlet values) at each stage time, from the form's set_time."""
+        op, forms = self.op, self.forms
+        cF = np.empty((len(times), forms.constants().size))
+        G = np.empty((len(times), self._bc.size))
+        for k, t in enumerate(times):
+            op.set_time(t)
+            cF[k] = forms.constants()
+            G[k] = op.bc_values()
+        return cF, G
+
+    def run(self, t0, h, steps, u, v, a=None):
+        """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's)."""
+        alpha = self.alpha
+        tension = np.empty(steps + 1)
+        tension[0] = self.tension0(u)
+        if a is None:
+            a = self.start(t0, h, u, v)
+        u, v, a = u.copy(), v.copy(), np.array(a, dtype=float)
+        if self._lu_h != h:
+            self._has_lu[0], self._lu_h = False, h
+        n = self.op.n
+        hist, nhist = np.zeros((3, n)), np.zeros(1, np.int64)
+        scheme = np.array(alpha.scheme)
+        sv, sa = alpha.shifts(h)
+        cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h)
+        code, k, size, theta = _steps(
+            u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
+            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self._has_lu, self.op._D,
+            self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
+            alpha.order, self._counters)
+        if code != OK:
+            t = t0 + k * h
+            self._has_lu[0] = False
+            raise SolverError({
+                NON_FINITE: f"compiled alpha2: the state became NaN or Inf at t = {t:.6g} "
+                            f"(normalised)",
+                DIVERGES: f"compiled alpha2: Newton diverges with a fresh Jacobian at t = {t:.6g} "
+                          f"(normalised; contraction {theta:.2g}); try a smaller step (time.dt_s)",
+                NO_CONVERGENCE: f"compiled alpha2: no convergence in {alpha.max_it} iterations at "
+                                f"t = {t:.6g} (normalised; last |dz| = {size:.3g}, tol "
+                                f"{alpha.tol:g}); try a smaller step (time.dt_s)"}[code])
+        self.acceleration = a
+        return u, v, tension
