@@ -2,7 +2,7 @@
 (:meth:`~rawehelix.solvers.generalised_alpha.AlphaStepper.solve_stage`, its
 predictor, Hairer's test, the LU refresh rule and its failures) in numba's
 nopython mode, on F and J assembled by the FFCx kernels
-(:mod:`~rawehelix.solvers.compiled_forms`) and a dense LU with partial pivoting.
+(:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting (J's band from the mesh's dofs).
 
 The time data (the forms' constants and the Dirichlet values g at each step's
 stage time) come from the formulation's own ``set_time`` (Python, once per step,
@@ -20,77 +20,67 @@ import numpy as np
 
 from rawehelix.solvers import generalised_alpha as ga
 from rawehelix.solvers.chord import ChordAlpha
-from rawehelix.solvers.compiled_forms import CompiledForms, _assemble_matrix, _assemble_vector
+from rawehelix.solvers.compiled_forms import CompiledForms
 from rawehelix.solvers.snes import SolverError
 
 # the compiled loop's outcomes (its return code)
-OK, NON_FINITE, DIVERGES, NO_CONVERGENCE = 0, 1, 2, 3
+OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
 
 
 @numba.njit(cache=False)
-def _lu_factor(A, piv):
-    """A <- its LU factors in place (partial pivoting, LAPACK's getrf in plain loops)."""
+def _lu_factor(A, piv, kl):
+    """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
+    storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
+    in kl rows and U has kl + kl off-diagonals.  Returns the first zero pivot's
+    row + 1 (0: none)."""
     n = A.shape[0]
     for k in range(n):
+        last = min(n - 1, k + kl)
         p, big = k, abs(A[k, k])
-        for i in range(k + 1, n):
+        for i in range(k + 1, last + 1):
             if abs(A[i, k]) > big:
                 p, big = i, abs(A[i, k])
         piv[k] = p
+        if big == 0.0:
+            return k + 1
         if p != k:
             for j in range(n):
                 A[k, j], A[p, j] = A[p, j], A[k, j]
         d = A[k, k]
-        for i in range(k + 1, n):
-            A[i, k] /= d
-            f = A[i, k]
+        right = min(n - 1, k + 2 * kl)
+        for i in range(k + 1, last + 1):
+            f = A[i, k] / d
+            A[i, k] = f
             if f != 0.0:
-                for j in range(k + 1, n):
+                for j in range(k + 1, right + 1):
                     A[i, j] -= f * A[k, j]
+    return 0
 
 
 @numba.njit(cache=False)
-def _lu_solve(LU, piv, b, x):
+def _lu_solve(LU, piv, kl, b, x):
+    """x = J^-1 b with :func:`_lu_factor`'s factors."""
     n = LU.shape[0]
-    for i in range(n):
-        x[i] = b[i]
+    x[:] = b
     for k in range(n):
         p = piv[k]
         if p != k:
             x[k], x[p] = x[p], x[k]
-    for i in range(n):  # L (unit diagonal)
+    for i in range(n):  # L (unit diagonal, kl below)
         s = x[i]
-        for j in range(i):
+        for j in range(max(0, i - kl), i):
             s -= LU[i, j] * x[j]
         x[i] = s
-    for i in range(n - 1, -1, -1):  # U
+    for i in range(n - 1, -1, -1):  # U (2 kl above)
         s = x[i]
-        for j in range(i + 1, n):
+        for j in range(i + 1, min(n, i + 2 * kl + 1)):
             s -= LU[i, j] * x[j]
         x[i] = s / LU[i, i]
 
 
 @numba.njit(cache=False)
-def _residual(b, X, consts, pieces):
-    b[:] = 0.0
-    for p in pieces:
-        _assemble_vector(b, p[0], X, consts, p[1], p[2], p[3], p[4], p[5], p[6], p[7])
-
-
-@numba.njit(cache=False)
-def _jacobian(A, X, consts, pieces, bc):
-    A[:, :] = 0.0
-    for p in pieces:
-        _assemble_matrix(A, p[0], X, consts, p[1], p[2], p[3], p[4], p[5], p[6], p[7])
-    for i in bc:
-        A[i, :] = 0.0
-        A[:, i] = 0.0
-        A[i, i] = 1.0
-
-
-@numba.njit(cache=False)
-def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, Fp, Jp,
-           LU, piv, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
+def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, residual, jacobian,
+           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
     Dirichlet values.  Returns (code, step, size, theta) and counts iterations and
@@ -133,15 +123,16 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 for j in range(cF.shape[1]):
                     cj[shift_slots[2 + j]] = cF[k, j]
                 cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
-                _jacobian(LU, X, cj, Jp, bc)
-                _lu_factor(LU, piv)
+                jacobian(LU, X, cj)
+                if _lu_factor(LU, piv, kl) != 0:
+                    return SINGULAR, k, 0.0, -1.0
                 has_lu[0] = True
                 counters[1] += 1
                 fresh, last = True, -1.0
-            _residual(R, X, cF[k], Fp)
+            residual(R, X, cF[k])
             for j in range(bc.shape[0]):
                 R[bc[j]] = 0.0
-            _lu_solve(LU, piv, R, dz)
+            _lu_solve(LU, piv, kl, R, dz)
             size = 0.0
             for i in range(n):
                 size = max(size, abs(dz[i]))
@@ -209,7 +200,7 @@ class CompiledChordAlpha(ChordAlpha):
         super().__init__(params, rho_inf, solver, tol, rate, max_it, order)
         op = self.op
         self.forms = CompiledForms(op)
-        self._Fp, self._Jp = self.forms.pieces()
+        self._residual, self._jacobian = self.forms.assemblers()
         sv_slot, sa_slot, rest = self.forms._shift_slots
         self._slots = np.concatenate([[sv_slot, sa_slot], rest]).astype(np.int64)
         self._bc = np.asarray(op.bc_dofs, dtype=np.int64)
@@ -217,6 +208,9 @@ class CompiledChordAlpha(ChordAlpha):
         self._LU, self._piv = np.zeros((n, n)), np.zeros(n, np.int64)
         self._has_lu, self._lu_h = np.zeros(1, np.bool_), None
         self._counters = np.zeros(3, np.int64)
+        self._bc_sources = op.form.bc_sources()
+        if self._bc_sources is None:
+            raise SolverError("compiled steps: a Dirichlet value that is not a function")
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
@@ -226,12 +220,13 @@ class CompiledChordAlpha(ChordAlpha):
     def time_data(self, times):
         """(constants of F, Dirichlet values) at each stage time, from the form's set_time."""
         op, forms = self.op, self.forms
+        functions, index = self._bc_sources
         cF = np.empty((len(times), forms.constants().size))
         G = np.empty((len(times), self._bc.size))
         for k, t in enumerate(times):
             op.set_time(t)
             cF[k] = forms.constants()
-            G[k] = op.bc_values()
+            G[k] = np.concatenate([f.x.array for f in functions])[index]
         return cF, G
 
     def run(self, t0, h, steps, u, v, a=None):
@@ -251,7 +246,7 @@ class CompiledChordAlpha(ChordAlpha):
         cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h)
         code, k, size, theta = _steps(
             u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
-            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self._has_lu, self.op._D,
+            G, self._bc, self._residual, self._jacobian, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
             alpha.order, self._counters)
         if code != OK:
@@ -264,6 +259,8 @@ class CompiledChordAlpha(ChordAlpha):
                           f"(normalised; contraction {theta:.2g}); try a smaller step (time.dt_s)",
                 NO_CONVERGENCE: f"compiled alpha2: no convergence in {alpha.max_it} iterations at "
                                 f"t = {t:.6g} (normalised; last |dz| = {size:.3g}, tol "
-                                f"{alpha.tol:g}); try a smaller step (time.dt_s)"}[code])
+                                f"{alpha.tol:g}); try a smaller step (time.dt_s)",
+                SINGULAR: f"compiled alpha2: the Jacobian is singular at t = {t:.6g} (normalised); "
+                          f"try a smaller step (time.dt_s)"}[code])
         self.acceleration = a
         return u, v, tension
