@@ -21,6 +21,9 @@ from __future__ import annotations
 import cffi
 import numba
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 
 import dolfinx.cpp
 
@@ -105,20 +108,38 @@ def entities(form, functions, mesh, dofmap):
     return out
 
 
-@numba.njit(cache=False)
+@intrinsic
+def _tabulate(typingctx, kernel, A, w, c, x, e, p):
+    """FFCx's tabulate_tensor(A, w, c, coordinate_dofs, entity_local_index,
+    quadrature_permutation) at the address ``kernel``, the arrays by their addresses
+    (integers: so the nopython functions cache to disk, where a cffi pointer
+    cannot, and cost nothing to pass)."""
+    sig = types.void(kernel, A, w, c, x, e, p)
+
+    def codegen(context, builder, signature, args):
+        dbl, i32, u8 = (ir.DoubleType().as_pointer(), ir.IntType(32).as_pointer(),
+                        ir.IntType(8).as_pointer())
+        kinds = (dbl, dbl, dbl, dbl, i32, u8)
+        fn = builder.inttoptr(args[0], ir.FunctionType(ir.VoidType(), kinds).as_pointer())
+        builder.call(fn, [builder.inttoptr(v, t) for v, t in zip(args[1:], kinds)])
+        return context.get_dummy_value()
+    return sig, codegen
+
+
+@numba.njit(cache=True)
 def _assemble_vector(b, kern, X, consts, dofs, coords, local, wmap, perm):
     Ae, w = np.empty(dofs.shape[1]), np.empty(wmap.shape[1])
     for e in range(dofs.shape[0]):
         for j in range(wmap.shape[1]):
             w[j] = X[wmap[e, j]]
         Ae[:] = 0.0
-        kern(_FFI.from_buffer(Ae), _FFI.from_buffer(w), _FFI.from_buffer(consts),
-             _FFI.from_buffer(coords[e]), _FFI.from_buffer(local[e]), _FFI.from_buffer(perm))
+        _tabulate(kern, Ae.ctypes.data, w.ctypes.data, consts.ctypes.data, coords[e].ctypes.data,
+                  local[e].ctypes.data, perm.ctypes.data)
         for i in range(dofs.shape[1]):
             b[dofs[e, i]] += Ae[i]
 
 
-@numba.njit(cache=False)
+@numba.njit(cache=True)
 def _assemble_matrix(A, kern, X, consts, dofs, coords, local, wmap, perm):
     m = dofs.shape[1]
     Ae, w = np.empty(m * m), np.empty(wmap.shape[1])
@@ -126,50 +147,34 @@ def _assemble_matrix(A, kern, X, consts, dofs, coords, local, wmap, perm):
         for j in range(wmap.shape[1]):
             w[j] = X[wmap[e, j]]
         Ae[:] = 0.0
-        kern(_FFI.from_buffer(Ae), _FFI.from_buffer(w), _FFI.from_buffer(consts),
-             _FFI.from_buffer(coords[e]), _FFI.from_buffer(local[e]), _FFI.from_buffer(perm))
+        _tabulate(kern, Ae.ctypes.data, w.ctypes.data, consts.ctypes.data, coords[e].ctypes.data,
+                  local[e].ctypes.data, perm.ctypes.data)
         for i in range(m):
             for j in range(m):
                 A[dofs[e, i], dofs[e, j]] += Ae[i * m + j]
 
 
-def _padded(pieces):
-    """Three pieces (a form without one integral type: zero entities of it)."""
-    pieces = list(pieces)
-    while len(pieces) < 3:
-        kern, dofs, coords, local, wmap, perm = pieces[0]
-        pieces.append((kern, dofs[:0], coords[:0], local[:0], wmap[:0], perm))
-    return pieces
+@numba.njit(cache=True)
+def residual(b, X, consts, P):
+    """b = F(X) by the kernels of P (:meth:`CompiledForms.pieces`'s first)."""
+    b[:] = 0.0
+    _assemble_vector(b, P[0][0], X, consts, P[1], P[2], P[3], P[4], P[13])
+    _assemble_vector(b, P[0][1], X, consts, P[5], P[6], P[7], P[8], P[13])
+    _assemble_vector(b, P[0][2], X, consts, P[9], P[10], P[11], P[12], P[13])
 
 
-def _vector_assembler(pieces):
-    (k0, d0, x0, l0, w0, p0), (k1, d1, x1, l1, w1, p1), \
-        (k2, d2, x2, l2, w2, p2) = _padded(pieces)
-
-    @numba.njit(cache=False)
-    def residual(b, X, consts):
-        b[:] = 0.0
-        _assemble_vector(b, k0, X, consts, d0, x0, l0, w0, p0)
-        _assemble_vector(b, k1, X, consts, d1, x1, l1, w1, p1)
-        _assemble_vector(b, k2, X, consts, d2, x2, l2, w2, p2)
-    return residual
-
-
-def _matrix_assembler(pieces, bc):
-    (k0, d0, x0, l0, w0, p0), (k1, d1, x1, l1, w1, p1), \
-        (k2, d2, x2, l2, w2, p2) = _padded(pieces)
-
-    @numba.njit(cache=False)
-    def jacobian(A, X, consts):
-        A[:, :] = 0.0
-        _assemble_matrix(A, k0, X, consts, d0, x0, l0, w0, p0)
-        _assemble_matrix(A, k1, X, consts, d1, x1, l1, w1, p1)
-        _assemble_matrix(A, k2, X, consts, d2, x2, l2, w2, p2)
-        for i in bc:
-            A[i, :] = 0.0
-            A[:, i] = 0.0
-            A[i, i] = 1.0
-    return jacobian
+@numba.njit(cache=True)
+def jacobian(A, X, consts, P, bc):
+    """A = J(X) by the kernels of P (:meth:`CompiledForms.pieces`'s second), its
+    Dirichlet rows and columns ``bc`` zero with a unit diagonal."""
+    A[:, :] = 0.0
+    _assemble_matrix(A, P[0][0], X, consts, P[1], P[2], P[3], P[4], P[13])
+    _assemble_matrix(A, P[0][1], X, consts, P[5], P[6], P[7], P[8], P[13])
+    _assemble_matrix(A, P[0][2], X, consts, P[9], P[10], P[11], P[12], P[13])
+    for i in bc:
+        A[i, :] = 0.0
+        A[:, i] = 0.0
+        A[i, i] = 1.0
 
 
 class CompiledForms:
@@ -238,38 +243,34 @@ class CompiledForms:
         return cj
 
     def _arguments(self, ents, kernels):
-        args = []
-        for typ in TYPES:
+        """(kernel addresses, then dofs, coords, local, wmap of each integral type,
+        then the quadrature permutation): a missing type has no entities."""
+        any_e = next(iter(ents.values()))
+        addresses, arrays = np.zeros(3, np.int64), []
+        for k, typ in enumerate(TYPES):
             e = ents.get(typ)
             if e is None:
-                continue
-            args.append((kernels[typ], e.dofs, e.coords, e.local, e.wmap,
-                         np.zeros(2, np.uint8)))
-        return tuple(args)
+                arrays += [any_e.dofs[:0], any_e.coords[:0], any_e.local[:0], any_e.wmap[:0]]
+            else:
+                addresses[k] = int(_FFI.cast("uintptr_t", kernels[typ]))
+                arrays += [e.dofs, e.coords, e.local, e.wmap]
+        return (addresses, *arrays, np.zeros(2, np.uint8))
 
     def pieces(self):
-        """(F's arguments, J's arguments), tuples per integral type."""
-        return self._arguments(self.F_entities, self.F_kernels), \
-            self._arguments(self.J_entities, self.J_kernels)
-
-    def assemblers(self):
-        """(residual(b, X, consts), jacobian(A, X, consts)): nopython functions with
-        the kernels and entity data frozen in (a cffi pointer passed as an argument
-        costs ~80 us a call; frozen, ~1 us).  J's Dirichlet rows and columns are
-        zero with a unit diagonal; R's Dirichlet rows are left to the caller."""
-        if getattr(self, "_assemblers", None) is None:
-            Fp, Jp = self.pieces()
-            self._assemblers = (_vector_assembler(Fp), _matrix_assembler(Jp, self.bc_dofs))
-        return self._assemblers
+        """(F's arguments, J's arguments) of :func:`residual` and :func:`jacobian`."""
+        if getattr(self, "_pieces", None) is None:
+            self._pieces = (self._arguments(self.F_entities, self.F_kernels),
+                            self._arguments(self.J_entities, self.J_kernels))
+        return self._pieces
 
     def residual(self, X, consts):
         b = np.zeros(self.n)
-        self.assemblers()[0](b, X, consts)
+        residual(b, X, consts, self.pieces()[0])
         return b
 
     def jacobian(self, X, cj):
         A = np.zeros((self.n, self.n))
-        self.assemblers()[1](A, X, cj)
+        jacobian(A, X, cj, self.pieces()[1], self.bc_dofs)
         return A
 
     def check(self, X, sv, sa, tol=1e-12):

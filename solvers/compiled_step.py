@@ -20,14 +20,14 @@ import numpy as np
 
 from rawehelix.solvers import generalised_alpha as ga
 from rawehelix.solvers.chord import ChordAlpha
-from rawehelix.solvers.compiled_forms import CompiledForms
+from rawehelix.solvers.compiled_forms import CompiledForms, jacobian, residual
 from rawehelix.solvers.snes import SolverError
 
 # the compiled loop's outcomes (its return code)
 OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
 
 
-@numba.njit(cache=False)
+@numba.njit(cache=True)
 def _lu_factor(A, piv, kl):
     """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
     storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
@@ -57,7 +57,7 @@ def _lu_factor(A, piv, kl):
     return 0
 
 
-@numba.njit(cache=False)
+@numba.njit(cache=True)
 def _lu_solve(LU, piv, kl, b, x):
     """x = J^-1 b with :func:`_lu_factor`'s factors."""
     n = LU.shape[0]
@@ -78,8 +78,8 @@ def _lu_solve(LU, piv, kl, b, x):
         x[i] = s / LU[i, i]
 
 
-@numba.njit(cache=False)
-def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, residual, jacobian,
+@numba.njit(cache=True)
+def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, Fp, Jp,
            LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
@@ -123,13 +123,13 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 for j in range(cF.shape[1]):
                     cj[shift_slots[2 + j]] = cF[k, j]
                 cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
-                jacobian(LU, X, cj)
+                jacobian(LU, X, cj, Jp, bc)
                 if _lu_factor(LU, piv, kl) != 0:
                     return SINGULAR, k, 0.0, -1.0
                 has_lu[0] = True
                 counters[1] += 1
                 fresh, last = True, -1.0
-            residual(R, X, cF[k])
+            residual(R, X, cF[k], Fp)
             for j in range(bc.shape[0]):
                 R[bc[j]] = 0.0
             _lu_solve(LU, piv, kl, R, dz)
@@ -200,7 +200,7 @@ class CompiledChordAlpha(ChordAlpha):
         super().__init__(params, rho_inf, solver, tol, rate, max_it, order)
         op = self.op
         self.forms = CompiledForms(op)
-        self._residual, self._jacobian = self.forms.assemblers()
+        self._Fp, self._Jp = self.forms.pieces()
         sv_slot, sa_slot, rest = self.forms._shift_slots
         self._slots = np.concatenate([[sv_slot, sa_slot], rest]).astype(np.int64)
         self._bc = np.asarray(op.bc_dofs, dtype=np.int64)
@@ -208,6 +208,8 @@ class CompiledChordAlpha(ChordAlpha):
         self._LU, self._piv = np.zeros((n, n)), np.zeros(n, np.int64)
         self._has_lu, self._lu_h = np.zeros(1, np.bool_), None
         self._counters = np.zeros(3, np.int64)
+        # the last stage values (newest first), carried into a continued run
+        self._hist, self._nhist = np.zeros((3, n)), np.zeros(1, np.int64)
         self._bc_sources = op.form.bc_sources()
         if self._bc_sources is None:
             raise SolverError("compiled steps: a Dirichlet value that is not a function")
@@ -230,23 +232,27 @@ class CompiledChordAlpha(ChordAlpha):
         return cF, G
 
     def run(self, t0, h, steps, u, v, a=None):
-        """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's)."""
+        """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's); a
+        run continued (``a`` given, the same h) keeps the predictor's history."""
         alpha = self.alpha
         tension = np.empty(steps + 1)
         tension[0] = self.tension0(u)
+        given = a
         if a is None:
             a = self.start(t0, h, u, v)
         u, v, a = u.copy(), v.copy(), np.array(a, dtype=float)
-        if self._lu_h != h:
+        same_h = self._lu_h is not None and abs(h - self._lu_h) <= 1e-9 * h
+        if not same_h:  # the LU's shifts are h's (round-off of h: the chord copes)
             self._has_lu[0], self._lu_h = False, h
-        n = self.op.n
-        hist, nhist = np.zeros((3, n)), np.zeros(1, np.int64)
+        if given is None or not same_h:  # the predictor's history: a new start
+            self._nhist[0] = 0
+        hist, nhist = self._hist, self._nhist
         scheme = np.array(alpha.scheme)
         sv, sa = alpha.shifts(h)
         cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h)
         code, k, size, theta = _steps(
             u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
-            G, self._bc, self._residual, self._jacobian, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
+            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
             alpha.order, self._counters)
         if code != OK:

@@ -15,6 +15,8 @@ period loses less than 1e-4 of its amplitude per period.  Options (prefix
     -rawehelix_ts_jacobian_reuse 0.1   modified Newton: keep the Jacobian and its LU
                                        across iterations and steps until an iteration
                                        contracts |F| by less than this (0: full Newton)
+    -rawehelix_ts_compiled 1           alpha2's fixed steps by compiled chord Newton
+                                       (solvers/compiled_dynamics.py; one rank)
     -rawehelix_ts_snes_monitor, ...
 
 TSALPHA2 solves the second-order form; every other type gets the first-order
@@ -39,7 +41,9 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
+from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
+from rawehelix.solvers import compiled_dynamics
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
@@ -139,6 +143,17 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
             self.ts = self._create_ts(ts_type)
+            options_db = PETSc.Options()
+            self._compiled = None
+            if options_db.getBool(PREFIX + "ts_compiled", False):  # issue 46
+                why = compiled_dynamics.refusal(
+                    ts_type, options_db.getString(PREFIX + "ts_adapt_type", "basic"),
+                    comm.size, end_twist)
+                if why:
+                    raise SceneError("PETSc options", compiled_dynamics.OPTION,
+                                     f"the compiled steps {why}")
+                self._compiled = compiled_dynamics.CompiledAdvance
+                self._alpha_radius = options_db.getReal(PREFIX + "ts_alpha_radius", 0.9)
         self.probes = Probes(self.form)
         rod_ = self.rod
         self._v_top = dolfinx.fem.Function(rod_.V_r)  # the upper end's velocity, Eq. (70)
@@ -273,6 +288,10 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         the state is then the last good one (see :meth:`state`)."""
         if not self._has_state:
             raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
+        if self._compiled is not None:  # -rawehelix_ts_compiled: solvers/compiled_dynamics.py
+            if isinstance(self._compiled, type):
+                self._compiled = self._compiled(self, self._alpha_radius)
+            return self._compiled(t_end, on_step, on_output, output_every)
         ts = self.ts
         t0 = ts.getTime()
         eps = 1e-9 * max(1.0, t_end)
