@@ -7,7 +7,9 @@ nopython mode, on F and J assembled by the FFCx kernels
 The time data (the forms' constants and the Dirichlet values g at each step's
 stage time) come from the formulation's own ``set_time`` (Python, once per step,
 before the compiled loop): the loop only reads them.  So the numbers are
-ChordAlpha's to the Newton tolerance (tests/test_speed.py compares them); one
+ChordAlpha's to the Newton tolerance (tests/test_compiled_steps.py compares them
+with TS).  Like ChordAlpha it has no line search: a step whose Newton diverges
+with a fresh Jacobian raises; one
 rank, dense (3 n <= generalised_alpha.MAX_STATE).
 """
 
@@ -31,7 +33,9 @@ OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
 def _lu_factor(A, piv, kl):
     """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
     storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
-    in kl rows and U has kl + kl off-diagonals.  Returns the first zero pivot's
+    in kl rows and U has kl + kl off-diagonals; a swap moves the trailing columns
+    only, so L's column k stays in rows k + 1 .. k + kl (a full-row swap would move
+    its entries further from the diagonal than the solve reads).  Returns the first zero pivot's
     row + 1 (0: none)."""
     n = A.shape[0]
     for k in range(n):
@@ -43,11 +47,11 @@ def _lu_factor(A, piv, kl):
         piv[k] = p
         if big == 0.0:
             return k + 1
-        if p != k:
-            for j in range(n):
+        right = min(n - 1, k + 2 * kl)
+        if p != k:  # the trailing columns only: L's column j stays where step j put it
+            for j in range(k, right + 1):
                 A[k, j], A[p, j] = A[p, j], A[k, j]
         d = A[k, k]
-        right = min(n - 1, k + 2 * kl)
         for i in range(k + 1, last + 1):
             f = A[i, k] / d
             A[i, k] = f
@@ -62,15 +66,13 @@ def _lu_solve(LU, piv, kl, b, x):
     """x = J^-1 b with :func:`_lu_factor`'s factors."""
     n = LU.shape[0]
     x[:] = b
-    for k in range(n):
+    for k in range(n):  # L (unit diagonal, kl below) with the row swaps in turn (gbtrs)
         p = piv[k]
         if p != k:
             x[k], x[p] = x[p], x[k]
-    for i in range(n):  # L (unit diagonal, kl below)
-        s = x[i]
-        for j in range(max(0, i - kl), i):
-            s -= LU[i, j] * x[j]
-        x[i] = s
+        xk = x[k]
+        for i in range(k + 1, min(n, k + kl + 1)):
+            x[i] -= LU[i, k] * xk
     for i in range(n - 1, -1, -1):  # U (2 kl above)
         s = x[i]
         for j in range(i + 1, min(n, i + 2 * kl + 1)):
@@ -262,7 +264,8 @@ class CompiledChordAlpha(ChordAlpha):
                 NON_FINITE: f"compiled alpha2: the state became NaN or Inf at t = {t:.6g} "
                             f"(normalised)",
                 DIVERGES: f"compiled alpha2: Newton diverges with a fresh Jacobian at t = {t:.6g} "
-                          f"(normalised; contraction {theta:.2g}); try a smaller step (time.dt_s)",
+                          f"(normalised; contraction {theta:.2g}, |dz| {size:.2g}); try a smaller step "
+                          f"(time.dt_s)",
                 NO_CONVERGENCE: f"compiled alpha2: no convergence in {alpha.max_it} iterations at "
                                 f"t = {t:.6g} (normalised; last |dz| = {size:.3g}, tol "
                                 f"{alpha.tol:g}); try a smaller step (time.dt_s)",

@@ -135,6 +135,14 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
+            options_db = PETSc.Options()
+            compiled = options_db.getBool(PREFIX + "ts_compiled", False)  # issue 46
+            why = compiled and compiled_dynamics.refusal(
+                ts_type, options_db.getString(PREFIX + "ts_adapt_type", "basic"), comm.size,
+                end_twist)
+            if why:
+                raise SceneError("PETSc options", compiled_dynamics.OPTION,
+                                 f"the compiled steps {why}")
             if end_twist is not None and ts_type != "alpha2":
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
@@ -143,17 +151,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
             self.ts = self._create_ts(ts_type)
-            options_db = PETSc.Options()
-            self._compiled = None
-            if options_db.getBool(PREFIX + "ts_compiled", False):  # issue 46
-                why = compiled_dynamics.refusal(
-                    ts_type, options_db.getString(PREFIX + "ts_adapt_type", "basic"),
-                    comm.size, end_twist)
-                if why:
-                    raise SceneError("PETSc options", compiled_dynamics.OPTION,
-                                     f"the compiled steps {why}")
-                self._compiled = compiled_dynamics.CompiledAdvance
-                self._alpha_radius = options_db.getReal(PREFIX + "ts_alpha_radius", 0.9)
+            self._compiled = compiled_dynamics.CompiledAdvance if compiled else None
+            self._alpha_radius = PETSc.Options().getReal(PREFIX + "ts_alpha_radius", 0.9)
         self.probes = Probes(self.form)
         rod_ = self.rod
         self._v_top = dolfinx.fem.Function(rod_.V_r)  # the upper end's velocity, Eq. (70)
@@ -179,6 +178,14 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         if solver.form.moving_top:  # the end starts with the circle's velocity, Eq. (70)
             solver.set_end_motion(params.ends.circle_frequency_Hz, 0.0)
         return solver
+
+    @property
+    def compiled(self):
+        """The compiled steps' :class:`~rawehelix.solvers.compiled_dynamics.CompiledAdvance`
+        (built at first use), or None: PETSc TS steps (``-rawehelix_ts_compiled``)."""
+        if isinstance(self._compiled, type):
+            self._compiled = self._compiled(self, self._alpha_radius)
+        return self._compiled
 
     def residual_floor(self) -> float:
         """An absolute Newton tolerance ten times the round-off floor of |F|.
@@ -288,10 +295,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         the state is then the last good one (see :meth:`state`)."""
         if not self._has_state:
             raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
-        if self._compiled is not None:  # -rawehelix_ts_compiled: solvers/compiled_dynamics.py
-            if isinstance(self._compiled, type):
-                self._compiled = self._compiled(self, self._alpha_radius)
-            return self._compiled(t_end, on_step, on_output, output_every)
+        if self.compiled is not None:  # -rawehelix_ts_compiled: solvers/compiled_dynamics.py
+            return self.compiled(t_end, on_step, on_output, output_every)
         ts = self.ts
         t0 = ts.getTime()
         eps = 1e-9 * max(1.0, t_end)
