@@ -33,6 +33,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ scripts/install.sh 
   echo "install: pip install -e . (numpy==$numpy_version)"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e . "numpy==$numpy_version" \
       "import-linter==2.1"  # lint-imports: the import contracts of .importlinter (tests/test_architecture.py)
+  # numba: the compiled time steps (-rawehelix_ts_compiled 1, solvers/compiled_step.py);
+  # 0.57.1: the version measured here with Debian 12's numpy 1.24.2 and Python 3.11
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check "numpy==$numpy_version" \
+      "numba==0.57.1"
   # pyvista renders off screen; it is optional and must not move numpy.  Before 0.46:
   # later ones bring cyclopts -> rich -> markdown-it-py >= 2.2, which shadows Debian's
   # 2.1 and breaks Debian's myst-parser (make docs), with a resolver error at install.

@@ -45,6 +45,7 @@ import numpy as np
 import ufl
 from petsc4py import PETSc
 
+import dolfinx.cpp
 import dolfinx.fem
 
 from rawehelix import compat
@@ -182,7 +183,8 @@ class _Formulation:
         (found once by probing set_bc with numbered values): a gather of a few us,
         where :meth:`bc_values` goes through a PETSc vector (~15 us at N = 8)."""
         functions = [bc.value for bc in self.bcs]
-        if not all(hasattr(f, "x") for f in functions):
+        if not all(isinstance(f, (dolfinx.fem.Function, dolfinx.cpp.fem.Function_float64))
+                   for f in functions):
             return None  # a Constant's value: no probing needed by the callers so far
         saved = [f.x.array.copy() for f in functions]
         start = 1.0
