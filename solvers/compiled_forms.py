@@ -127,14 +127,20 @@ def _tabulate(typingctx, kernel, A, w, c, x, e, p):
 
 
 @numba.njit(cache=True)
+def _element(Ae, w, kern, X, consts, coords, local, wmap, perm, e):
+    """Ae <- entity e's element tensor, its coefficients gathered from X into w."""
+    for j in range(wmap.shape[1]):
+        w[j] = X[wmap[e, j]]
+    Ae[:] = 0.0
+    _tabulate(kern, Ae.ctypes.data, w.ctypes.data, consts.ctypes.data, coords[e].ctypes.data,
+              local[e].ctypes.data, perm.ctypes.data)
+
+
+@numba.njit(cache=True)
 def _assemble_vector(b, kern, X, consts, dofs, coords, local, wmap, perm):
     Ae, w = np.empty(dofs.shape[1]), np.empty(wmap.shape[1])
     for e in range(dofs.shape[0]):
-        for j in range(wmap.shape[1]):
-            w[j] = X[wmap[e, j]]
-        Ae[:] = 0.0
-        _tabulate(kern, Ae.ctypes.data, w.ctypes.data, consts.ctypes.data, coords[e].ctypes.data,
-                  local[e].ctypes.data, perm.ctypes.data)
+        _element(Ae, w, kern, X, consts, coords, local, wmap, perm, e)
         for i in range(dofs.shape[1]):
             b[dofs[e, i]] += Ae[i]
 
@@ -144,11 +150,7 @@ def _assemble_matrix(A, kern, X, consts, dofs, coords, local, wmap, perm):
     m = dofs.shape[1]
     Ae, w = np.empty(m * m), np.empty(wmap.shape[1])
     for e in range(dofs.shape[0]):
-        for j in range(wmap.shape[1]):
-            w[j] = X[wmap[e, j]]
-        Ae[:] = 0.0
-        _tabulate(kern, Ae.ctypes.data, w.ctypes.data, consts.ctypes.data, coords[e].ctypes.data,
-                  local[e].ctypes.data, perm.ctypes.data)
+        _element(Ae, w, kern, X, consts, coords, local, wmap, perm, e)
         for i in range(m):
             for j in range(m):
                 A[dofs[e, i], dofs[e, j]] += Ae[i * m + j]

@@ -20,7 +20,6 @@ import math
 import numba
 import numpy as np
 
-from rawehelix.solvers import generalised_alpha as ga
 from rawehelix.solvers.chord import ChordAlpha
 from rawehelix.solvers.compiled_forms import CompiledForms, jacobian, residual
 from rawehelix.solvers.snes import SolverError
