@@ -22,11 +22,11 @@ OPTION = "-rawehelix_ts_compiled"
 def refusal(ts_type: str, adapt: str, comm_size: int, end_twist) -> str | None:
     """Why the compiled steps cannot run this solver (None: they can)."""
     if comm_size > 1:
-        return "runs on one rank (drop it, or run without mpirun)"
+        return "run on one rank (drop it, or run without mpirun)"
     if ts_type != "alpha2":
         return f"steps alpha2 only, not -rawehelix_ts_type {ts_type}"
     if adapt != "none":
-        return ("takes fixed steps: a scene with a moving upper end (ends.circle_radius_m > 0), "
+        return ("take fixed steps: a scene with a moving upper end (ends.circle_radius_m > 0), "
                 "or -rawehelix_ts_adapt_type none")
     if end_twist is not None:
         return "does not run the prescribed end twist of the torsion test"
