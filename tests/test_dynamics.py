@@ -208,11 +208,9 @@ def test_without_twist_field(ts_type):
 
 @pytest.mark.parametrize("kinematics", (
     "paper", "extensible", "extensible+EI_law",
-    # -rawehelix_ts_compiled 1 (issue 46): its chord Newton (Hairer's test at 1e-11) leaves
-    # a balance of 4.2e-5 (4.4e-5 drift; 7.0e-6 at tol 1e-13) where TS's full Newton
-    # leaves 3.1e-7: not yet within 1e-6, so the compiled steps are not the default
-    pytest.param("paper+compiled", marks=pytest.mark.xfail(
-        strict=True, reason="chord Newton's stopping error: balance 4.2e-5 > 1e-6"))))
+    # -rawehelix_ts_compiled 1 (issue 46): balance 2.9e-7 with Hairer's test at 1e-14
+    # (solvers/compiled_dynamics.py; at ChordAlpha's 1e-11 it was 4.2e-5)
+    "paper+compiled"))
 def test_energy_is_conserved(kinematics):
     """Undamped, unforced free vibration, alpha2 with spectral radius 1 (the
     trapezoidal rule): the energy above the stationary state stays within 0.1%
