@@ -72,3 +72,15 @@ def test_compiled_steps_refuse_what_they_do_not_step(options, allowed):
     with pytest.raises(SceneError, match=f"-rawehelix_ts_compiled: .*{allowed}"):
         DynamicsSolver(params, MPI.COMM_SELF, options={"ts_compiled": 1, **options})
 
+
+
+@pytest.mark.mpi
+def test_compiled_steps_refuse_two_ranks():
+    """MPI: the compiled steps are one rank's; on 2 ranks every rank refuses alike
+    (no rank left waiting), naming the option."""
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        pytest.skip("refuses on 2 ranks: run under mpirun -n 2")
+    params = scene.load("mobile_end", elements=2, degree=3)
+    with pytest.raises(SceneError, match="-rawehelix_ts_compiled: the compiled steps run on one rank"):
+        DynamicsSolver(params, comm, options={"ts_compiled": 1})
