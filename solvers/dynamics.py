@@ -41,7 +41,6 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
-from rawehelix.errors import SceneError
 from rawehelix.parameters import Parameters
 from rawehelix.solvers import compiled_dynamics
 from rawehelix.solvers.discrete import RodDiscretisation
@@ -55,6 +54,10 @@ from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
 
 PREFIX = "rawehelix_"
+#: integrations other than PETSc TS: solvers/compiled_step.py registers "compiled" when
+#: imported (which imports the rod operator, which imports this module: not from here)
+ADVANCES: dict = {}
+
 TS_DEFAULTS = {
     "ts_type": "alpha2",
     "ts_alpha_radius": 0.9,
@@ -135,14 +138,7 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
-            options_db = PETSc.Options()
-            compiled = options_db.getBool(PREFIX + "ts_compiled", False)  # issue 46
-            why = compiled and compiled_dynamics.refusal(
-                ts_type, options_db.getString(PREFIX + "ts_adapt_type", "basic"), comm.size,
-                end_twist)
-            if why:
-                raise SceneError("PETSc options", compiled_dynamics.OPTION,
-                                 f"the compiled steps {why}")
+            compiled = compiled_dynamics.wanted(PREFIX, ts_type, comm.size, end_twist)  # issue 46
             if end_twist is not None and ts_type != "alpha2":
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
@@ -151,7 +147,7 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
             self.ts = self._create_ts(ts_type)
-            self._compiled = compiled_dynamics.CompiledAdvance if compiled else None
+            self.compiled_wanted, self._compiled = compiled, None  # ADVANCES["compiled"]
             self._alpha_radius = PETSc.Options().getReal(PREFIX + "ts_alpha_radius", 0.9)
         self.probes = Probes(self.form)
         rod_ = self.rod
@@ -181,10 +177,11 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
 
     @property
     def compiled(self):
-        """The compiled steps' :class:`~rawehelix.solvers.compiled_dynamics.CompiledAdvance`
+        """The compiled steps' :class:`~rawehelix.solvers.compiled_step.CompiledAdvance`
         (built at first use), or None: PETSc TS steps (``-rawehelix_ts_compiled``)."""
-        if isinstance(self._compiled, type):
-            self._compiled = self._compiled(self, self._alpha_radius)
+        if self._compiled is None and self.compiled_wanted:
+            compiled_dynamics.check_loaded(ADVANCES)
+            self._compiled = ADVANCES["compiled"](self, self._alpha_radius)
         return self._compiled
 
     def residual_floor(self) -> float:

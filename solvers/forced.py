@@ -48,6 +48,8 @@ class FEBackend:
         self.params = params
         self.solver = DynamicsSolver.from_stationary(
             params, comm, options={**self.OPTIONS, **(options or {})})
+        if self.solver.compiled_wanted:  # -rawehelix_ts_compiled 1: registers the steps
+            import rawehelix.solvers.compiled_step  # noqa: F401
         self.dt = params.time.dt_s / params.normalised().t_scale
         self._stationary = self.solver.state()
         self._motion = (params.ends.circle_frequency_Hz, 0.0)

@@ -256,6 +256,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     disc, tm = params.discretisation, params.time
     until_s = until_s if until_s is not None else tm.until_s
     solver = DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name)
+    if solver.compiled_wanted:  # -rawehelix_ts_compiled 1: registers the compiled steps
+        import rawehelix.solvers.compiled_step  # noqa: F401
     tracker = structure_limits.of_params(params)
     rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)),
                     tracker=tracker, limits_every=LIMITS_EVERY)

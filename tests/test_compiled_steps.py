@@ -84,3 +84,14 @@ def test_compiled_steps_refuse_two_ranks():
     params = scene.load("mobile_end", elements=2, degree=3)
     with pytest.raises(SceneError, match="-rawehelix_ts_compiled: the compiled steps run on one rank"):
         DynamicsSolver(params, comm, options={"ts_compiled": 1})
+
+
+def test_compiled_steps_not_loaded_say_so():
+    """The steps register themselves when solvers/compiled_step.py is imported
+    (simulate and the sweep's backend import it); a registry without them refuses
+    with the option's name instead of running PETSc TS silently."""
+    from rawehelix.errors import SolverError
+    from rawehelix.solvers import compiled_dynamics, compiled_step, dynamics
+    assert dynamics.ADVANCES["compiled"] is compiled_step.CompiledAdvance
+    with pytest.raises(SolverError, match="-rawehelix_ts_compiled: the compiled steps are not loaded"):
+        compiled_dynamics.check_loaded({})

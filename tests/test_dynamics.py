@@ -171,6 +171,8 @@ def test_temporal_order(ts_type, order, until, dts):
 
     ts_type, _, compiled = ts_type.partition("+")
     opts = {"ts_type": ts_type, "ts_adapt_type": "none", **({"ts_compiled": 1} if compiled else {})}
+    if compiled:
+        import rawehelix.solvers.compiled_step  # noqa: F401  (registers the compiled steps)
 
     def run(dt):
         solver = perturbed(free_scene(dt_s=dt), opts, 1e-3, 1e-2)
@@ -239,6 +241,8 @@ def test_energy_is_conserved(kinematics):
     balance 7.0e-7."""
     kinematics, _, law = kinematics.partition("+")
     compiled, law = law == "compiled", law != "compiled" and law
+    if compiled:
+        import rawehelix.solvers.compiled_step  # noqa: F401  (registers the compiled steps)
     p = free_scene(elements=8).replace(  # EI_law: Eq. (64)
         model={"kinematics": kinematics},
         helix={"EI_law": PAPER_EI_LAW if law else None})
