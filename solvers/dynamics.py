@@ -292,7 +292,7 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         the state is then the last good one (see :meth:`state`)."""
         if not self._has_state:
             raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
-        if self.compiled is not None:  # -rawehelix_ts_compiled: solvers/compiled_dynamics.py
+        if self.compiled is not None:  # -rawehelix_ts_compiled: compiled_step.CompiledAdvance
             return self.compiled(t_end, on_step, on_output, output_every)
         ts = self.ts
         t0 = ts.getTime()
