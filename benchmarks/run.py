@@ -36,6 +36,11 @@ sections and keeps the others' last results.
     stationary solves (benchmarks/operate.py).
 16. ``campbell``: the Campbell diagram of those 25 points against the power curve
     (benchmarks/campbell.py).
+17. ``compiled``: issue 46's target, the Sec. 5.3 run by `simulate` (10 Hz, N = 8,
+    p = 3, dt = 0.5 ms) with -rawehelix_ts_compiled 1 against PETSc TS in the same
+    process, taken in turn: CPU real-time factor of the time loop, output every 2 ms
+    (the scene's) and every 50 ms, and T max at 10 Hz on both paths (the sweep's
+    periodic response) against TENSION_MAX_REF_N.
 14. ``hb``: harmonic balance (benchmarks/harmonic_balance.py): the whole curve at N = 8
     against the sweep, at N = 32, a fold curve over EI x 4, and a point's parts.
 11. ``curve``: the issue-13 target, the whole Fig. 8 curve by continuation
@@ -69,6 +74,7 @@ import operate as operate_bench  # benchmarks/operate.py
 import hb_stability as hb_stability_bench  # benchmarks/hb_stability.py
 import network as network_bench  # benchmarks/network.py
 import study as study_bench  # benchmarks/study.py
+import compiled_step as compiled_bench  # benchmarks/compiled_step.py
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
@@ -507,6 +513,40 @@ def bench_chord(repeats: int, sim_s: float = 1.0):
     return out
 
 
+def bench_compiled(repeats: int, sim_s: float = 2.0):
+    """Issue 46 (module docstring, item 15): compiled steps against TS, same process."""
+    from mpi4py import MPI
+    from rawehelix.solvers.forced import FEBackend
+    from rawehelix.solvers.periodic import periodic_response
+    variants = {"ts": {}, "compiled": {"ts_compiled": 1}}
+    base = _chord_params(5e-4, ends={"circle_frequency_Hz": 10.0})
+    compiled_bench._loop_cpu(base, 0.01, variants["compiled"])  # the JIT (cached on disk)
+    out = {}
+    for every in (0.002, 0.05):
+        params = base.replace(time={"output_every_s": every})
+        cpu, parts = {k: [] for k in variants}, {}
+        for _ in range(repeats):
+            for key, options in variants.items():
+                c, _ = compiled_bench._loop_cpu(params, sim_s, options,
+                                                parts if key == "compiled" else None)
+                cpu[key].append(sim_s / c)
+        row = {k: {"rtf": stats(v)} for k, v in cpu.items()}
+        row["speedup"] = row["compiled"]["rtf"]["median"] / row["ts"]["rtf"]["median"]
+        row["compiled_parts_s"] = {k: v / repeats for k, v in parts.items()}
+        out[f"output_every_{every * 1e3:g}ms"] = row
+    out["floor_us"] = compiled_bench.floor_us(base)
+    p = _chord_params(5e-4, sweep={"lead_in_s": 3.0, "periodic_tolerance": 1e-5})
+    for key, options in variants.items():
+        backend = FEBackend(p, MPI.COMM_SELF, options=options)
+        t0 = time.process_time()
+        result, _, _ = periodic_response(backend, p.normalised(), 10.0, backend.stationary(), 0.0,
+                                         p.sweep, lead_in=True)
+        out[f"tension_max_{key}"] = {"tension_max_N": result.tension_max_N,
+                                     "rel_error": result.tension_max_N / TENSION_MAX_REF_N - 1,
+                                     "cpu_s": time.process_time() - t0}
+    return out
+
+
 TARGETS = {
     "sweep": "FE at converged N: as fast as or faster than the paper's N = 2 reference (ratio <= 1)",
     "step_cost": "linear in N (exponent 1)",
@@ -614,6 +654,30 @@ def markdown(r: dict) -> str:
                      f"{_spread(t['rtf'], '.2f', '')} (x{v['speedup']:.2f}); T max error "
                      f"{c['tension_max_rel_error']:+.2e} (TS {t['tension_max_rel_error']:+.2e}) | "
                      f"{TARGETS['rtf']['sec5.3']} |")
+    comp = r.get("compiled") or {}
+    for key, v in comp.items():
+        if not key.startswith("output_every_"):
+            continue
+        c, t = v["compiled"], v["ts"]
+        tm = comp.get("tension_max_compiled", {})
+        lines.append(f"| 15. compiled steps (`-rawehelix_ts_compiled 1`), `simulate` mobile_end 10 Hz N = 8, "
+                     f"{key.replace('_', ' ')}, CPU of the time loop | real-time factor "
+                     f"{_spread(c['rtf'], '.2f', '')} against TS {_spread(t['rtf'], '.2f', '')} "
+                     f"(x{v['speedup']:.2f}); T max error {tm.get('rel_error', float('nan')):+.2e} (TS "
+                     f"{comp.get('tension_max_ts', {}).get('rel_error', float('nan')):+.2e}) | "
+                     f"real-time factor >= 10 on one core, output included, T max error <= 1e-3 "
+                     f"(issue 46) |")
+        parts = v.get("compiled_parts_s", {})
+        if parts.get("loop"):
+            lines.append(f"| 15. the compiled loop's parts, {key.replace('_', ' ')} (CPU, share of the loop) | "
+                         + "; ".join(f"{k} {100 * x / parts['loop']:.0f} %" for k, x in parts.items()
+                                     if k != "loop") + " | measured |")
+    if comp.get("floor_us"):
+        f = comp["floor_us"]
+        lines.append(f"| 15. a compiled step's parts at N = 8, p = 3 ({f['unknowns']} unknowns, "
+                     f"bandwidth {f['bandwidth']}), CPU | "
+                     + ", ".join(f"{k} {x:.1f} us" for k, x in f.items()
+                                 if k not in ("bandwidth", "unknowns")) + " | measured |")
     for N, row in (r.get("section_law") or {}).items():
         if N == "orbit_point":
             ratio = {law: row[f"{law}_ratio"] for law in ("tensegrity", "saturating")
@@ -686,7 +750,8 @@ def markdown(r: dict) -> str:
 
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
-            "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network")
+            "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network",
+            "compiled")
 
 
 def main():
@@ -725,7 +790,8 @@ def main():
                      ("operate", lambda: operate_bench.bench_operate(8, repeats)),
                      ("campbell", lambda: campbell_bench.bench_campbell(8, repeats)),
                      ("hb_stability", lambda: hb_stability_bench.bench_sizes()),
-                     ("network", lambda: network_bench.bench_network(stats, repeats))):
+                     ("network", lambda: network_bench.bench_network(stats, repeats)),
+                     ("compiled", lambda: bench_compiled(repeats))):
         if name not in only:
             continue
         t0 = time.perf_counter()

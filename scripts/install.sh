@@ -37,6 +37,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ scripts/install.sh 
   # does not see Debian's h5py (dist-info h5py._debian_h5py_serial) and would install
   # PyPI's over it; numpy, scipy, pandas and h5py are already there
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps "pyconturb==2.7.4"
+  # numba: the compiled time steps (-rawehelix_ts_compiled 1, solvers/compiled_step.py);
+  # 0.57.1: the version measured here with Debian 12's numpy 1.24.2 and Python 3.11
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check "numpy==$numpy_version" \
+      "numba==0.57.1"
   # pyvista renders off screen; it is optional and must not move numpy.  Before 0.46:
   # later ones bring cyclopts -> rich -> markdown-it-py >= 2.2, which shadows Debian's
   # 2.1 and breaks Debian's myst-parser (make docs), with a resolver error at install.

@@ -15,6 +15,8 @@ period loses less than 1e-4 of its amplitude per period.  Options (prefix
     -rawehelix_ts_jacobian_reuse 0.1   modified Newton: keep the Jacobian and its LU
                                        across iterations and steps until an iteration
                                        contracts |F| by less than this (0: full Newton)
+    -rawehelix_ts_compiled 1           alpha2's fixed steps by compiled chord Newton
+                                       (solvers/compiled_dynamics.py; one rank)
     -rawehelix_ts_snes_monitor, ...
 
 TSALPHA2 solves the second-order form; every other type gets the first-order
@@ -40,7 +42,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
-from rawehelix.solvers import weather
+from rawehelix.solvers import compiled_dynamics, weather
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
@@ -53,6 +55,10 @@ from rawehelix.solvers.stationary import StationarySolver
 from rawehelix.solvers.ts_forms import FirstOrder, SecondOrder
 
 PREFIX = "rawehelix_"
+#: integrations other than PETSc TS: solvers/compiled_step.py registers "compiled" when
+#: imported (which imports the rod operator, which imports this module: not from here)
+ADVANCES: dict = {}
+
 TS_DEFAULTS = {
     "ts_type": "alpha2",
     "ts_alpha_radius": 0.9,
@@ -137,6 +143,7 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
+            compiled = compiled_dynamics.wanted(PREFIX, ts_type, comm.size, end_twist)  # issue 46
             if end_twist is not None and ts_type != "alpha2":
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
@@ -144,12 +151,18 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             ends = EndTorques.of(self.q, self.machine)  # the rotor's and generator's (issue 43)
             # the wind in time and a start-up's release (issue 44), each set at each time
             self.weather, self.release, ends = weather.install(self.machine, self.q, self.rod, ends)
+            if compiled and (self.machine.active or self.weather is not None):
+                raise errors.SceneError("PETSc options", compiled_dynamics.OPTION,
+                                        "the compiled steps do not step the machine's end "
+                                        "torques or its wind in time: drop the option")
             self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
             self.form.time_data += [x for x in (self.weather, self.release) if x is not None]
             if end_twist is not None:
                 self.form.time_data.append(
                     lambda t: set_constant(self.rod.alpha_top, [end_twist(t)]))
             self.ts = self._create_ts(ts_type)
+            self.compiled_wanted, self._compiled = compiled, None  # ADVANCES["compiled"]
+            self._alpha_radius = PETSc.Options().getReal(PREFIX + "ts_alpha_radius", 0.9)
         self.probes = Probes(self.form)
         rod_ = self.rod
         self._v_top = dolfinx.fem.Function(rod_.V_r)  # the upper end's velocity, Eq. (70)
@@ -192,6 +205,15 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         solver.set_state(state)  # Eq. (40)'s C: its ground torque balances the top's
         solver.form.offset.value += torque
         return solver
+
+    @property
+    def compiled(self):
+        """The compiled steps' :class:`~rawehelix.solvers.compiled_step.CompiledAdvance`
+        (built at first use), or None: PETSc TS steps (``-rawehelix_ts_compiled``)."""
+        if self._compiled is None and self.compiled_wanted:
+            compiled_dynamics.check_loaded(ADVANCES)
+            self._compiled = ADVANCES["compiled"](self, self._alpha_radius)
+        return self._compiled
 
     def residual_floor(self) -> float:
         """An absolute Newton tolerance ten times the round-off floor of |F|.
@@ -301,6 +323,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         the state is then the last good one (see :meth:`state`)."""
         if not self._has_state:
             raise RuntimeError("DynamicsSolver: no state yet; call set_state or use from_stationary")
+        if self.compiled is not None:  # -rawehelix_ts_compiled: compiled_step.CompiledAdvance
+            return self.compiled(t_end, on_step, on_output, output_every)
         ts = self.ts
         t0 = ts.getTime()
         eps = 1e-9 * max(1.0, t_end)

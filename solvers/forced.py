@@ -48,6 +48,8 @@ class FEBackend:
         self.params = params
         self.solver = DynamicsSolver.from_stationary(
             params, comm, options={**self.OPTIONS, **(options or {})})
+        if self.solver.compiled_wanted:  # -rawehelix_ts_compiled 1: registers the steps
+            import rawehelix.solvers.compiled_step  # noqa: F401
         self.dt = params.time.dt_s / params.normalised().t_scale
         self._stationary = self.solver.state()
         self._motion = (params.ends.circle_frequency_Hz, 0.0)
@@ -94,6 +96,8 @@ class FEBackend:
 
     def advance(self, state: RodState, t0: float, t1: float, t_out):
         solver = self.solver
+        if solver.compiled is not None and self.section_sampler is None:
+            return self._advance_compiled(state, t0, t1, t_out)
         restart = self._begin(state, t0)
         ts = solver.ts
         ts.setTime(t0)  # (the sum of the steps may differ from t0 by round-off)
@@ -121,6 +125,28 @@ class FEBackend:
         values = np.array([v for _, v in samples])
         tension = np.interp(np.asarray(t_out), times, values) if len(times) else np.full(len(t_out), np.nan)
         return self._end(solver.state()), tension
+
+    def _advance_compiled(self, state: RodState, t0: float, t1: float, t_out):
+        """:meth:`advance` by the solver's compiled steps (``-rawehelix_ts_compiled 1``):
+        the same uniform steps, the tension at every step from the compiled loop."""
+        solver, form = self.solver, self.solver.form
+        compiled = solver.compiled
+        restart = self._begin(state, t0)
+        steps = math.ceil((t1 - t0) / self.dt - 1e-9)
+        h = (t1 - t0) / steps
+        it0, st0 = compiled.stepper.iterations, compiled.stepper.steps
+        u, v, tension = compiled.stepper.run(t0, h, steps, form.u.x.array.copy(),
+                                             form.v.x.array.copy(),
+                                             a=None if restart else compiled.stepper.acceleration)
+        solver.newton_iterations += compiled.stepper.iterations - it0
+        solver.steps += compiled.stepper.steps - st0
+        form.u.x.array[:] = u
+        form.v.x.array[:] = v
+        solver.ts.setTime(t1)
+        times = t0 + h * np.arange(steps + 1)
+        out = solver.rod.get_state(form.u, form.v, t1)
+        out.offset = float(form.offset.value)
+        return self._end(out), np.interp(np.asarray(t_out), times, tension)
 
     def parts(self, state: RodState) -> dict:
         """The state's parts whose change over a period says what is still moving

@@ -95,6 +95,7 @@ def probe():
     _set_up(PREFIX, made[-1], TS_DEFAULTS)
     _set_up(PREFIX + "ts_", made[-1].getSNES(), {**SNES_DEFAULTS, **lu}, *ksp_pc)
     PETSc.Options().getReal(PREFIX + "ts_jacobian_reuse", 0.0)
+    PETSc.Options().getBool(PREFIX + "ts_compiled", False)  # solvers/compiled_dynamics.py
     made.append(direct_solver(comm))  # the frequency response (solvers/response.py)
     _set_up(RESPONSE_PREFIX, made[-1], {})
     from slepc4py import SLEPc  # the modes (solvers/pep.py)

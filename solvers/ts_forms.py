@@ -45,6 +45,7 @@ import numpy as np
 import ufl
 from petsc4py import PETSc
 
+import dolfinx.cpp
 import dolfinx.fem
 
 from rawehelix import compat
@@ -214,6 +215,29 @@ class _Formulation:
             dolfinx.fem.petsc.set_bc(g, self.bcs)
             self._bc_values = g.getArray(readonly=True)[self.bc_dofs].copy()
         return self._bc_values
+
+    def bc_sources(self):
+        """(functions, index): g at :attr:`bc_dofs` is
+        ``np.concatenate([f.x.array for f in functions])[index]`` after any set_time
+        (found once by probing set_bc with numbered values): a gather of a few us,
+        where :meth:`bc_values` goes through a PETSc vector (~15 us at N = 8)."""
+        functions = [bc.value for bc in self.bcs]
+        if not all(isinstance(f, (dolfinx.fem.Function, dolfinx.cpp.fem.Function_float64))
+                   for f in functions):
+            return None  # a Constant's value: no probing needed by the callers so far
+        saved = [f.x.array.copy() for f in functions]
+        start = 1.0
+        try:
+            for f in functions:
+                f.x.array[:] = start + np.arange(f.x.array.size)
+                start += f.x.array.size
+            self._bc_values = None
+            index = np.round(self.bc_values()).astype(np.int64) - 1
+        finally:
+            for f, s in zip(functions, saved):
+                f.x.array[:] = s
+            self._bc_values = None
+        return functions, index
 
     def _bc_mismatch(self, x) -> float:
         """max |x - g| over this rank's owned Dirichlet dofs (g of the last set_time)."""

@@ -264,6 +264,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     until_s = until_s if until_s is not None else tm.until_s
     ends = machine.of(params)  # the rotor and the generator (issue 43); off: the paper's
     solver, start_point = machine.solver(params, ends, comm, options)
+    if solver.compiled_wanted:  # -rawehelix_ts_compiled 1: registers the compiled steps
+        import rawehelix.solvers.compiled_step  # noqa: F401
     tracker = structure_limits.of_params(params)
     rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)),
                     tracker=tracker, limits_every=LIMITS_EVERY,

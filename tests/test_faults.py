@@ -36,6 +36,10 @@ FAULTS = [
      "-rawehelix_snes_type nonexistent: Unable to find requested SNES type nonexistent"),
     (["simulate", "nominal_operation", "-rawehelix_ts_type", "nonexistent"], 2,
      "Unknown TS type: nonexistent"),
+    # the compiled steps (issue 46) on a scene of adaptive steps: refused when the
+    # dynamics solver is built (after the stationary solve), nothing written
+    (["simulate", "nominal_operation", "--elements", "2", "-rawehelix_ts_compiled", "1"], 2,
+     "-rawehelix_ts_compiled: the compiled steps take fixed steps"),
     (["response", "mobile_end", "-rawehelix_ksp_rtol", "abc"], 2,
      "-rawehelix_ksp_rtol abc: Input string abc has no numeric value"),
     (["labtest", "bending", "-rawehelix_labtest_snes_type", "nonexistent"], 2,

@@ -1,0 +1,130 @@
+"""Issue 46: the Sec. 5.3 run (mobile_end, 10 Hz, N = 8, p = 3, dt = 0.5 ms) by
+`simulate` with PETSc TS (the default) against -rawehelix_ts_compiled 1, taken in
+turn in one process, ``--repeats`` times; CPU time (process_time) of the time
+loop (DynamicsSolver.advance: steps and the outputs' callbacks; set-up, the
+stationary solve and the JIT excluded), and the same loop's parts on the compiled
+path (the compiled steps, the time data in Python, the outputs).  Not a test.
+
+    .venv/bin/python benchmarks/compiled_step.py [--until 2] [--repeats 3] [--output-every 0.002]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import time
+
+import numpy as np
+
+
+def _loop_cpu(params, until, options, parts=None):
+    """CPU seconds of simulate.compute's time loop (and ``parts``: seconds by part)."""
+    from rawehelix.solvers import compiled_step
+    from rawehelix.solvers.dynamics import DynamicsSolver
+    from rawehelix.studies import simulate
+    acc = {"loop": 0.0}
+    saved = {}
+
+    def wrap(obj, name, key):
+        f = saved[(obj, name)] = getattr(obj, name)
+
+        def timed(*a, **k):
+            t = time.process_time()
+            try:
+                return f(*a, **k)
+            finally:
+                acc[key] = acc.get(key, 0.0) + time.process_time() - t
+        setattr(obj, name, timed)
+    wrap(DynamicsSolver, "advance", "loop")
+    if parts is not None:
+        wrap(compiled_step.CompiledChordAlpha, "time_data", "time data (set_time, Python)")
+        wrap(compiled_step, "_steps", "compiled steps (nopython)")
+        wrap(DynamicsSolver, "_accepted", "outputs (probes, limits, frames)")
+    try:
+        result = simulate.compute(params, until_s=until, options=options, progress=False)
+    finally:
+        for (obj, name), f in saved.items():
+            setattr(obj, name, f)
+    if parts is not None:
+        for k, v in acc.items():
+            parts[k] = parts.get(k, 0.0) + v
+    return acc["loop"], result
+
+
+def floor_us(params, repeats: int = 2000) -> dict:
+    """CPU microseconds of a compiled step's parts at the stationary state (a loop of
+    ``repeats`` calls from Python; the call's dispatch, ~1-2 us, included)."""
+    from rawehelix.solvers import compiled_forms
+    from rawehelix.solvers.compiled_step import CompiledChordAlpha, _lu_factor, _lu_solve
+    s = CompiledChordAlpha(params)
+    op, forms = s.op, s.forms
+    n, kl = op.n, forms.bandwidth
+    X, c = op.X_stationary.copy(), forms.constants()
+    h = params.time.dt_s / params.normalised().t_scale
+    cj = forms.jacobian_constants(c, *s.alpha.shifts(h))
+    Fp, Jp = forms.pieces()
+    R, A, piv, x = np.zeros(n), np.zeros((n, n)), np.zeros(n, np.int64), np.zeros(n)
+    compiled_forms.jacobian(A, X, cj, Jp, s._bc)
+    _lu_factor(A.copy(), piv, kl)
+    LU = A.copy()
+    _lu_factor(LU, piv, kl)
+    parts = {"residual F": lambda: compiled_forms.residual(R, X, c, Fp),
+             "banded LU solve": lambda: _lu_solve(LU, piv, kl, R, x),
+             "Jacobian J": lambda: compiled_forms.jacobian(A, X, cj, Jp, s._bc),
+             "banded LU factor": lambda: _lu_factor(A.copy(), piv, kl),
+             "time data (set_time, constants, g)": lambda: s.time_data([0.1])}
+    out = {}
+    for name, f in parts.items():
+        m = repeats // 10 if "J" in name or "factor" in name else repeats
+        f()
+        t0 = time.process_time()
+        for _ in range(m):
+            f()
+        out[name] = (time.process_time() - t0) / m * 1e6
+    out["bandwidth"], out["unknowns"] = kl, n
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--until", type=float, default=2.0)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--output-every", type=float, default=None,
+                        help="time.output_every_s (default: the scene's, 2 ms)")
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args()
+    logging.getLogger().setLevel(logging.WARNING)
+    from rawehelix.studies import scene
+    params = scene.load("mobile_end", elements=8, degree=3).replace(
+        ends={"circle_frequency_Hz": 10.0})
+    if args.output_every:
+        params = params.replace(time={"output_every_s": args.output_every})
+    variants = {"ts": {}, "compiled": {"ts_compiled": 1}}
+    _loop_cpu(params, 0.01, variants["compiled"])  # the JIT (cached to disk after the first)
+    cpu = {k: [] for k in variants}
+    rows, parts = {}, {}
+    for _ in range(args.repeats):
+        for key, options in variants.items():
+            c, result = _loop_cpu(params, args.until, options, parts if key == "compiled" else None)
+            cpu[key].append(c)
+            rows[key] = result.rows
+    out = {"until_s": args.until, "output_every_s": params.time.output_every_s}
+    for key in variants:
+        rtf = args.until / np.array(cpu[key])
+        out[key] = {"rtf_median": float(np.median(rtf)), "rtf_min": float(rtf.min()),
+                    "rtf_max": float(rtf.max()), "loop_cpu_s": cpu[key]}
+    out["ratio"] = out["compiled"]["rtf_median"] / out["ts"]["rtf_median"]
+    out["compiled_parts_s"] = {k: v / args.repeats for k, v in parts.items()}  # each run's
+    T = {k: r[:, 5] for k, r in rows.items()}
+    out["tension_s0_max_N"] = {k: float(v.max()) for k, v in T.items()}
+    out["tension_s0_rel_diff"] = float(np.abs(T["compiled"] - T["ts"]).max() / np.abs(T["ts"]).max())
+    out["floor_us"] = floor_us(params)
+    print(json.dumps(out, indent=1))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

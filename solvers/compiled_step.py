@@ -1,0 +1,340 @@
+"""TSALPHA2's steps by chord Newton, compiled (issue 46): solvers/chord.py's loop
+(:meth:`~rawehelix.solvers.generalised_alpha.AlphaStepper.solve_stage`, its
+predictor, Hairer's test, the LU refresh rule and its failures) in numba's
+nopython mode, on F and J assembled by the FFCx kernels
+(:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting (J's band from the mesh's dofs).
+
+The time data (the forms' constants and the Dirichlet values g at each step's
+stage time) come from the formulation's own ``set_time`` (Python, once per step,
+before the compiled loop): the loop only reads them.  So the numbers are
+ChordAlpha's to the Newton tolerance (tests/test_compiled_steps.py compares them
+with TS).  Like ChordAlpha it has no line search: a step whose Newton diverges
+with a fresh Jacobian raises; one
+rank, dense (3 n <= generalised_alpha.MAX_STATE).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from rawehelix.solvers import compiled_dynamics, dynamics
+from rawehelix.solvers.chord import ChordAlpha
+from rawehelix.solvers.compiled_forms import CompiledForms, jacobian, residual
+from rawehelix.solvers.generalised_alpha import TOL
+from rawehelix.solvers.snes import SolverError
+
+# the compiled loop's outcomes (its return code)
+OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
+
+
+@numba.njit(cache=True)
+def _lu_factor(A, piv, kl):
+    """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
+    storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
+    in kl rows and U has kl + kl off-diagonals; a swap moves the trailing columns
+    only, so L's column k stays in rows k + 1 .. k + kl (a full-row swap would move
+    its entries further from the diagonal than the solve reads).  Returns the first zero pivot's
+    row + 1 (0: none)."""
+    n = A.shape[0]
+    for k in range(n):
+        last = min(n - 1, k + kl)
+        p, big = k, abs(A[k, k])
+        for i in range(k + 1, last + 1):
+            if abs(A[i, k]) > big:
+                p, big = i, abs(A[i, k])
+        piv[k] = p
+        if big == 0.0:
+            return k + 1
+        right = min(n - 1, k + 2 * kl)
+        if p != k:  # the trailing columns only: L's column j stays where step j put it
+            for j in range(k, right + 1):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        d = A[k, k]
+        for i in range(k + 1, last + 1):
+            f = A[i, k] / d
+            A[i, k] = f
+            if f != 0.0:
+                for j in range(k + 1, right + 1):
+                    A[i, j] -= f * A[k, j]
+    return 0
+
+
+@numba.njit(cache=True)
+def _lu_solve(LU, piv, kl, b, x):
+    """x = J^-1 b with :func:`_lu_factor`'s factors."""
+    n = LU.shape[0]
+    x[:] = b
+    for k in range(n):  # L (unit diagonal, kl below) with the row swaps in turn (gbtrs)
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
+        xk = x[k]
+        for i in range(k + 1, min(n, k + kl + 1)):
+            x[i] -= LU[i, k] * xk
+    for i in range(n - 1, -1, -1):  # U (2 kl above)
+        s = x[i]
+        for j in range(i + 1, min(n, i + 2 * kl + 1)):
+            s -= LU[i, j] * x[j]
+        x[i] = s / LU[i, i]
+
+
+@numba.njit(cache=True)
+def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, Fp, Jp,
+           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
+    """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
+    (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
+    Dirichlet values.  Returns (code, step, size, theta) and counts iterations and
+    factorisations in ``counters``."""
+    am, af, g_, b_ = scheme[0], scheme[1], scheme[2], scheme[3]
+    n = u.shape[0]
+    X = np.empty(3 * n)
+    R, dz, z = np.empty(n), np.empty(n), np.empty(n)
+    cj = np.empty(cJ.shape[0])
+    for k in range(G.shape[0]):
+        # predictor (AlphaStepper.predict): extrapolation, or constant acceleration
+        if nhist[0] < order + 1:
+            for i in range(n):
+                z[i] = u[i] + af * (h * v[i] + 0.5 * h * h * a[i])
+        elif order == 2:
+            for i in range(n):
+                z[i] = 3.0 * hist[0, i] - 3.0 * hist[1, i] + hist[2, i]
+        else:
+            for i in range(n):
+                z[i] = hist[0, i]
+        for j in range(bc.shape[0]):
+            z[bc[j]] = G[k, j]
+        zmax = 0.0
+        for i in range(n):
+            zmax = max(zmax, abs(z[i]))
+        noise = 1e-14 * max(1.0, zmax)  # generalised_alpha.ROUNDOFF
+        # newmark's V_a, A_a of z
+        for i in range(n):
+            u1 = (z[i] - (1 - af) * u[i]) / af
+            a1 = (u1 - u[i] - h * v[i] - h * h * (0.5 - b_) * a[i]) / (b_ * h * h)
+            v1 = v[i] + h * ((1 - g_) * a[i] + g_ * a1)
+            X[n + i] = v[i] + af * (v1 - v[i])
+            X[2 * n + i] = a[i] + am * (a1 - a[i])
+        fresh, last, size, theta = False, -1.0, 0.0, -1.0
+        done = False
+        for it in range(max_it):
+            for i in range(n):
+                X[i] = z[i]
+            if not has_lu[0]:
+                for j in range(cF.shape[1]):
+                    cj[shift_slots[2 + j]] = cF[k, j]
+                cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
+                jacobian(LU, X, cj, Jp, bc)
+                if _lu_factor(LU, piv, kl) != 0:
+                    return SINGULAR, k, 0.0, -1.0
+                has_lu[0] = True
+                counters[1] += 1
+                fresh, last = True, -1.0
+            residual(R, X, cF[k], Fp)
+            for j in range(bc.shape[0]):
+                R[bc[j]] = 0.0
+            _lu_solve(LU, piv, kl, R, dz)
+            size = 0.0
+            for i in range(n):
+                size = max(size, abs(dz[i]))
+            if not size < math.inf:
+                return NON_FINITE, k, size, theta
+            at_floor = size <= noise
+            theta = -1.0 if (at_floor or last < 0.0) else size / last
+            if theta >= 1.0:
+                if size <= 100.0 * noise:  # generalised_alpha.STALL: converged at R's floor
+                    done = True
+                    break
+                if fresh:
+                    return DIVERGES, k, size, theta
+                has_lu[0] = False
+                continue
+            for i in range(n):
+                z[i] -= dz[i]
+                X[n + i] -= sv * dz[i]
+                X[2 * n + i] -= sa * dz[i]
+            counters[0] += 1
+            if at_floor:
+                done = True
+                break
+            if theta >= 0.0:
+                eta = theta / (1.0 - theta)
+                if eta * size <= tol:
+                    if theta > rate:
+                        has_lu[0] = False
+                    done = True
+                    break
+                if theta > rate:
+                    has_lu[0] = False
+                    fresh = False
+                    continue
+            last = size
+        if not done:
+            return NO_CONVERGENCE, k, size, theta
+        for i in range(n):
+            u[i] = u[i] + (z[i] - u[i]) / af
+            v[i] = v[i] + (X[n + i] - v[i]) / af
+            a[i] = a[i] + (X[2 * n + i] - a[i]) / am
+        for j in range(hist.shape[0] - 1, 0, -1):
+            hist[j, :] = hist[j - 1, :]
+        hist[0, :] = z
+        nhist[0] = min(nhist[0] + 1, hist.shape[0])
+        counters[2] += 1
+        r2 = 0.0
+        for c in range(3):
+            d = 0.0
+            for i in range(n):
+                d += D[c, i] * u[i]
+            r2 += d * d
+        tension[k] = sigma * (math.sqrt(r2) - 1.0)
+    return OK, G.shape[0], 0.0, 0.0
+
+
+class CompiledChordAlpha(ChordAlpha):
+    """ChordAlpha whose steps (not its start) run compiled: same scheme, predictor,
+    chord Newton and tests, on the FFCx kernels (module docstring)."""
+
+    def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
+                 rate: float = 0.03, max_it: int = 8, order: int = 2):
+        if order not in (0, 2):
+            raise SolverError(f"compiled steps: predictor order {order} (0 or 2)")
+        super().__init__(params, rho_inf, solver, tol, rate, max_it, order)
+        op = self.op
+        self.forms = CompiledForms(op)
+        self._Fp, self._Jp = self.forms.pieces()
+        sv_slot, sa_slot, rest = self.forms._shift_slots
+        self._slots = np.concatenate([[sv_slot, sa_slot], rest]).astype(np.int64)
+        self._bc = np.asarray(op.bc_dofs, dtype=np.int64)
+        n = op.n
+        self._LU, self._piv = np.zeros((n, n)), np.zeros(n, np.int64)
+        self._has_lu, self._lu_h = np.zeros(1, np.bool_), None
+        self._counters = np.zeros(3, np.int64)
+        # the last stage values (newest first), carried into a continued run
+        self._hist, self._nhist = np.zeros((3, n)), np.zeros(1, np.int64)
+        self._bc_sources = op.form.bc_sources()
+        if self._bc_sources is None:
+            raise SolverError("compiled steps: a Dirichlet value that is not a function")
+
+    # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
+    iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
+    factorisations = property(lambda self: self.alpha.factorisations + int(self._counters[1]))
+    steps = property(lambda self: self.alpha.steps + int(self._counters[2]))
+
+    def time_data(self, times):
+        """(constants of F, Dirichlet values) at each stage time, from the form's set_time."""
+        op, forms = self.op, self.forms
+        functions, index = self._bc_sources
+        cF = np.empty((len(times), forms.constants().size))
+        G = np.empty((len(times), self._bc.size))
+        for k, t in enumerate(times):
+            op.set_time(t)
+            cF[k] = forms.constants()
+            G[k] = np.concatenate([f.x.array for f in functions])[index]
+        return cF, G
+
+    def run(self, t0, h, steps, u, v, a=None):
+        """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's); a
+        run continued (``a`` given, the same h) keeps the predictor's history."""
+        alpha = self.alpha
+        tension = np.empty(steps + 1)
+        tension[0] = self.tension0(u)
+        given = a
+        if a is None:
+            a = self.start(t0, h, u, v)
+        u, v, a = u.copy(), v.copy(), np.array(a, dtype=float)
+        same_h = self._lu_h is not None and abs(h - self._lu_h) <= 1e-9 * h
+        if not same_h:  # the LU's shifts are h's (round-off of h: the chord copes)
+            self._has_lu[0], self._lu_h = False, h
+        if given is None or not same_h:  # the predictor's history: a new start
+            self._nhist[0] = 0
+        hist, nhist = self._hist, self._nhist
+        scheme = np.array(alpha.scheme)
+        sv, sa = alpha.shifts(h)
+        cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h)
+        code, k, size, theta = _steps(
+            u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
+            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
+            self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
+            alpha.order, self._counters)
+        if code != OK:
+            t = t0 + k * h
+            self._has_lu[0] = False
+            raise SolverError({
+                NON_FINITE: f"compiled alpha2: the state became NaN or Inf at t = {t:.6g} "
+                            f"(normalised)",
+                DIVERGES: f"compiled alpha2: Newton diverges with a fresh Jacobian at t = {t:.6g} "
+                          f"(normalised; contraction {theta:.2g}, |dz| {size:.2g}); try a smaller step "
+                          f"(time.dt_s)",
+                NO_CONVERGENCE: f"compiled alpha2: no convergence in {alpha.max_it} iterations at "
+                                f"t = {t:.6g} (normalised; last |dz| = {size:.3g}, tol "
+                                f"{alpha.tol:g}); try a smaller step (time.dt_s)",
+                SINGULAR: f"compiled alpha2: the Jacobian is singular at t = {t:.6g} (normalised); "
+                          f"try a smaller step (time.dt_s)"}[code])
+        self.acceleration = a
+        return u, v, tension
+
+
+class CompiledAdvance:
+    """``DynamicsSolver.advance`` by compiled steps (module docstring)."""
+
+    def __init__(self, solver, rho_inf: float):
+        self.solver = solver
+        # Hairer's test at the orbits' 1e-14, not ChordAlpha's 1e-11: the energy balance
+        # of an undamped free vibration is then TS's (2.9e-7 against 3.1e-7 over 2000
+        # steps; 1e-11: 4.2e-5, 1e-13: 7.0e-6), for 2.8 iterations a step instead of 2.0
+        self.stepper = CompiledChordAlpha(solver.params, rho_inf, solver=solver, tol=TOL)
+        self._last = None  # (t, U) where the last advance ended, with its acceleration
+
+    def __call__(self, t_end: float, on_step=None, on_output=None, output_every=None):
+        solver, stepper = self.solver, self.stepper
+        ts, form = solver.ts, solver.form
+        t = ts.getTime()
+        eps = 1e-9 * max(1.0, t_end)
+        h0 = ts.getTimeStep()
+        steps = max(1, math.ceil((t_end - t) / h0 - 1e-9))
+        h_end = (t_end - t) / steps
+        if on_step is not None:  # every step is an output
+            ends = [t + k * h_end for k in range(1, steps + 1)]
+        elif output_every:
+            n = int(math.floor((t_end - t) / output_every + 1e-9))
+            ends = [t + k * output_every for k in range(1, n + 1)]
+            if not ends or ends[-1] < t_end - eps:
+                ends.append(t_end)
+        else:
+            ends = [t_end]
+        U, V = ts.getSolution2()
+        u, v = form.u.x.array.copy(), form.v.x.array.copy()
+        last = self._last
+        a = last[2] if (last is not None and abs(last[0] - t) <= eps
+                        and (last[1] == u).all()) else None
+        solver._on_step, solver._on_output = on_step, on_output
+        if solver._fresh:
+            solver._fresh = False
+            solver._pending = []
+            solver._accepted(t, first=True)
+        it0, st0 = stepper.iterations, stepper.steps
+        try:
+            for end in ends:
+                n = max(1, math.ceil((end - t) / h0 - 1e-9))
+                try:
+                    u, v, _ = stepper.run(t, (end - t) / n, n, u, v, a)
+                except SolverError as err:
+                    solver._restore_good()
+                    t_s = solver.q.time_s(solver._good[0] if solver._good else t)
+                    raise SolverError(f"dynamics stopped at t = {float(t_s):.6g} s (simulated): "
+                                      f"{err}; or run without {compiled_dynamics.OPTION}") from None
+                a, t = stepper.acceleration, end
+                U.array[:] = u
+                V.array[:] = v
+                ts.setTime(t)
+                solver._pending = [t]
+                solver._accepted(t)
+        finally:
+            solver.newton_iterations += stepper.iterations - it0
+            solver.steps += stepper.steps - st0
+        self._last = (t, u.copy(), a)
+
+
+dynamics.ADVANCES["compiled"] = CompiledAdvance
