@@ -50,7 +50,13 @@ def solver(params, machine: Machine, comm, options):
     """(DynamicsSolver, the summary's ``machine`` block): started at the operating
     point with a rotor; from the stationary state at rest without one."""
     from rawehelix.solvers.dynamics import DynamicsSolver
-    if machine.rotor is None or starts_from_rest(params, machine):
+    rest = machine.rotor is None or starts_from_rest(params, machine)
+    if rest and params.lifter.active:  # the lifted top starts at the operating point only
+        raise SceneError(params.name, "lifter.top",
+                         "'lifted' in simulate starts from the lifted state at the rotor's "
+                         "operating point: give [rotor] a table and no generator.release_rpm, "
+                         "or set lifter.top = 'fixed' (--set 'lifter.top=\"fixed\"')")
+    if rest:
         return DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name), \
             ({"start": "rest", "wind_hub_m_s": machine.wind_hub_m_s} if machine.rotor else {})
     point = start_point(params, machine)
