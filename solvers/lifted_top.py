@@ -31,8 +31,10 @@ class LiftedTop:
             load.total_N() / rod.q.force_scale, dtype=PETSc.ScalarType))
         self.mass = params.rotor.mass_kg / params.helix.mass_kg  # m_top / M
 
-    def residual(self, fields, v, ds, thrust):
-        """The top's terms of F(t, U, V, A); ``thrust`` F_t [M g], a UFL scalar."""
+    def residual(self, fields, v, ds, ends):
+        """The top's terms of F(t, U, V, A); ``ends`` the run's EndTorques (None: no
+        machine), whose rotor's thrust F_t [M g] at the top's spin it takes."""
+        thrust = 0.0 if ends is None else ends.thrust(fields)
         return (lifter.top_inertia_residual(self.mass, fields.r_tt, v, ds)
                 + lifter.end_residual(self.force, fields.r, v, ds)
                 + lifter.follower_residual(thrust, fields.r, v, ds))

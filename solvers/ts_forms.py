@@ -63,8 +63,8 @@ class Fields:
     def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None, n=None, n_t=None,
                  alpha_tt=None, r_tt=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
-        self.alpha_tt = alpha_tt  # the twist's acceleration (a rotor's inertia at an end)
-        self.r_tt = r_tt  # the centre line's (the lifted top's mass)
+        # the accelerations: the twist's (a rotor's inertia), the centre line's (a lifted top)
+        self.alpha_tt, self.r_tt = alpha_tt, r_tt
         self.kappa, self.z = kappa, z
         self.n, self.n_t = n, n_t  # the shearable rod's director and its rate
 
@@ -96,10 +96,8 @@ class _Formulation:
 
     second_order: bool
 
-    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques | None = None,
-                 top=None):
-        self.rod = rod_
-        self.top = top  # the lifted top (solvers/lifted_top.py); None: r(1) prescribed
+    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques = None, top=None):
+        self.rod, self.top = rod_, top  # the lifted top (solvers/lifted_top.py); None: r(1) fixed
         # the rotor and the generator (solvers/end_torques.py); None or off: the paper's ends
         self.end_torques = end_torques if end_torques is not None and end_torques.machine.active \
             else None
@@ -111,9 +109,9 @@ class _Formulation:
         self._t_set = None  # (t, scene, moving end) of the data last set
         self.reuse = None  # a snes.ReusedJacobian: the Jacobian callbacks skip a fresh one
         self.time_data = []  # more callables t -> None for set_time (a prescribed end twist)
-        # the machine's energy account (_machine_forms); None without a rotor or generator
+        # the machine's energy account (_machine_forms, the lifted top's too); None: no machine
         self.rotor_kinetic = self.power_in = self.power_generator = self.power_drag = None
-        self.top_energy = None  # the lifted top's stored energy (_machine_forms)
+        self.top_energy = None
 
     def _keep_jacobian(self, *shifts) -> bool:
         """True if the assembled Jacobian (and its LU) may serve again."""
@@ -172,8 +170,7 @@ class _Formulation:
             ufl.conditional(top, 0.5 * c.beta * j * fields.alpha_t**2, 0.0) * ds)
         power_in = c.beta * self.m_in * fields.alpha_t * ds
         if self.top is not None:  # the thrust's work on the moving top, its stored energy
-            thrust = self.end_torques.thrust(fields)
-            power_in = power_in + self.top.thrust_power(fields, ds, thrust)
+            power_in += self.top.thrust_power(fields, ds, self.end_torques.thrust(fields))
             self.top_energy = dolfinx.fem.form(self.top.stored_energy(fields, ds))
         self.power_in = dolfinx.fem.form(power_in)
         self.power_generator = dolfinx.fem.form(c.beta * self.m0 * fields.alpha_t * ds)
@@ -248,8 +245,7 @@ class SecondOrder(_Formulation):
 
     second_order = True
 
-    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques | None = None,
-                 top=None):
+    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques = None, top=None):
         super().__init__(rod_, bcs, end_torques, top)
         W = rod_.W
         self.u = rod_.w  # (r, alpha)
@@ -262,9 +258,8 @@ class SecondOrder(_Formulation):
         F = rod_.model.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree,
                                 rod_.penalty, rod_.measures)
         if top is not None:  # the lifted top's mass and end forces (solvers/lifted_top.py)
-            thrust = 0.0 if self.end_torques is None else self.end_torques.thrust(fields)
             F = F + top.residual(fields, rod_.model.split(rod_.test)["centre_line"],
-                                 rod_.measures[2], thrust)
+                                 rod_.measures[2], self.end_torques)
         J = (ufl.derivative(F, self.u, rod_.trial)
              + self.shift_v * ufl.derivative(F, self.v, rod_.trial)
              + self.shift_a * ufl.derivative(F, self.a, rod_.trial))
