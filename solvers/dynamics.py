@@ -135,6 +135,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             # a moving end (Eq. 70) starts with the end's velocity and acceleration
             # jumping, which alpha2's error estimate never accepts: fixed steps
             ts_defaults["ts_adapt_type"] = "none"
+        if params.lifter.active:  # the top's axial mode bounds the step (solvers/lifted_top.py)
+            ts_defaults["ts_adapt_dt_max"] = lifted_top.max_step_s(params) / self.q.t_scale
         snes_defaults = {**SNES_DEFAULTS, **lu_options(comm), "snes_atol": self.residual_floor()}
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):

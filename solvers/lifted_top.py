@@ -17,6 +17,10 @@ import dolfinx.fem
 import numpy as np
 from petsc4py import PETSc
 
+import math
+
+from scipy.optimize import brentq
+
 from rawehelix.errors import SceneError
 from rawehelix.forms import lifter
 from rawehelix.solvers import lifted
@@ -50,6 +54,27 @@ class LiftedTop:
         return lifter.thrust_power(thrust, fields.r, fields.r_t, ds)
 
 
+#: the adaptive step's largest, per period of the top's axial mode: alpha2's Newton
+#: diverged at 0.075 s (2.3 steps per period; step_rated, N = 2) and ran at 0.038 s
+STEPS_PER_AXIAL_PERIOD = 8
+
+
+def axial_period_s(params) -> float:
+    """The period [s] of the top's axial mode: a bar (the helix: EA, L0, M) fixed at the
+    ground with the tip mass m_top, kL tan kL = M / m_top, omega = k sqrt(EA L0 / M)."""
+    h, m = params.helix, params.rotor.mass_kg
+    if m <= 0:  # no tip mass: the fixed-free bar's quarter wave
+        kL = math.pi / 2
+    else:
+        kL = brentq(lambda x: x * math.tan(x) - h.mass_kg / m, 1e-12, math.pi / 2 - 1e-12)
+    return 2 * math.pi * h.length_m / (kL * math.sqrt(h.EA_N * h.length_m / h.mass_kg))
+
+
+def max_step_s(params) -> float:
+    """The adaptive step's largest [s] with a lifted top (:data:`STEPS_PER_AXIAL_PERIOD`)."""
+    return axial_period_s(params) / STEPS_PER_AXIAL_PERIOD
+
+
 def of(params, rod, ts_type: str) -> LiftedTop | None:
     """The run's lifted top (None: the top held at [ends]' position); the first-order
     TS forms are refused with it (SceneError, exit 2)."""
@@ -62,4 +87,4 @@ def of(params, rod, ts_type: str) -> LiftedTop | None:
     return LiftedTop(params, rod)
 
 
-__all__ = ["LiftedTop", "of"]
+__all__ = ["LiftedTop", "STEPS_PER_AXIAL_PERIOD", "axial_period_s", "max_step_s", "of"]
