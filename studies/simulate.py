@@ -260,6 +260,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     until_s = until_s if until_s is not None else tm.until_s
     ends = machine.of(params)  # the rotor and the generator (issue 43); off: the paper's
     solver, start_point = machine.solver(params, ends, comm, options)
+    top_start = machine.top_position(params, solver)  # a lifted top's [m]; None: fixed
     tracker = structure_limits.of_params(params)
     rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)),
                     tracker=tracker, limits_every=LIMITS_EVERY,
@@ -300,6 +301,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                   "limits": comm.bcast(tracker.block() if comm.rank == 0 else None, root=0)})
         if account is not None:  # work in = generator + dissipated + stored (issue 43)
             s["energy"] = account.summary(q)
+        if top_start is not None:  # the lifted top moving (issue 44)
+            s["lifter"] = machine.lifter_block(top_start, machine.top_position(params, solver))
         if solver.release is not None:  # a start-up from rest (issue 44)
             s["startup"] = machine.startup(ends, solver.release, rows)
         if len(rows):
@@ -383,6 +386,7 @@ def report(result: TimeSeries) -> str:
     if f and "power_W" in f:
         lines.append(f"  rotor {f['rotor_rpm']:.3f} rpm, generator power {f['power_W']:.2f} W, "
                      f"thrust {f['thrust_N']:.2f} N at a hub wind of {f['wind_hub_m_s']:.3g} m/s")
-    lines[-1] += (machine.startup_line(s.get("startup"), s["simulated_s"])
+    lines[-1] += (machine.lifter_line(s.get("lifter"))
+                  + machine.startup_line(s.get("startup"), s["simulated_s"])
                   + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy")))
     return "\n".join(lines)

@@ -163,3 +163,8 @@ def test_adaptive_steps_run_through_the_step():
     print(f"\n{s['steps']} adaptive steps, balance {s['energy']['balance_of_work_in']:.2e}")
     assert s["complete"] and s["simulated_s"] == pytest.approx(1.5)
     assert s["energy"]["balance_of_work_in"] < 1e-4
+    # summary.json's lifter block and the report's line: the top has moved from its start
+    block = s["lifter"]
+    moved = np.linalg.norm(np.subtract(block["top_position_m"], block["start_top_position_m"]))
+    assert block["moved_m"] == pytest.approx(moved) and moved > 0.05
+    assert "lifted top at (" in simulate.report(series)
