@@ -114,12 +114,21 @@ class RotorTorque:
     cp: PiecewisePolynomial  # Cp(lambda)
     power_n: Any
     lam_per_omega: Any
+    ct: PiecewisePolynomial | None = None  # CT(lambda): the thrust's (None: not asked)
+    # (GJ / L0) / (R M g): power_n lam_per_omega times it is 1/2 rho pi R^2 V_n^2 / (M g)
+    thrust_scale: float = 0.0
     given_in_time = False  # a law of the spin: Eq. (40)'s feedforward cannot know it
 
     def __call__(self, omega, time=None):
         # Q = P Cp / Omega = P (R / V_n) Cp(lambda) / lambda: finite at rest through a
         # table from tsr 0 (Cq = Cp / lambda, the torque coefficient)
         return self.power_n * self.lam_per_omega * self.cp.over_x(self.lam_per_omega * omega)
+
+    def thrust(self, omega):
+        """F = 1/2 rho pi R^2 V_n^2 CT(lambda) [M g] at the spin ``omega``: the same two
+        numbers as the torque (so a moving wind sets both)."""
+        return (self.power_n * self.lam_per_omega * self.thrust_scale
+                * self.ct(self.lam_per_omega * omega))
 
 
 @dataclass(frozen=True)

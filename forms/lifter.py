@@ -41,3 +41,22 @@ def follower_residual(F_t, r, v, ds):
     the end tangent (not a variation: a follower load)."""
     x = ufl.SpatialCoordinate(ds.ufl_domain())
     return -F_t * ufl.dot(d(r) / stretch(r), v) * x[0] * ds
+
+
+def top_kinetic(m, r_t, ds):
+    """1/2 m |r_t(1)|^2 [M g L0]: the top mass's kinetic energy (``m`` by M, the rod's
+    mass, as the rod's 1/2 int |r_t|^2 of forms/energy.py)."""
+    x = ufl.SpatialCoordinate(ds.ufl_domain())
+    return 0.5 * m * ufl.dot(r_t, r_t) * x[0] * ds
+
+
+def top_inertia_residual(m, r_tt, v, ds):
+    """m r_tt(1) . v(1): d/dt of the kinetic energy's derivative by r_t(1) (Lagrange),
+    its variation at the rate r_tt: the top's lumped mass in the residual."""
+    return variation(lambda y: top_kinetic(m, y, ds), r_tt, v, ds.ufl_domain())
+
+
+def thrust_power(F_t, r, r_t, ds):
+    """F_t t(1) . r_t(1) [M g L0 / t_scale]: the follower thrust's power on the top."""
+    x = ufl.SpatialCoordinate(ds.ufl_domain())
+    return F_t * ufl.dot(d(r) / stretch(r), r_t) * x[0] * ds

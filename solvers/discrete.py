@@ -94,6 +94,7 @@ class RodDiscretisation:
         false), ``curvature_bcs`` kappa = 0 at the ends (mixed form).  ``free_top``:
         without the top's position (36), whose force is then a natural term
         (the lifted top, solvers/lifted.py)."""
+        self.free_top = free_top
         mesh = self.mesh
         vertices = {"bottom": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 0.0)),
                     "top": compat.locate_boundary_vertices(mesh, lambda x: np.isclose(x[0], 1.0))}

@@ -42,7 +42,7 @@ import dolfinx.fem.petsc
 
 from rawehelix import compat, errors
 from rawehelix.parameters import Parameters
-from rawehelix.solvers import compiled_dynamics, weather
+from rawehelix.solvers import compiled_dynamics, lifted, lifted_top, weather
 from rawehelix.solvers.discrete import RodDiscretisation
 from rawehelix.solvers.dynamics_outputs import DynamicsOutputs
 from rawehelix.solvers.dynamics_states import DynamicsStates
@@ -130,8 +130,10 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         self.rod = rod if rod is not None else RodDiscretisation(params, comm)
         self.rod.q = self.q = self._q_scene
         self.rod.c.m0.value = 0.0  # the ground torque is the controller's, in the form
-        # (35)-(36): r(0) = 0, r(1) = r_N(t); alpha is free (unless model.twist = false)
-        bcs = self.rod.bcs[:2] + self.rod.twist_bcs + self.rod.curvature_bcs  # (37): mixed form
+        # (35)-(36): r(0) = 0, r(1) = r_N(t) (a lifted top: r(0) only); alpha is free
+        # (unless model.twist = false)
+        positions = 1 if getattr(self.rod, "free_top", False) else 2
+        bcs = self.rod.bcs[:positions] + self.rod.twist_bcs + self.rod.curvature_bcs  # (37)
         if end_twist is not None:  # a torsion test: alpha(0) = 0, alpha(1) = end_twist(t)
             bcs += self.rod.end_twist_conditions()
         ts_defaults = dict(TS_DEFAULTS)
@@ -139,6 +141,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             # a moving end (Eq. 70) starts with the end's velocity and acceleration
             # jumping, which alpha2's error estimate never accepts: fixed steps
             ts_defaults["ts_adapt_type"] = "none"
+        if params.lifter.active:  # the top's axial mode bounds the step (solvers/lifted_top.py)
+            ts_defaults["ts_adapt_dt_max"] = lifted_top.max_step_s(params) / self.q.t_scale
         snes_defaults = {**SNES_DEFAULTS, **lu_options(comm), "snes_atol": self.residual_floor()}
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):
@@ -155,7 +159,9 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
                 raise errors.SceneError("PETSc options", compiled_dynamics.OPTION,
                                         "the compiled steps do not step the machine's end "
                                         "torques or its wind in time: drop the option")
-            self.form = (SecondOrder if ts_type == "alpha2" else FirstOrder)(self.rod, bcs, ends)
+            top = lifted_top.of(params, self.rod, ts_type)  # None: r(1) prescribed
+            self.form = (SecondOrder(self.rod, bcs, ends, top) if ts_type == "alpha2"
+                         else FirstOrder(self.rod, bcs, ends))
             self.form.time_data += [x for x in (self.weather, self.release) if x is not None]
             if end_twist is not None:
                 self.form.time_data.append(
@@ -166,8 +172,8 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         self.probes = Probes(self.form)
         rod_ = self.rod
         self._v_top = dolfinx.fem.Function(rod_.V_r)  # the upper end's velocity, Eq. (70)
-        self._bc_v = dolfinx.fem.dirichletbc(self._v_top, rod_.end_dofs["top"],
-                                             rod_.sub("centre_line"))
+        self._bc_v = None if getattr(rod_, "free_top", False) else dolfinx.fem.dirichletbc(
+            self._v_top, rod_.end_dofs["top"], rod_.sub("centre_line"))
         self._velocity = dolfinx.fem.Function(rod_.W)  # scratch for the first-order form
         self.newton_iterations = 0
         self.steps = 0
@@ -196,9 +202,17 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         """A solver with ``machine`` started at t = 0 from the stationary state twisted by
         ``torque`` at both ends (normalised, set_end_torques) spinning uniformly at
         ``spin`` (normalised): at the rigid-shaft point Q = tau, the relative equilibrium."""
-        stationary = StationarySolver(params, comm, scene=scene)
-        stationary.set_end_torques(ground=torque, top=torque)
-        state = stationary.solve().state
+        if params.lifter.active:  # the lifted top under the point's thrust (solvers/lifted.py)
+            q = params.normalised()
+            omega = spin / q.t_scale  # [rad/s]
+            stationary, top = lifted.stationary(
+                params, comm=comm, top_torque_Nm=q.torque_Nm(torque), omega_rad_s=omega,
+                tangent_thrust_N=machine.thrust_N(omega))
+            state = top.result.state
+        else:
+            stationary = StationarySolver(params, comm, scene=scene)
+            stationary.set_end_torques(ground=torque, top=torque)
+            state = stationary.solve().state
         state.w_t = np.zeros_like(state.w)  # alpha = spin t + phi(s):
         state.w_t[stationary.rod.dofs("twist")] = spin
         solver = cls(params, comm, options, rod=stationary.rod, machine=machine)

@@ -11,7 +11,7 @@ import dolfinx.fem
 
 
 #: the energy account's entries of a run with a rotor or a generator (None without)
-MACHINE_ENERGY = ("rotor_kinetic", "power_in", "power_generator", "power_drag")
+MACHINE_ENERGY = ("rotor_kinetic", "power_in", "power_generator", "power_drag", "top_energy")
 
 
 class DynamicsOutputs:

@@ -83,8 +83,12 @@ def rotor_scales(machine: Machine, q) -> tuple[float, float]:
 
 
 def rotor_torque(machine: Machine, q) -> forms.RotorTorque:
-    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py)."""
-    return forms.RotorTorque(cp_polynomial(machine.rotor), *rotor_scales(machine, q))
+    """Q(omega~) of the machine's rotor, normalised (forms/end_torques.py), with its
+    thrust's CT(lambda) (the lifted top's end force)."""
+    law = machine.rotor
+    return forms.RotorTorque(cp_polynomial(law), *rotor_scales(machine, q),
+                             ct=forms.PiecewisePolynomial.fit(law.ct, law.table_tsr, 3),
+                             thrust_scale=q.torque_scale / (law.radius_m * q.force_scale))
 
 
 def cp_polynomial(law) -> forms.PiecewisePolynomial:
@@ -138,6 +142,10 @@ class EndTorques:
         """The top's driving torque: the ramp's c.mN (Eq. 69) + the rotor's Q(alpha_t)
         (a law of the spin; forms.RampTorque: of the time)."""
         return c.mN if self.rotor is None else c.mN + self.rotor(fields.alpha_t, time)
+
+    def thrust(self, fields):
+        """The rotor's thrust at the top's spin alpha_t [M g] (0 without a rotor)."""
+        return 0.0 if self.rotor is None else self.rotor.thrust(fields.alpha_t)
 
     def given(self, c, fields, time):
         """The part of the top's torque that is a given function of time, m_N(t) of the

@@ -5,7 +5,9 @@
 
 the dissipation being the structural damping's int 2 D dt, the drag's loss
 -int F_A . r_t ds dt (Eq. 14) and the non-variational terms' -int P_nv dt
-(forms/energy.py), the stored energy K + U + 1/2 J Omega(L0)^2 (the rotor's spin).
+(forms/energy.py), the stored energy K + U + 1/2 J Omega(L0)^2 (the rotor's spin)
+and, with a lifted top, 1/2 m_top |r_t(L0)|^2 - F . r(L0) (its mass and the lifter's and
+weight's constant force; the thrust's power is in the work in).
 Each power is the trapezoidal integral over the accepted steps (normalised, then SI:
 energies by M g L0)."""
 
@@ -32,7 +34,8 @@ class EnergyAccount:
         solver.form.set_time(t)  # the step's own time: alpha2 leaves t_{n + alpha_f} set
         e = solver.energy()  # collective
         powers = {k: e[k] for k in POWERS}
-        stored = e["kinetic"] + e["potential"] + e["rotor_kinetic"]
+        # the lifted top's 1/2 m |r_t(1)|^2 - F . r(1) (solvers/lifted_top.py) with it
+        stored = e["kinetic"] + e["potential"] + e["rotor_kinetic"] + e.get("top_energy", 0.0)
         if self._last is None:
             self.t0, self.stored0 = t, stored
         elif t > self._last[0]:

@@ -62,9 +62,10 @@ class Fields:
     Bouc-Wen twist ``z`` of the hysteretic torsion (None: elastic)."""
 
     def __init__(self, r, alpha, r_t, alpha_t, kappa=None, z=None, n=None, n_t=None,
-                 alpha_tt=None):
+                 alpha_tt=None, r_tt=None):
         self.r, self.alpha, self.r_t, self.alpha_t = r, alpha, r_t, alpha_t
-        self.alpha_tt = alpha_tt  # the twist's acceleration (a rotor's inertia at an end)
+        # the accelerations: the twist's (a rotor's inertia), the centre line's (a lifted top)
+        self.alpha_tt, self.r_tt = alpha_tt, r_tt
         self.kappa, self.z = kappa, z
         self.n, self.n_t = n, n_t  # the shearable rod's director and its rate
 
@@ -73,10 +74,10 @@ class Fields:
         """The views of the state ``u``, its rate ``v`` (and acceleration ``a``) on
         ``model``'s space (models/base.py): the roles' fields under the paper's names."""
         f, f_t = model.split(u), model.split(v)
-        alpha_tt = None if a is None else model.split(a)["twist"]
+        f_tt = {"twist": None, "centre_line": None} if a is None else model.split(a)
         return cls(f["centre_line"], f["twist"], f_t["centre_line"], f_t["twist"],
                    f["curvature"], f["internal_twist"], f["director"], f_t["director"],
-                   alpha_tt)
+                   f_tt["twist"], f_tt["centre_line"])
 
     def roles(self) -> tuple[dict, dict]:
         """(fields, rates) by role, as the model's forms take them."""
@@ -96,8 +97,8 @@ class _Formulation:
 
     second_order: bool
 
-    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques | None = None):
-        self.rod = rod_
+    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques = None, top=None):
+        self.rod, self.top = rod_, top  # the lifted top (solvers/lifted_top.py); None: r(1) fixed
         # the rotor and the generator (solvers/end_torques.py); None or off: the paper's ends
         self.end_torques = end_torques if end_torques is not None and end_torques.machine.active \
             else None
@@ -109,8 +110,9 @@ class _Formulation:
         self._t_set = None  # (t, scene, moving end) of the data last set
         self.reuse = None  # a snes.ReusedJacobian: the Jacobian callbacks skip a fresh one
         self.time_data = []  # more callables t -> None for set_time (a prescribed end twist)
-        # the machine's energy account (_machine_forms); None without a rotor or generator
+        # the machine's energy account (_machine_forms, the lifted top's too); None: no machine
         self.rotor_kinetic = self.power_in = self.power_generator = self.power_drag = None
+        self.top_energy = None
 
     def _keep_jacobian(self, *shifts) -> bool:
         """True if the assembled Jacobian (and its LU) may serve again."""
@@ -167,7 +169,11 @@ class _Formulation:
         j = self.end_torques.inertia
         self.rotor_kinetic = dolfinx.fem.form(
             ufl.conditional(top, 0.5 * c.beta * j * fields.alpha_t**2, 0.0) * ds)
-        self.power_in = dolfinx.fem.form(c.beta * self.m_in * fields.alpha_t * ds)
+        power_in = c.beta * self.m_in * fields.alpha_t * ds
+        if self.top is not None:  # the thrust's work on the moving top, its stored energy
+            power_in += self.top.thrust_power(fields, ds, self.end_torques.thrust(fields))
+            self.top_energy = dolfinx.fem.form(self.top.stored_energy(fields, ds))
+        self.power_in = dolfinx.fem.form(power_in)
         self.power_generator = dolfinx.fem.form(c.beta * self.m0 * fields.alpha_t * ds)
         # (14) at each point's height (a wind profile reads r): gravity is in U
         drag = rod.body_force(fields.r_t, c, fields.r) - c.gravity * rod.K_E
@@ -264,8 +270,8 @@ class SecondOrder(_Formulation):
 
     second_order = True
 
-    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques | None = None):
-        super().__init__(rod_, bcs, end_torques)
+    def __init__(self, rod_: RodDiscretisation, bcs, end_torques: EndTorques = None, top=None):
+        super().__init__(rod_, bcs, end_torques, top)
         W = rod_.W
         self.u = rod_.w  # (r, alpha)
         self.v = dolfinx.fem.Function(W, name="velocity")  # (r_t, alpha_t)
@@ -276,6 +282,9 @@ class SecondOrder(_Formulation):
         c_dyn = self._coefficients(fields)
         F = rod_.model.residual(self.u, self.v, self.a, rod_.test, c_dyn, rod_.degree,
                                 rod_.penalty, rod_.measures)
+        if top is not None:  # the lifted top's mass and end forces (solvers/lifted_top.py)
+            F = F + top.residual(fields, rod_.model.split(rod_.test)["centre_line"],
+                                 rod_.measures[2], self.end_torques)
         J = (ufl.derivative(F, self.u, rod_.trial)
              + self.shift_v * ufl.derivative(F, self.v, rod_.trial)
              + self.shift_a * ufl.derivative(F, self.a, rod_.trial))

@@ -50,7 +50,13 @@ def solver(params, machine: Machine, comm, options):
     """(DynamicsSolver, the summary's ``machine`` block): started at the operating
     point with a rotor; from the stationary state at rest without one."""
     from rawehelix.solvers.dynamics import DynamicsSolver
-    if machine.rotor is None or starts_from_rest(params, machine):
+    rest = machine.rotor is None or starts_from_rest(params, machine)
+    if rest and params.lifter.active:  # the lifted top starts at the operating point only
+        raise SceneError(params.name, "lifter.top",
+                         "'lifted' in simulate starts from the lifted state at the rotor's "
+                         "operating point: give [rotor] a table and no generator.release_rpm, "
+                         "or set lifter.top = 'fixed' (--set 'lifter.top=\"fixed\"')")
+    if rest:
         return DynamicsSolver.from_stationary(params, comm, options=options, scene=params.name), \
             ({"start": "rest", "wind_hub_m_s": machine.wind_hub_m_s} if machine.rotor else {})
     point = start_point(params, machine)
@@ -123,6 +129,32 @@ def startup_line(block: dict | None, simulated_s: float) -> str:
     return f"\n  start-up: generator {released}; {reached}"
 
 
+def top_position(params, solver) -> list | None:
+    """The lifted top's position r(L0) [m] (x, y, z down) in the solver's state, on every
+    rank (collective); None with the top held at [ends]' position."""
+    if not params.lifter.active:
+        return None
+    _, r = solver.rod.gather_centre_line()
+    top = None if r is None else [float(x) for x in solver.q.length_m(r[-1])]
+    return solver.comm.bcast(top, root=0)
+
+
+def lifter_block(start_m, now_m) -> dict:
+    """summary.json's ``lifter`` of a run: the top at the start and at the end [m] and
+    the distance between them."""
+    return {"top": "lifted", "start_top_position_m": start_m, "top_position_m": now_m,
+            "moved_m": float(np.linalg.norm(np.subtract(now_m, start_m)))}
+
+
+def lifter_line(block: dict | None) -> str:
+    """The report's line of a lifted top ('' with the top fixed)."""
+    if not block:
+        return ""
+    x, y, z = block["top_position_m"]
+    return (f"\n  lifted top at ({x:.4f}, {y:.4f}, {z:.4f}) m (z down), "
+            f"{block['moved_m']:.4g} m from its start")
+
+
 def row(machine: Machine, t_s: float, spin0_rpm: float, spin1_rpm: float,
         ground_torque_Nm: float) -> tuple:
     """The :data:`COLUMNS` at an output time (SI), in the wind of that time."""
@@ -149,5 +181,5 @@ def check_step(machine: Machine, solver) -> None:
         thrust(machine.at(t_s), float(solver.probes.value("spin1")) / q.t_scale, t_s)
 
 
-__all__ = ["COLUMNS", "check_step", "of", "row", "solver", "start_point", "starts_from_rest",
-           "startup", "startup_line", "thrust"]
+__all__ = ["COLUMNS", "check_step", "lifter_block", "lifter_line", "of", "row", "solver",
+           "start_point", "starts_from_rest", "startup", "startup_line", "thrust", "top_position"]

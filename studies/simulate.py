@@ -266,6 +266,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     solver, start_point = machine.solver(params, ends, comm, options)
     if solver.compiled_wanted:  # -rawehelix_ts_compiled 1: registers the compiled steps
         import rawehelix.solvers.compiled_step  # noqa: F401
+    top_start = machine.top_position(params, solver)  # a lifted top's [m]; None: fixed
     tracker = structure_limits.of_params(params)
     rec = _Recorder(solver, fields_every=int(round(tm.fields_every_s / tm.output_every_s)),
                     tracker=tracker, limits_every=LIMITS_EVERY,
@@ -306,6 +307,8 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
                   "limits": comm.bcast(tracker.block() if comm.rank == 0 else None, root=0)})
         if account is not None:  # work in = generator + dissipated + stored (issue 43)
             s["energy"] = account.summary(q)
+        if top_start is not None:  # the lifted top moving (issue 44)
+            s["lifter"] = machine.lifter_block(top_start, machine.top_position(params, solver))
         if solver.release is not None:  # a start-up from rest (issue 44)
             s["startup"] = machine.startup(ends, solver.release, rows)
         if len(rows):
@@ -389,7 +392,8 @@ def report(result: TimeSeries) -> str:
     if f and "power_W" in f:
         lines.append(f"  rotor {f['rotor_rpm']:.3f} rpm, generator power {f['power_W']:.2f} W, "
                      f"thrust {f['thrust_N']:.2f} N at a hub wind of {f['wind_hub_m_s']:.3g} m/s")
-    lines[-1] += (machine.startup_line(s.get("startup"), s["simulated_s"])
+    lines[-1] += (machine.lifter_line(s.get("lifter"))
+                  + machine.startup_line(s.get("startup"), s["simulated_s"])
                   + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy"))
                   + network_simulate.line(s))
     return "\n".join(lines)

@@ -30,7 +30,8 @@ LONG: dict[str, str] = {
     "solvers/dynamics.py": "the PETSc TS driver (options, stepping, output times, failures); "
                            "the states it takes and returns and what it reports of them are "
                            "dynamics_states.py and dynamics_outputs.py, the time data it "
-                           "installs (the wind, a release) solvers/weather.py",
+                           "installs (the wind, a release) solvers/weather.py, the lifted "
+                           "top's terms solvers/lifted_top.py",
     "solvers/harmonic_balance/problem.py": "HarmonicBalance, the periodic-orbit problem by "
                                            "harmonic balance (its residual, Jacobian, Newton, "
                                            "and where the guarded stability step hooks in); "

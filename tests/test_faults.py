@@ -91,6 +91,14 @@ FAULTS = [
      "rotor.table: starts at tsr 1 with cp 0.034861: a start-up from rest"),
     (["simulate", "startup", "--elements", "2", "--set", "generator.release_rpm=-1"], 2,
      "generator.release_rpm: -1.0 must be a finite number of rpm >= 0"),
+    # issue 44: simulate's lifted top starts at the rotor's operating point, on alpha2
+    (["simulate", "stationary_table2", "--elements", "2", "--set", 'lifter.top="lifted"',
+      "--set", "lifter.force_N=300"], 2,
+     "lifter.top: 'lifted' in simulate starts from the lifted state at the rotor's operating"),
+    (["simulate", "rotor_example", "--elements", "2", "--set", 'lifter.top="lifted"',
+      "--set", "lifter.force_N=300", "-rawehelix_ts_type", "beuler"], 2,
+     "lifter.top: 'lifted' runs with the second-order time stepper only, not "
+     "-rawehelix_ts_type beuler"),
     # issue 43: operate's wind speeds and a scene without a rotor
     (["operate", "rotor_example", "--wind", "4:16"], 2, "--wind: 4:16: must be LO:HI:STEP"),
     (["operate", "stationary_table2", "--wind", "4:16:1"], 2,
