@@ -162,7 +162,7 @@ e = s["energy"]
 dissipated = (e["damping_dissipated_J"] + e["drag_dissipated_J"]
               + e["non_variational_dissipated_J"])
 print(f"work in {e['work_in_J']:.2f} J = generator {e['generator_work_J']:.2f} J"
-      f" + dissipated {dissipated:.3g} J + stored {e['stored_change_J']:.4f} J")
+      f" + dissipated {dissipated:.3g} J + stored {e['stored_change_J']:.3g} J")
 print(f"balance: {e['balance_J']:.3g} J, "
       f"{e['balance_of_work_in']:.1e} of the work in")
 assert e["balance_of_work_in"] < 1e-3
