@@ -21,8 +21,9 @@ from rawehelix.studies.analysis import metrics
 
 
 def compute(params, until_s: float):
-    """The run to ``until_s`` [s], outputs every time.output_every_s."""
-    from rawehelix.studies.simulate import SimulationError, TimeSeries
+    """The run to ``until_s`` [s], outputs every time.output_every_s: (its rows, its
+    summary, why it stopped early or None), which studies/simulate.py makes its
+    TimeSeries (or its SimulationError)."""
     start = time.perf_counter()
     net = Network.from_parameters(params, end_torque_Nm=0.0)  # the ramp starts at 0
     st = solve(net)
@@ -70,18 +71,4 @@ def compute(params, until_s: float):
                          "ground_torque_Nm": data[-1, 4], "tension_s0_N": data[-1, 5],
                          "tension_L0_N": data[-1, 6], "lateral_mid_m": data[-1, 7]},
                "tension_range_N": [float(data[:, 5:7].min()), float(data[:, 5:7].max())]}
-    series = TimeSeries(params, data, summary=summary, _start=start)
-    if error is not None:
-        raise SimulationError(error, series)
-    return series
-
-
-def line(summary: dict) -> str:
-    """The network's line of a report ("" for another scheme's run)."""
-    n = summary.get("network")
-    if not n:
-        return ""
-    slack = ("no tether slack" if n["first_slack_s"] is None
-             else f"first slack at t = {n['first_slack_s']:.4f} s")
-    return (f"\n  network: {n['rings']} rings (l = {n['spacing_m']:.4g} m), step {n['dt_s']:.3g} s; "
-            f"smallest tether force {n['smallest_tether_force_N']:.2f} N, {slack}")
+    return data, summary, error, start

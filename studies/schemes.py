@@ -68,8 +68,9 @@ class Scheme(SchemeCore):
         return f"N = {info['elements']} ("
 
     def time_series(self, params: Parameters, until_s: float):
-        """``rawehelix simulate``'s TimeSeries by the scheme's own integrator, or None:
-        the FE's dynamics solver runs it (studies/simulate.py)."""
+        """``rawehelix simulate`` by the scheme's own integrator: (rows, summary, why it
+        stopped early or None, its perf_counter start), which studies/simulate.py makes
+        its TimeSeries; or None: the FE's dynamics solver runs it."""
         return None
 
     def stationary_tension_N(self, params: Parameters) -> float:

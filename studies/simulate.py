@@ -38,7 +38,8 @@ from rawehelix.parameters import Parameters
 from rawehelix.solvers import stepsize
 from rawehelix.solvers.energy_account import EnergyAccount
 from rawehelix.solvers.snes import SolverError
-from rawehelix.studies import limits, machine, network_simulate, schemes
+from rawehelix.studies import limits, machine, schemes
+from rawehelix.studies.present import network_report
 from rawehelix.studies.analysis import metrics, structure_limits
 from rawehelix.studies.store import writers
 from rawehelix.studies.scene import SceneError
@@ -254,7 +255,10 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     own = schemes.of(params).time_series(params, until_s if until_s is not None
                                          else params.time.until_s)
     if own is not None:  # a scheme with its own time integration (the network)
-        return own
+        series = TimeSeries(params, own[0], summary=own[1], _start=own[3])
+        if own[2] is not None:  # why it stopped early
+            raise SimulationError(own[2], series)
+        return series
     limits.check_bending_resolution(params, "simulate")
     # a fixed step must resolve the forcing and the modes a moving end excites
     adapt = (options or {}).get("ts_adapt_type")
@@ -318,7 +322,7 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
             s["tension_range_N"] = [float(rows[:, 5:7].min()), float(rows[:, 5:7].max())]
             if ends.active:  # the machine's columns (studies/machine.py)
                 s["final"].update(zip(machine.COLUMNS, map(float, rows[-1, len(COLUMNS):])))
-            s["statistics"] = statistics(rows, columns, slack)
+            s["statistics"] = metrics.run_statistics(rows, columns, slack)
             s["real_time_factor"] = s["simulated_s"] / max(s["solve_s"], 1e-12)
         return series
 
@@ -364,18 +368,6 @@ def compute(params: Parameters, until_s: float | None = None, comm=MPI.COMM_WORL
     return series
 
 
-def statistics(rows, columns, slack: float | None) -> dict:
-    """The run's statistics over its outputs (a seed study's quantities, issue 44): the
-    mean generator power (with a machine), the largest tension at each end, and
-    ``slack``, the fraction of the limits block's times at which any member was slack
-    (structure_limits.Tracker.slack_time_fraction)."""
-    col = {name: i for i, name in enumerate(columns)}
-    power = rows[:, col["power_W"]] if "power_W" in col else None
-    return {"power_mean_W": None if power is None else float(np.mean(power)),
-            "tension_s0_max_N": float(rows[:, 5].max()), "tension_L0_max_N": float(rows[:, 6].max()),
-            "slack_time_fraction": slack}
-
-
 def report(result: TimeSeries) -> str:
     """The lines a user reads after a run."""
     s = result.summary
@@ -395,5 +387,5 @@ def report(result: TimeSeries) -> str:
     lines[-1] += (machine.lifter_line(s.get("lifter"))
                   + machine.startup_line(s.get("startup"), s["simulated_s"])
                   + structure_limits.line(s.get("limits")) + EnergyAccount.line(s.get("energy"))
-                  + network_simulate.line(s))
+                  + network_report.line(s))
     return "\n".join(lines)

@@ -37,6 +37,10 @@ LONG: dict[str, str] = {
                                            "and where the guarded stability step hooks in); "
                                            "the Fourier algebra is harmonics.py, Hill's method "
                                            "hill.py, the guard's rules stability.py",
+    "solvers/ts_forms.py": "the rod equations (30)-(31) as PETSc TS residuals, second and first "
+                           "order, with the terms the ends add to them (Eq. 40's controller, "
+                           "the machine's torques, the lifted top): the terms themselves are "
+                           "forms/end_torques.py, forms/lifter.py and solvers/lifted_top.py",
 }
 
 

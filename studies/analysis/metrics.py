@@ -46,3 +46,15 @@ def overshoot(values, target) -> float:
     """The largest value above ``target``: max(values) - target (negative when
     the signal stays below the target)."""
     return float(np.max(values) - target)
+
+
+def run_statistics(rows, columns, slack: float | None) -> dict:
+    """The run's statistics over its outputs (a seed study's quantities, issue 44): the
+    mean generator power (with a machine), the largest tension at each end, and
+    ``slack``, the fraction of the limits block's times at which any member was slack
+    (structure_limits.Tracker.slack_time_fraction)."""
+    col = {name: i for i, name in enumerate(columns)}
+    power = rows[:, col["power_W"]] if "power_W" in col else None
+    return {"power_mean_W": None if power is None else float(np.mean(power)),
+            "tension_s0_max_N": float(rows[:, 5].max()), "tension_L0_max_N": float(rows[:, 6].max()),
+            "slack_time_fraction": slack}
