@@ -17,6 +17,8 @@ def readme_example() -> str:
     return re.search(r"```python\n(.*?)```", section, re.S).group(1)
 
 
+@pytest.mark.long  # 47 s on an idle machine (2026-12-05): make test-long; make test keeps the
+# API's pieces (test_bad_scene_values_raise_the_cli_message and the commands' own API tests)
 def test_readme_example_runs(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     exec(compile(readme_example(), "README.md", "exec"), {})
