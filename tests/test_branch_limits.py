@@ -102,6 +102,8 @@ def test_the_summary_block_finds_the_first_limit_by_f1():
     assert out["points_recorded"] == 4 and out["points_without"] == 1
 
 
+@pytest.mark.long  # 7.6 s: make test's budget (2026-12-05); make test keeps
+# test_the_orbits_summary_carries_the_branch_block_and_resumes_it and the sweep point's block
 def test_an_orbit_point_carries_the_observables_and_agrees_with_brute_force():
     """The shooting orbit's moment_ratio_max over one period (AlphaMap.sections, the
     generalised-alpha stepper's period from the orbit's state) against the sweep's

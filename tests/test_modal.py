@@ -264,6 +264,8 @@ def test_same_spectrum_on_all_ranks():
     assert abs(serial[0].eigenvalue) < 1e-4 and abs(parallel[0].eigenvalue) < 1e-4
 
 
+@pytest.mark.long  # 5.1 s: make test's budget (2026-12-05); make test keeps the modes command
+# through test_compute_default_selection_fe and the faults' modes rows
 def test_cli_writes_outputs(tmp_path):
     """``rawehelix modes`` with the FE scheme: table, summary.json (the spline
     reference's mode keys plus discretisation and wall time), PNG and XDMF."""

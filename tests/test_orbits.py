@@ -60,6 +60,9 @@ def test_broyden_updates_meet_the_secant_condition():
                            atol=1e-12)
 
 
+@pytest.mark.long  # 6.4 s: make test's budget (2026-12-05); make test keeps the monodromy's
+# checks test_monodromy_equals_finite_differences_of_the_period_map and
+# test_the_linear_monodromy_is_a_chord_for_the_shooting
 def test_the_linear_monodromy_is_exact_without_forcing():
     """AlphaMap.linear_monodromy (the first step's tangent to the M-th power; N = 4,
     2.5 Hz, at the orbit) against the tangent period: where the end's circle

@@ -170,6 +170,8 @@ def test_planar_reduction_is_exact(N, kinematics):
     assert np.max(np.abs(full.tension - planar.tension)) < 1e-7
 
 
+@pytest.mark.long  # 7 s: make test's budget (2026-12-05); the model's line is also read by
+# test_stationary_torque.py and the faults' stationary rows in make test
 def test_stationary_command_says_which_model(tmp_path):
     from rawehelix.studies import stationary
     s = stationary.compute(table2(8), MPI.COMM_SELF).summary
