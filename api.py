@@ -124,8 +124,10 @@ def operate(scene: Parameters, wind_m_s, comm=None):
     comm = _world(comm)
     from rawehelix.studies import operate as study
     winds = study.check_winds(wind_m_s)
-    planned = study.plan(scene, winds)  # numpy: the refusals before any FE work
+    # the elongation of ends.tension_N first (the plan's axis reads the chord), then the
+    # table's refusals before the operating points' FE work
     scene = _ready(scene, "operate", comm)
+    planned = study.plan(scene, winds)
     return study.compute(scene, winds, comm, planned)
 
 

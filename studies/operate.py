@@ -155,10 +155,13 @@ def drive_of(params: Parameters) -> Drive:
 def at_wind(params: Parameters, V: float) -> Parameters:
     """The scene at the wind V [m/s] at the reference height: ``[wind]``'s speed where the
     scene has that section (with environment.wind_speed_m_s where it gives the same),
-    else environment.wind_speed_m_s (the paper's uniform wind; the helix's drag, Eq. 14)."""
+    else environment.wind_speed_m_s (the paper's uniform wind; the helix's drag, Eq. 14).
+    The ends keep the scene's elongation (for ``ends.tension_N``, the one found at the
+    scene's own wind): the helix is anchored once, whatever the wind does."""
+    held = {"ends": {"elongation": params.ends.elongation}} if params.ends.resolved else {}
     if not params.wind.active:
-        return params.replace(environment={"wind_speed_m_s": float(V)})
-    changes = {"wind": {"speed_m_s": float(V)}}
+        return params.replace(environment={"wind_speed_m_s": float(V)}, **held)
+    changes = {"wind": {"speed_m_s": float(V)}, **held}
     if params.environment.wind_speed_m_s != 0:
         changes["environment"] = {"wind_speed_m_s": float(V)}
     return params.replace(**changes)

@@ -245,3 +245,25 @@ def test_a_lifted_top_takes_the_thrust_into_the_tension():
                                      omega_rad_s=p.omega_rad_s, tangent_thrust_N=p.thrust_N)
         assert d["top_m"] == pytest.approx(alone.top_m, abs=1e-8)
         assert p.v_n_m_s == pytest.approx(p.hub_wind_m_s * abs(alone.end_tangent[0]), rel=1e-8)
+
+
+def test_a_scene_given_by_its_tension_runs_with_the_elongation_found_once(tmp_path):
+    """A designer's scene gives ``ends.tension_N`` (it failed with a traceback: the wind of
+    each point dropped the elongation found for the scene's own wind).  The helix is
+    anchored once: every point runs at the elongation found at the scene's wind, which
+    gives the asked mean tension there."""
+    from rawehelix.solvers import tension_target
+    from rawehelix.studies import operate as study
+    shipped = Path(rh.__file__).parent / "studies" / "scenes"
+    text = (shipped / "rotor_example.toml").read_text()
+    scene = tmp_path / "own.toml"
+    scene.write_text(text.replace("elongation = 0.0055", "tension_N = 210.0"))
+    shutil.copy(shipped / "rotor_example.csv", tmp_path)
+    p = rh.load_scene(scene, elements=2)
+    assert not p.ends.resolved
+    result = rh.operate(p, [5.0, 6.0], comm=MPI.COMM_SELF)
+    assert [pt["wind_m_s"] for pt in result.summary["points"]] == [5.0, 6.0]
+    found = tension_target.resolve(p, MPI.COMM_SELF).ends.elongation
+    for V in (5.0, 6.0):
+        at = study.at_wind(tension_target.resolve(p, MPI.COMM_SELF), V)
+        assert at.ends.elongation == found and at.ends.resolved
