@@ -727,12 +727,9 @@ def markdown(r: dict) -> str:
                      f"N = {c['elements']}, CPU time of each command | "
                      f"{_spread(c['orbits_cpu_s'])} against {_spread(c['sweep_cpu_s'])}: ratio "
                      f"{c['ratio']:.2f} | {TARGETS['curve']} |")
-    if r.get("hb"):
-        lines += hb_bench.markdown(r["hb"])
-    if r.get("operate"):
-        lines += operate_bench.markdown(r["operate"])
-    if r.get("campbell"):
-        lines += campbell_bench.markdown(r["campbell"])
+    for key, bench in (("hb", hb_bench), ("operate", operate_bench), ("campbell", campbell_bench)):
+        if r.get(key):  # the sections that write their own rows
+            lines += bench.markdown(r[key])
     for row in r.get("refactor_42") or []:  # measured by hand: the rows' own commands
         w, c = row["ratio_wall"], row["ratio_cpu"]
         lines.append(
@@ -742,10 +739,9 @@ def markdown(r: dict) -> str:
             f"{w['median']:.3f} ({w['min']:.3f}-{w['max']:.3f}), CPU {c['median']:.3f} "
             f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
-    if r.get("hb_stability"):
-        lines += hb_stability_bench.markdown(r["hb_stability"])
-    if r.get("network"):
-        lines += network_bench.markdown(r["network"])
+    for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench)):
+        if r.get(key):
+            lines += bench.markdown(r[key])
     return "\n".join(lines) + "\n"
 
 
