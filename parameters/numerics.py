@@ -106,6 +106,12 @@ class Time:
         _positive("time", self, "until_s", "dt_s", "output_every_s", "fields_every_s")
 
 
+def periods_to_judge(record_periods: int) -> int:
+    """Periods the periodicity test (solvers/periodic.py's transient) needs before it
+    can judge: three blocks of ``record_periods``, and the one before them."""
+    return 3 * record_periods + 1
+
+
 @dataclass(frozen=True)
 class Sweep:
     """A sweep over the frequency f1 of the upper end's circle (Sec. 5.3, Fig. 8)."""
@@ -134,6 +140,11 @@ class Sweep:
         if self.samples_per_period < 8:
             raise ParameterError("sweep.samples_per_period", self.samples_per_period,
                                  "must be an integer >= 8")
+
+    @property
+    def periods_to_judge(self) -> int:
+        """:func:`periods_to_judge` of this sweep's record_periods."""
+        return periods_to_judge(self.record_periods)
 
     def frequencies(self) -> list[float]:
         n = int(math.floor((self.f1_stop_Hz - self.f1_start_Hz) / self.f1_step_Hz + 1e-9))

@@ -34,6 +34,7 @@ from typing import Protocol
 import numpy as np
 
 from rawehelix.parameters import Normalised, Sweep
+from rawehelix.parameters.numerics import periods_to_judge
 
 
 class Backend(Protocol):
@@ -139,7 +140,7 @@ class Transient:
 def transient(maxima, minima, means, tolerance: float, periods: int) -> Transient | None:
     """The periodicity test's measure (:func:`settled`); None: fewer than its
     3 ``periods`` + 1 periods."""
-    need = 3 * periods + 1
+    need = periods_to_judge(periods)
     if len(maxima) < need:
         return None
     hi, lo, mean = (np.asarray(v[-need:], dtype=float) for v in (maxima, minima, means))
@@ -257,7 +258,7 @@ def unsettled(q: Normalised, measure: Transient | None, ends, sweep: Sweep,
     out = {"judged": "T max and T min at s = 0, from one period to the next",
            "periods": periods, "tolerance": sweep.periodic_tolerance}
     if measure is None:
-        out["periods_to_judge"] = 3 * sweep.record_periods + 1
+        out["periods_to_judge"] = sweep.periods_to_judge
         out["reason"] = (f"too few periods to judge: the test needs 3 x sweep.record_periods "
                          f"+ 1 = {out['periods_to_judge']}")
     else:

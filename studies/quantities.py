@@ -258,12 +258,28 @@ def refined() -> dict[str, Quantity]:
     return {name: q for name, q in QUANTITIES.items() if q.refinement is not None}
 
 
+def other_command(name: str) -> str:
+    """A hint when ``name`` is the other command's quantity: ``converge`` refines
+    ``tension_s0``, ``study`` takes ``tension_s0_N`` at a point ("" if neither)."""
+    base = name.partition(AT)[0]
+    if base in refined():
+        near = [n for n in AT_A_POINT if n.partition(AT)[0] == base + "_N"]
+        return (f" ({base} is rawehelix converge's refined quantity"
+                + (f"; at a point it is {' or '.join(near)}" if near else "") + ")")
+    if any(n.partition(AT)[0] == base for n in AT_A_POINT):
+        near = [n for n in refined() if base.startswith(n + "_")]
+        return (f" ({base} is rawehelix study's quantity at a point"
+                + (f"; refined it is {' or '.join(near)}" if near else "") + ")")
+    return ""
+
+
 def parse(name: str, where: str = "--quantity") -> tuple[Quantity, float | None]:
     """The quantity of a name (``tension_max_N@10`` -> the family at f1 = 10 Hz)."""
     base, sep, f1_text = name.partition(AT)
     key = f"{base}{AT}F1" if sep else base
     if key not in AT_A_POINT or (key.endswith(f"{AT}F1") and not sep):
-        raise SceneError(where, name, "unknown quantity; known are " + ", ".join(AT_A_POINT))
+        raise SceneError(where, name, "unknown quantity" + other_command(name)
+                         + "; known are " + ", ".join(AT_A_POINT))
     if not sep:
         return AT_A_POINT[key], None
     try:

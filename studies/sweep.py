@@ -259,6 +259,8 @@ def compute(params: Parameters, f1_Hz=None, comm=MPI.COMM_WORLD, checkpoint=None
     rank_log = log or logging.getLogger("rawehelix").info
     if comm.size > 1:
         rank_log = (lambda m, _log=rank_log: _log(f"[rank {comm.rank}]{m}"))
+    if comm.rank == 0 and sweep_advice.too_few_periods(params.sweep):
+        logging.getLogger("rawehelix").warning(sweep_advice.too_few_periods(params.sweep))
     if mine:
         rank_log(f"  chunk {mine[0]:.2f}-{mine[-1]:.2f} Hz ({len(mine)} points)")
     show = sys.stderr.isatty() and comm.size == 1  # a terminal, not a log file (or ranks)

@@ -17,6 +17,17 @@ K1 = 0.5
 TAU_S = 1.0e-3
 
 
+def too_few_periods(sweep) -> str | None:
+    """The warning before a sweep whose ``max_periods`` is below what the periodicity
+    test needs (the tester's D8b), or None."""
+    if sweep.max_periods >= sweep.periods_to_judge:
+        return None
+    return (f"sweep.max_periods = {sweep.max_periods} is below the {sweep.periods_to_judge} "
+            f"periods the periodicity test needs (3 x sweep.record_periods + 1): a point that "
+            f"is not stationary will be flagged NOT PERIODIC; raise it with --set "
+            f"sweep.max_periods={sweep.periods_to_judge}")
+
+
 def reason(why: dict) -> str:
     """One line: what the test measured, and which parts move the most."""
     if "change_N" not in why:

@@ -29,3 +29,20 @@ def test_stable_is_no_multiplier_outside_the_circle(mu, stable):
     assert orbit.entry()["stable"] is stable
     # the bifurcation counts see the same circle: no unstable multiplier iff stable
     assert (sum(_unstable(orbit.multipliers).values()) == 0) is stable
+
+
+def test_a_crawling_shooting_branch_is_told_to_try_hb():
+    """The tester's D3: shooting on an undamped helix stepped about 0.001 Hz a point and
+    nothing suggested harmonic balance; the report now does, for a method that steps in
+    time only, and not for a branch with ordinary steps."""
+    from rawehelix.studies.present import orbits_report
+
+    from rawehelix.studies.orbit_method import HB, SHOOTING
+
+    def branch(step, points=40):
+        return [{"f1_Hz": 10.0 - k * step} for k in range(points)]
+    hint = orbits_report.crawl_hint(branch(0.001), SHOOTING.steps_in_time)
+    assert hint and "median 0.001 Hz over 40 points" in hint and "--method hb" in hint
+    assert orbits_report.crawl_hint(branch(0.001), HB.steps_in_time) is None  # already HB
+    assert orbits_report.crawl_hint(branch(0.05), True) is None  # ordinary steps
+    assert orbits_report.crawl_hint(branch(0.001, points=5), True) is None  # short

@@ -59,8 +59,12 @@ def test_one_registry_serves_study_and_converge():
     all from the one registry; neither accepts the other's."""
     assert set(quantities.names()) | set(quantities.refined()) == set(quantities.QUANTITIES)
     assert not set(quantities.names()) & set(quantities.refined())
-    with pytest.raises(rh.SceneError, match="unknown quantity"):
+    with pytest.raises(rh.SceneError, match="unknown quantity") as refused:
         quantities.parse("tension_s0")  # converge's, refined only
+    # the tester's D8c: the other command's name is told, with this command's twin
+    assert "converge's refined quantity; at a point it is tension_s0_N)" in str(refused.value)
+    assert quantities.other_command("tension_s0_N").endswith("refined it is tension_s0)")
+    assert quantities.other_command("no_such") == ""
     assert all(q.refinement.methods and q.stage is None for q in quantities.refined().values())
 
 

@@ -92,14 +92,18 @@ def test_bad_f1_range(tmp_path, fast_scene, capsys, spec):
     assert not (tmp_path / "o").exists()
 
 
-def test_cap_is_flagged(tmp_path):
-    """A point that hits max_periods before it is periodic is flagged, not accepted."""
+def test_cap_is_flagged(tmp_path, caplog):
+    """A point that hits max_periods before it is periodic is flagged, not accepted;
+    a max_periods below the test's 3 x record_periods + 1 is said before the work."""
     path = write_scene(tmp_path / "s.toml", {"sweep": {
         "lead_in_s": 0.0, "min_periods": 2, "max_periods": 2, "record_periods": 1,
         "periodic_tolerance": 1e-9}, "discretisation": {"scheme": "spline", "elements": 2}},
         name="mobile_end")
     params = scene.load(path)
-    summary = sweep.compute(params, [10.0], comm=MPI.COMM_SELF).summary
+    with caplog.at_level("WARNING", logger="rawehelix"):
+        summary = sweep.compute(params, [10.0], comm=MPI.COMM_SELF).summary
+    assert "sweep.max_periods = 2 is below the 4 periods" in caplog.text
+    assert "--set sweep.max_periods=4" in caplog.text
     (point,) = summary["points"]
     assert point["periodic"] is False and point["periods"] == 2
     assert summary["not_periodic_Hz"] == [10.0]

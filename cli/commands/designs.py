@@ -22,7 +22,8 @@ def _converge(rh, params, args, outdir, comm) -> int:
     from rawehelix.studies.converge import study as converge
     if args.quantity not in quantities.refined():
         raise SceneError("--quantity", args.quantity,
-                         f"is not one of {', '.join(quantities.refined())}")
+                         f"is not one of {', '.join(quantities.refined())}"
+                         + quantities.other_command(args.quantity))
     converge.run(params, quantities.refined()[args.quantity], outdir, name=params.name,
                  log=lambda m: say(comm, m), comm=comm)
     return 0

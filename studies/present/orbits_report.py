@@ -2,7 +2,30 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from rawehelix.studies.analysis import branch_limits
+
+#: a branch whose median step in f1 is below this [Hz] gets the hint to harmonic
+#: balance when it ran by a method that steps in time (the tester's undamped helix:
+#: shooting crawled at about 0.001 Hz a point)
+SMALL_STEP_HZ = 0.005
+#: ... and at least this many points (a short branch's steps say little)
+SMALL_STEP_POINTS = 20
+
+
+def crawl_hint(branch: list, steps_in_time: bool) -> str | None:
+    """The line that suggests ``--method hb`` when a method that steps in time
+    (shooting) crawled along ``branch`` (None: no hint)."""
+    if len(branch) < SMALL_STEP_POINTS or not steps_in_time:
+        return None
+    step = float(np.median(np.abs(np.diff([p["f1_Hz"] for p in branch]))))
+    if step >= SMALL_STEP_HZ:
+        return None
+    return (f"  hint: the branch stepped f1 by a median {step:.2g} Hz over {len(branch)} points: "
+            f"a lightly damped helix keeps the period map's steps small; --method hb traces "
+            f"the same branch by harmonic balance at the cost of a Newton step a point "
+            f"(or add [damping])")
 
 
 def report(result) -> str:
@@ -16,6 +39,9 @@ def report(result) -> str:
             f"; H {min(a['H'] for a in acc)}-{max(a['H'] for a in acc)}, the highest "
             f"harmonic's energy at most {max(a['tail'] for a in acc):.1e} of the oscillation's; "
             f"{acc[0]['stability']}" if acc else ""))
+    hint = crawl_hint(s["branch"], s.get("dt_s") is not None)  # dt: the method steps in time
+    if hint:
+        lines.append(hint)
     unstable = [p["f1_Hz"] for p in s["branch"] if not p["stable"]]
     lines.append(f"  largest Floquet multiplier modulus: "
                  f"{max(p['max_multiplier'] for p in s['branch']):.6f}; unstable points: "
