@@ -75,3 +75,19 @@ def test_a_wind_that_drops_under_the_rotor_stops_the_run_with_its_time():
     assert 0.1 < stopped < 0.21
     partial = err.value.partial
     assert partial.summary["complete"] is False and partial.rows[-1, 0] <= stopped + 1e-12
+
+
+def test_energy_balance_in_turbulence():
+    """turbulent_rated (N = 2, seed 1 at its rated 6.61 m/s, 2 s of its record): work in
+    = generator work + dissipation (the drag's power of the moving air included) + change
+    of stored energy, to 1e-3 of the work in (the step's and the gust's: test_weather.py::
+    test_energy_balance_in_moving_wind; the start-up's: test_startup.py)."""
+    p = scene.load("turbulent_rated", elements=2, overrides={"wind.duration_s": 60.0,
+                                                             "time.until_s": 60.0})
+    series = simulate.compute(p, until_s=2.0, progress=False)
+    energy = series.summary["energy"]
+    print(f"\nturbulent: {energy}")
+    assert series.rows[-1, 0] == pytest.approx(2.0)
+    assert energy["work_in_J"] > 100
+    assert abs(energy["stored_change_J"]) > 1e-3 * energy["work_in_J"]  # the wind moves it
+    assert energy["balance_of_work_in"] < 1e-3
