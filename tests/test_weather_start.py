@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from rawehelix import api
@@ -91,3 +92,31 @@ def test_energy_balance_in_turbulence():
     assert energy["work_in_J"] > 100
     assert abs(energy["stored_change_J"]) > 1e-3 * energy["work_in_J"]  # the wind moves it
     assert energy["balance_of_work_in"] < 1e-3
+
+
+@pytest.mark.mpi
+def test_moving_wind_on_two_ranks_equals_one():
+    """turbulent_rated at N = 2, 0.3 s at fixed 20 ms steps, on the 2 ranks of mpirun
+    and on rank 0 alone: every column of the time series (the helix's, the rotor's and
+    the hub's wind) the same to the solver's tolerance (rtol 1e-8, as
+    test_dynamics.py::test_same_numbers_on_one_and_two_ranks); each rank generates the
+    record itself (test_wind_series.py::test_the_same_seed_on_one_and_two_ranks: bit for
+    bit)."""
+    from mpi4py import MPI
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        pytest.skip("compares 1 and 2 ranks: run under mpirun -n 2")
+    p = scene.load("turbulent_rated", elements=2, overrides={
+        "wind.duration_s": 30.0, "time.until_s": 30.0, "time.dt_s": 0.02,
+        "time.output_every_s": 0.1})
+    fixed = {"ts_adapt_type": "none"}
+    parallel = simulate.compute(p, until_s=0.3, options=fixed, progress=False, comm=comm).rows
+    if comm.rank == 0:
+        serial = simulate.compute(p, until_s=0.3, options=fixed, progress=False,
+                                  comm=MPI.COMM_SELF).rows
+        assert parallel.shape == serial.shape and len(serial) == 4
+        assert np.ptp(serial[:, 11]) > 0.05  # the wind moves
+        scale = np.abs(serial).max(axis=0)  # each column's own size
+        worst = (np.abs(parallel - serial) / np.maximum(scale, 1e-300)).max()
+        print(f"\n2 ranks against 1: largest difference {worst:.2e} of a column's size")
+        assert worst < 1e-8
