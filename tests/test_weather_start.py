@@ -120,3 +120,21 @@ def test_moving_wind_on_two_ranks_equals_one():
         worst = (np.abs(parallel - serial) / np.maximum(scale, 1e-300)).max()
         print(f"\n2 ranks against 1: largest difference {worst:.2e} of a column's size")
         assert worst < 1e-8
+
+
+@pytest.mark.mpi
+def test_operate_logs_its_points_on_rank_0_only(caplog):
+    """`mpirun -n 2 rawehelix operate` printed each point's log line once a rank; now rank
+    0 logs it, and the other ranks nothing (rotor_example at N = 2, one wind)."""
+    import logging
+
+    from mpi4py import MPI
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        pytest.skip("the ranks' logs: run under mpirun -n 2")
+    p = scene.load("rotor_example", elements=2)
+    with caplog.at_level(logging.INFO, logger="rawehelix"):
+        api.operate(p, [6.0], comm=comm)
+    lines = [r.getMessage() for r in caplog.records if r.getMessage().startswith("operate: 6 m/s")]
+    counts = comm.allgather(len(lines))
+    assert counts == [1] + [0] * (comm.size - 1), counts
