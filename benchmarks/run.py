@@ -51,6 +51,11 @@ sections and keeps the others' last results.
 15. ``network``: the network reference against the FE continuum at equal accuracy
     (benchmarks/network.py): a Sec. 5.2 spin-up second and a sweep point at 3 Hz,
     CPU time, ratios of medians.
+17. ``weather``: issue 44's cost (benchmarks/weather.py): ten simulated minutes of
+    ``turbulent_rated`` at N = 8, tensegrity against solid section, real-time factor
+    (median of 3, spread), and the whole seeds study (3 winds x 6 seeds x 10 min) on 2
+    ranks, wall.  ``--reduced`` (or RAWEHELIX_BENCH_REDUCED=1) shortens the simulated
+    time for a trial of a few minutes; the full size takes hours.
 """
 
 from __future__ import annotations
@@ -75,6 +80,7 @@ import hb_stability as hb_stability_bench  # benchmarks/hb_stability.py
 import network as network_bench  # benchmarks/network.py
 import study as study_bench  # benchmarks/study.py
 import compiled_step as compiled_bench  # benchmarks/compiled_step.py
+import weather as weather_bench  # benchmarks/weather.py
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
@@ -739,7 +745,8 @@ def markdown(r: dict) -> str:
             f"{w['median']:.3f} ({w['min']:.3f}-{w['max']:.3f}), CPU {c['median']:.3f} "
             f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
-    for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench)):
+    for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench),
+                       ("weather", weather_bench)):
         if r.get(key):
             lines += bench.markdown(r[key])
     return "\n".join(lines) + "\n"
@@ -747,7 +754,7 @@ def markdown(r: dict) -> str:
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
             "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network",
-            "compiled")
+            "compiled", "weather")
 
 
 def main():
@@ -757,6 +764,9 @@ def main():
                         help="comma-separated sections to run")
     parser.add_argument("--sweep-repeats", type=int, default=3)
     parser.add_argument("--curve-repeats", type=int, default=1)
+    parser.add_argument("--reduced", action="store_true",
+                        help="weather: shortened runs, a trial of a few minutes (or "
+                             f"{weather_bench.ENV_REDUCED}=1)")
     args = parser.parse_args()
     quiet()
     repeats = 2 if args.quick else 3
@@ -787,7 +797,9 @@ def main():
                      ("campbell", lambda: campbell_bench.bench_campbell(8, repeats)),
                      ("hb_stability", lambda: hb_stability_bench.bench_sizes()),
                      ("network", lambda: network_bench.bench_network(stats, repeats)),
-                     ("compiled", lambda: bench_compiled(repeats))):
+                     ("compiled", lambda: bench_compiled(repeats)),
+                     ("weather", lambda: weather_bench.bench_weather(
+                         repeats, args.reduced or weather_bench.reduced_from_env()))):
         if name not in only:
             continue
         t0 = time.perf_counter()

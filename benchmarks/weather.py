@@ -1,19 +1,29 @@
-"""Issue 44's cost (not a test): the turbulent scene's real-time factor at N = 8 with the
-tensegrity section against the solid one (median of 3 each), and a seed study's wall
-time on 2 MPI ranks against 1.
+"""Issue 44's cost, ``make bench``'s section ``weather`` (benchmarks/run.py; not a test):
 
-    .venv/bin/python benchmarks/weather.py [--until S] [--repeats 3] [--seeds 2]
+(a) ``simulate turbulent_rated`` at N = 8 for ten simulated minutes, the tensegrity
+    section against the solid one: the real-time factor (simulated / solve time), median
+    of 3 runs each with their spread, each run the whole compute in this process after
+    a warm-up run that compiles the forms;
+(b) the whole seeds study of the issue, ``rawehelix study turbulent_rated --vary
+    wind.seed=1:6:6 --vary wind.speed_m_s=5:9:3`` with its seven quantities (3 winds x
+    6 seeds, ten minutes each, N = 8, and its 3 sensitivity points) on 2 MPI ranks, its
+    wall time as a command.
 
-Each run is ``simulate turbulent_rated`` (the whole compute, in this process, after a
-warm-up run that compiles the forms) to ``--until`` simulated seconds; the study is the
-whole ``rawehelix study`` command under mpirun.  Prints the figures as JSON and the
-rows for benchmarks/results.md."""
+Reduced (``run.py --only weather --reduced``, or ``RAWEHELIX_BENCH_REDUCED=1``, or this
+script's ``--reduced``): the same runs shortened to :data:`REDUCED_S` simulated seconds
+(a) and :data:`REDUCED_STUDY_S` a study point (b), for a trial in a few minutes.  The
+full size takes hours on a shared 2-core machine (the report of the run that added it
+gives the estimate).
+
+    .venv/bin/python benchmarks/weather.py [--reduced] [--repeats 3]
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -21,12 +31,31 @@ import time
 
 import numpy as np
 
+SCENE = "turbulent_rated"
+ELEMENTS = 8  # N of both parts [-]
+FULL_S = 600.0  # ten simulated minutes [s]
+REDUCED_S = 10.0  # (a) reduced [s]
+REDUCED_STUDY_S = 5.0  # (b) reduced, a point [s]
+RANKS = 2
+#: how a scene gets the tensegrity section (docs/explanation/section_laws, example.toml's
+#: [section]): its members' energy, on the extensible kinematics it needs
 TENSEGRITY = {"section.law": "tensegrity", "model.kinematics": "extensible"}
+SOLID = {"section.law": "solid"}
+#: the issue's seeds study (docs/explanation/weather.md, "Statistics over seeds")
+STUDY = ["--vary", "wind.seed=1:6:6", "--vary", "wind.speed_m_s=5:9:3", "--quantity",
+         "power_mean_W,tension_s0_max_N,tension_L0_max_N,member_force_min_N,moment_ratio_max,"
+         "twist_max_rad_m,slack_time_fraction"]
+ENV_REDUCED = "RAWEHELIX_BENCH_REDUCED"
+
+
+def reduced_from_env() -> bool:
+    return os.environ.get(ENV_REDUCED, "") not in ("", "0")
 
 
 def real_time_factors(until_s: float, repeats: int, law: dict) -> list[float]:
+    """simulated / solve time of ``repeats`` runs to ``until_s`` (after a warm-up)."""
     from rawehelix.studies import scene, simulate
-    p = scene.load("turbulent_rated", elements=8, overrides=law)
+    p = scene.load(SCENE, elements=ELEMENTS, overrides=law)
     simulate.compute(p, until_s=min(until_s, 0.2), progress=False)  # compile
     out = []
     for _ in range(repeats):
@@ -35,46 +64,84 @@ def real_time_factors(until_s: float, repeats: int, law: dict) -> list[float]:
     return out
 
 
-def study_wall(ranks: int, seeds: int, until_s: float) -> float:
+def _mpi_free_env() -> dict:
+    """This environment without the variables an initialised MPI puts in it (mpirun
+    refuses to start under them), root allowed."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_"))}
+    return {**env, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
+
+
+def study_command(until_s: float, outdir: str) -> list[str]:
     exe = os.path.join(os.path.dirname(sys.executable), "rawehelix")
+    return ["mpirun", "--oversubscribe", "-n", str(RANKS), exe, "study", SCENE, "--elements",
+            str(ELEMENTS), "--set", f"time.until_s={until_s:g}", *STUDY, "-o", outdir]
+
+
+def shown(until_s: float) -> str:
+    """The study's command line as a user types it."""
+    cmd = study_command(until_s, "DIR")
+    return " ".join(["mpirun", "-n", str(RANKS), "rawehelix"] + cmd[5:])
+
+
+def study_wall(until_s: float) -> float:
+    """Wall time [s] of the whole study command on :data:`RANKS` ranks."""
+    if shutil.which("mpirun") is None:
+        raise RuntimeError("mpirun not found: make install puts Open MPI in place")
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [exe, "study", "turbulent_rated", "--elements", "2", "--set",
-               f"time.until_s={until_s}", "--vary", f"wind.seed=1:{seeds}:{seeds}", "--vary",
-               "wind.speed_m_s=6:8:2", "--quantity", "power_mean_W,member_force_min_N",
-               "--fd-step", "0", "-o", os.path.join(tmp, "s")]
-        if ranks > 1:
-            cmd = ["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(ranks)] + cmd
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True)
+        subprocess.run(study_command(until_s, os.path.join(tmp, "s")), check=True,
+                       capture_output=True, env=_mpi_free_env())
         return time.perf_counter() - t0
+
+
+def _stats(x) -> dict:
+    return {"median": float(np.median(x)), "min": float(min(x)), "max": float(max(x)),
+            "runs": len(x), "values": [float(v) for v in x]}
+
+
+def bench_weather(repeats: int = 3, reduced: bool = False) -> dict:
+    """Both parts (the study first: nothing MPI in this process yet)."""
+    until = REDUCED_S if reduced else FULL_S
+    study_until = REDUCED_STUDY_S if reduced else FULL_S
+    load0 = os.getloadavg()[0]
+    wall = study_wall(study_until)
+    solid = real_time_factors(until, repeats, SOLID)
+    tens = real_time_factors(until, repeats, TENSEGRITY)
+    return {"reduced": reduced, "elements": ELEMENTS, "until_s": until,
+            "solid_rtf": _stats(solid), "tensegrity_rtf": _stats(tens),
+            "ratio": float(np.median(tens) / np.median(solid)),
+            "study_until_s": study_until, "study_points": 18 + 3, "study_ranks": RANKS,
+            "study_wall_s": wall,
+            "study_command": shown(study_until),
+            "load_average_before": load0, "load_average_after": os.getloadavg()[0]}
+
+
+def markdown(w: dict) -> list[str]:
+    """The section's two rows of benchmarks/results.md."""
+    f = lambda s: f"{s['median']:.2f} ({s['min']:.2f}-{s['max']:.2f}, {s['runs']} runs)"  # noqa: E731
+    size = (f"reduced to {w['until_s']:g} s simulated (`--reduced`; the full size is "
+            f"{FULL_S:g} s)" if w["reduced"] else f"{w['until_s']:g} s simulated")
+    load = (f"load average {w['load_average_before']:.1f} before, "
+            f"{w['load_average_after']:.1f} after")
+    study = (f"reduced to {w['study_until_s']:g} s a point (`--reduced`; the full size is "
+             f"{FULL_S:g} s)" if w["reduced"] else f"{w['study_until_s']:g} s a point")
+    return [f"| 17. turbulent_rated, N = {w['elements']}, {size}, real-time factor (simulated / "
+            f"solve time), median of {w['solid_rtf']['runs']} | tensegrity {f(w['tensegrity_rtf'])} "
+            f"against solid {f(w['solid_rtf'])}: tensegrity/solid {w['ratio']:.2f}; {load} "
+            f"| measured (issue 44) |",
+            f"| 17. seed study, the issue's 3 winds x 6 seeds (+ 3 sensitivity points), N = "
+            f"{w['elements']}, {study}, whole `{w['study_command']}` command on "
+            f"{w['study_ranks']} ranks, wall | {w['study_wall_s']:.0f} s | measured (issue 44) |"]
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--until", type=float, default=600.0, help="simulated seconds a run")
+    ap.add_argument("--reduced", action="store_true", help="a trial: the runs shortened")
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--seeds", type=int, default=6, help="seeds of the study (x 2 winds)")
-    ap.add_argument("--study-until", type=float, default=600.0)
     a = ap.parse_args(argv)
-    load0 = os.getloadavg()[0]
-    # the studies first: mpirun refuses to start under a process that has MPI running
-    # (simulate's import initialises it)
-    walls = {r: study_wall(r, a.seeds, a.study_until) for r in (1, 2)}
-    print(json.dumps({"study_wall_s": walls}), flush=True)
-    solid = real_time_factors(a.until, a.repeats, {})
-    print(json.dumps({"solid_rtf": solid}), flush=True)
-    tens = real_time_factors(a.until, a.repeats, TENSEGRITY)
-    out = {"until_s": a.until, "repeats": a.repeats, "solid_rtf": solid, "tensegrity_rtf": tens,
-           "study_seeds": a.seeds, "study_until_s": a.study_until, "study_wall_s": walls,
-           "load_average_before": load0, "load_average_after": os.getloadavg()[0]}
-    print(json.dumps(out, indent=1))
-    med = lambda x: f"{np.median(x):.2f} ({min(x):.2f}-{max(x):.2f}, {len(x)} runs)"  # noqa: E731
-    print(f"| 17. turbulent_rated, N = 8, {a.until:g} s simulated, real-time factor | tensegrity "
-          f"{med(tens)} against solid {med(solid)}: ratio {np.median(tens) / np.median(solid):.2f} "
-          f"| measured (issue 44) |")
-    print(f"| 17. seed study ({a.seeds} seeds x 2 winds, N = 2, {a.study_until:g} s each), wall | "
-          f"1 rank {walls[1]:.0f} s, 2 ranks {walls[2]:.0f} s: x{walls[1] / walls[2]:.2f} "
-          f"| measured (issue 44) |")
+    w = bench_weather(a.repeats, a.reduced or reduced_from_env())
+    print(json.dumps(w, indent=1))
+    print("\n".join(markdown(w)))
 
 
 if __name__ == "__main__":

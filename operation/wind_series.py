@@ -177,6 +177,14 @@ class WindHistory:
         """u(z, t), the component along -i_E [m/s]."""
         return self.speed(t, z_m)[..., 0]
 
+    def mean_hub(self, t: float) -> float:
+        """u at the hub at the time ``t`` without the turbulence's fluctuation u':
+        V_ref(t) f(z_hub) + G(t), the wind a turbulent record fluctuates about [m/s]."""
+        i, w = self._at(t)
+        return float(self._series(self.reference_m_s, i, w)
+                     * self.profile.factor(self.profile.hub_height_m)
+                     + self._series(self.gust_m_s, i, w))
+
     def hub(self, t) -> np.ndarray:
         """u at the hub at the times ``t`` [m/s]."""
         z = self.profile.hub_height_m

@@ -1,12 +1,15 @@
 """simulate with the machine (issue 43): the rotor at the top, the generator at the
 ground, at a constant wind (solvers/end_torques.py).  A run with a rotor starts at the
 rigid-shaft operating point (operation/rigid_shaft.py: the stable root of Q = tau at
-the hub's wind, or the paper's law's target spin), on the stationary state twisted by
+the hub's mean wind at t = 0 (:func:`start_wind`: a turbulent record's fluctuation
+left out), or the paper's law's target spin), on the stationary state twisted by
 its torque and spinning uniformly: the relative equilibrium the run then keeps, or
 settles back to after a gust.  Its time series gains :data:`COLUMNS`, its summary the
 ``machine`` (the start) and the ``energy`` block (solvers/energy_account.py)."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -29,10 +32,24 @@ def of(params) -> Machine:
     return machine_of(params)
 
 
+def start_wind(machine: Machine) -> Machine:
+    """The machine in the wind a run starts in: the history's at t = 0 without the
+    turbulence's fluctuation (V_ref f(z_hub) + G(0), operation/wind_series.py), so a
+    turbulent run starts at its mean wind's operating point, the one ``rawehelix operate``
+    gives at that wind, whatever gust of the record happens to blow at t = 0.  A steady,
+    step, gust or file wind is unchanged (no fluctuation)."""
+    if machine.history is None:
+        return machine
+    v = machine.history.mean_hub(0.0)  # [m/s]
+    return dataclasses.replace(machine, wind_hub_m_s=v, wind_n_m_s=v * machine.normal_factor)
+
+
 def start_point(params, machine: Machine):
-    """The rigid-shaft operating point the run starts at, against the scene's ground law
-    (the paper's Eq. 40 holds its target spin): the stable one of the fastest rotor;
-    SceneError (exit 2) when the wind has none, naming the keys to change."""
+    """The rigid-shaft operating point the run starts at, in :func:`start_wind`, against
+    the scene's ground law (the paper's Eq. 40 holds its target spin): the stable one of
+    the fastest rotor; SceneError (exit 2) when the wind has none, naming the keys to
+    change."""
+    machine = start_wind(machine)
     ground = generator.from_params(params)  # every law, the paper's too (None: no torque)
     points = [p for p in operating_points(machine.rotor, ground, machine.wind_n_m_s,
                                           machine.air_density_kg_m3) if p.stable]
@@ -64,9 +81,10 @@ def solver(params, machine: Machine, comm, options):
     sv = DynamicsSolver.spinning(params, machine, point.omega_rad_s * q.t_scale,
                                  point.rotor_torque_Nm / q.torque_scale, comm, options,
                                  scene=params.name)
+    start = start_wind(machine)
     return sv, {"start_rotor_rpm": point.rotor_rpm, "start_torque_Nm": point.rotor_torque_Nm,
-                "start_power_W": point.power_W, "wind_hub_m_s": machine.wind_hub_m_s,
-                "wind_n_m_s": machine.wind_n_m_s, "tsr": point.tsr}
+                "start_power_W": point.power_W, "wind_hub_m_s": start.wind_hub_m_s,
+                "wind_n_m_s": start.wind_n_m_s, "tsr": point.tsr}
 
 
 def starts_from_rest(params, machine: Machine) -> bool:
@@ -182,4 +200,4 @@ def check_step(machine: Machine, solver) -> None:
 
 
 __all__ = ["COLUMNS", "check_step", "lifter_block", "lifter_line", "of", "row", "solver",
-           "start_point", "starts_from_rest", "startup", "startup_line", "thrust", "top_position"]
+           "start_point", "start_wind", "starts_from_rest", "startup", "startup_line", "thrust", "top_position"]

@@ -290,10 +290,11 @@ def compute(params: Parameters, winds, comm=MPI.COMM_WORLD, planned: Plan | None
             points.append(p)
             entries.append(_entry(p, branch))
             details.append(_detail(p, branch))
-            log.info("operate: %g m/s (branch %d): %.1f rpm, P %.1f W, T %.1f .. %.1f N, %d "
-                     "solves", V, branch, p.omega_rad_s / RPM, p.power_W,
-                     entries[-1]["tension_min_N"] or 0.0, entries[-1]["tension_max_N"] or 0.0,
-                     p.stationary_solves)
+            if comm.rank == 0:  # every rank solves the point; one says so
+                log.info("operate: %g m/s (branch %d): %.1f rpm, P %.1f W, T %.1f .. %.1f N, "
+                         "%d solves", V, branch, p.omega_rad_s / RPM, p.power_W,
+                         entries[-1]["tension_min_N"] or 0.0,
+                         entries[-1]["tension_max_N"] or 0.0, p.stationary_solves)
             if p.limits and p.limits.get("first_limit"):
                 reached.append((branch, p.limits["first_limit"]))
         if stop:

@@ -296,6 +296,10 @@ def compute(source: Source, variables: list[Variable], wanted: list[str], outdir
         source, variables, sample, points, fd_step,
         check=lambda p: resources.check_quantities(p, wanted, copies=comm.size))
     params = source.load()
+    # the points' records on the disk (a seed study's seeds x winds too), before any runs
+    from rawehelix.studies import needs
+    from rawehelix.studies.store import outdir as outdir_check
+    outdir_check.check(outdir, needs.get("study"), points=len(tasks))
     store = pool.Store(outdir, header(source, params, variables, sample, points, wanted,
                                       fd_step)).open(comm)
     out = pool.run(tasks, source.load, wanted, store, comm=comm, log=log,

@@ -122,6 +122,10 @@ FAULTS = [
      'wind.turbulence_class: "D" must be one of'),
     (["simulate", "turbulent_rated", "--until", "700"], 2,
      "wind.duration_s: 600.0: is shorter than the run, --until = 700.0"),
+    # a seed study past the memory (its disk: tests/test_weather_faults.py)
+    (["study", "turbulent_rated", "--elements", "2", "--set", "time.output_every_s=1e-6",
+      "--vary", "wind.seed=1:2:2", "--quantity", "power_mean_W"], 2,
+     "time.until_s: 600 s: 6e+08 output steps of 1e-06 s need about 300 GB, more than the"),
 ]
 
 

@@ -60,7 +60,12 @@ def gust():
     return stiff("gust_rated", 11.0, gust_start_s=0.2)
 
 
-@pytest.mark.parametrize("case", ["step", "gust"])
+#: the gust's run (11 s simulated, 12 s) in make test-long, make test's budget; the step
+#: (3 s) keeps both kinds in make test: the rigid-shaft ODE and the energy in moving wind
+CASES = ["step", pytest.param("gust", marks=pytest.mark.long)]
+
+
+@pytest.mark.parametrize("case", CASES)
 def test_a_stiff_helix_follows_the_rigid_shaft_ode(case, request):
     """Omega of the top (rotor_rpm) through the step (6.61 -> 9.92 m/s over 0.5 s) and
     the gust (V_gust 4.65 m/s, 10.5 s) equals scipy's ODE to 1e-3 at every output; the
@@ -86,7 +91,7 @@ def test_after_the_step_it_settles_to_the_new_operating_point(step):
     assert series.rows[-1, 8] == pytest.approx(point.rotor_rpm, rel=1e-6)
 
 
-@pytest.mark.parametrize("case", ["step", "gust"])
+@pytest.mark.parametrize("case", CASES)
 def test_energy_balance_in_moving_wind(case, request):
     """work in = generator work + dissipation (the drag's power of the moving air
     included) + change of stored energy, to 1e-3 of the work in."""
