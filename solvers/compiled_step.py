@@ -276,6 +276,17 @@ class CompiledChordAlpha(ChordAlpha):
         return u, v, tension
 
 
+def _steps_to(t, h0, outputs):
+    """The ends of the steps of at most ``h0`` from ``t`` landing on each output time
+    (DynamicsSolver.advance cuts TS's steps to land on them the same way)."""
+    ends = []
+    for end in outputs:
+        n = max(1, math.ceil((end - t) / h0 - 1e-9))
+        ends += [t + k * (end - t) / n for k in range(1, n)] + [end]
+        t = end
+    return ends
+
+
 class CompiledAdvance:
     """``DynamicsSolver.advance`` by compiled steps (module docstring)."""
 
@@ -293,17 +304,17 @@ class CompiledAdvance:
         t = ts.getTime()
         eps = 1e-9 * max(1.0, t_end)
         h0 = ts.getTimeStep()
-        steps = max(1, math.ceil((t_end - t) / h0 - 1e-9))
-        h_end = (t_end - t) / steps
-        if on_step is not None:  # every step is an output
-            ends = [t + k * h_end for k in range(1, steps + 1)]
-        elif output_every:
+        outputs = [t_end]
+        if output_every:
             n = int(math.floor((t_end - t) / output_every + 1e-9))
-            ends = [t + k * output_every for k in range(1, n + 1)]
-            if not ends or ends[-1] < t_end - eps:
-                ends.append(t_end)
-        else:
-            ends = [t_end]
+            outputs = [t + k * output_every for k in range(1, n + 1)]
+            if not outputs or outputs[-1] < t_end - eps:
+                outputs.append(t_end)
+        ends, marks = outputs, set(outputs)
+        if on_step is not None or solver.release is not None:
+            # every step ends a stretch (a start-up's release latches after each step, as
+            # in advance); the outputs stay TS's
+            ends = _steps_to(t, h0, outputs)
         U, V = ts.getSolution2()
         u, v = form.u.x.array.copy(), form.v.x.array.copy()
         last = self._last
@@ -329,7 +340,7 @@ class CompiledAdvance:
                 U.array[:] = u
                 V.array[:] = v
                 ts.setTime(t)
-                solver._pending = [t]
+                solver._pending = [t] if t in marks else []
                 solver._accepted(t)
         finally:
             solver.newton_iterations += stepper.iterations - it0
