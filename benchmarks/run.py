@@ -51,6 +51,10 @@ sections and keeps the others' last results.
 15. ``network``: the network reference against the FE continuum at equal accuracy
     (benchmarks/network.py): a Sec. 5.2 spin-up second and a sweep point at 3 Hz,
     CPU time, ratios of medians.
+18. ``compiled_weather``: issue 46 for the weather runs (benchmarks/compiled_weather.py):
+    ``simulate turbulent_rated`` 60 s at N = 8 (tensegrity, solid) and the reduced seeds
+    study on 2 ranks, compiled fixed steps against TS's adaptive ones, whole commands,
+    one run each (the study takes minutes).
 """
 
 from __future__ import annotations
@@ -75,6 +79,7 @@ import hb_stability as hb_stability_bench  # benchmarks/hb_stability.py
 import network as network_bench  # benchmarks/network.py
 import study as study_bench  # benchmarks/study.py
 import compiled_step as compiled_bench  # benchmarks/compiled_step.py
+import compiled_weather as compiled_weather_bench  # benchmarks/compiled_weather.py
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
@@ -739,7 +744,8 @@ def markdown(r: dict) -> str:
             f"{w['median']:.3f} ({w['min']:.3f}-{w['max']:.3f}), CPU {c['median']:.3f} "
             f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
-    for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench)):
+    for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench),
+                       ("compiled_weather", compiled_weather_bench)):
         if r.get(key):
             lines += bench.markdown(r[key])
     return "\n".join(lines) + "\n"
@@ -747,7 +753,7 @@ def markdown(r: dict) -> str:
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
             "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network",
-            "compiled")
+            "compiled", "compiled_weather")
 
 
 def main():
@@ -787,7 +793,8 @@ def main():
                      ("campbell", lambda: campbell_bench.bench_campbell(8, repeats)),
                      ("hb_stability", lambda: hb_stability_bench.bench_sizes()),
                      ("network", lambda: network_bench.bench_network(stats, repeats)),
-                     ("compiled", lambda: bench_compiled(repeats))):
+                     ("compiled", lambda: bench_compiled(repeats)),
+                     ("compiled_weather", lambda: compiled_weather_bench.bench())):
         if name not in only:
             continue
         t0 = time.perf_counter()
