@@ -277,12 +277,15 @@ class CompiledChordAlpha(ChordAlpha):
 
 
 def _steps_to(t, h0, outputs):
-    """The ends of the steps of at most ``h0`` from ``t`` landing on each output time
-    (DynamicsSolver.advance cuts TS's steps to land on them the same way)."""
+    """The ends of TS's steps from ``t``: steps of ``h0``, the one that would pass an
+    output time (or leave less than 1e-3 h0 before it) cut to land on it, as
+    DynamicsSolver.advance's prestep cuts them."""
     ends = []
     for end in outputs:
-        n = max(1, math.ceil((end - t) / h0 - 1e-9))
-        ends += [t + k * (end - t) / n for k in range(1, n)] + [end]
+        while t + h0 <= end - 1e-3 * h0:
+            t += h0
+            ends.append(t)
+        ends.append(end)
         t = end
     return ends
 
