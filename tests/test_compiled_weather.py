@@ -3,8 +3,8 @@
 the wind in time, a start-up's release and a lifted top, against PETSc TSALPHA2 with
 the same fixed step: `simulate`'s time series (rotor_rpm, power_W, the end tensions)
 to the Newton tolerance, and the energy account closing as on TS.  What the compiled
-steps still do not run (adaptive steps, the weather scenes' default) is refused before
-any step, naming the option.  N = 2, p = 3, fixed steps, a fraction of a second."""
+steps still do not run (adaptive steps, the weather scenes' default; a section law of
+its own, the tensegrity) is refused before any step, naming the option.  N = 2, p = 3, fixed steps, a fraction of a second."""
 
 import numpy as np
 import pytest
@@ -82,13 +82,20 @@ def test_startup_release_on_compiled_steps_at_ts_step():
     assert_same_series(ts, fast, 1e-5)
 
 
-@pytest.mark.parametrize("name", ["turbulent_rated", "startup"])
-def test_weather_scene_on_adaptive_steps_is_refused_before_any_step(name):
-    """A weather scene steps adaptively by default: the compiled steps refuse it when
-    the solver is built, naming the option that gives fixed steps."""
-    params = scene.load(name, elements=2, degree=3)
-    if name == "turbulent_rated":
-        params = params.replace(wind={"duration_s": 1.0}, time={"until_s": 1.0})
-    with pytest.raises(SceneError, match="-rawehelix_ts_compiled: the compiled steps take fixed "
-                                         "steps: add -rawehelix_ts_adapt_type none"):
-        DynamicsSolver(params, MPI.COMM_SELF, options={"ts_compiled": 1})
+ADAPTIVE = "take fixed steps: add -rawehelix_ts_adapt_type none"
+
+
+@pytest.mark.parametrize("name, overrides, options, allowed", [
+    ("turbulent_rated", {"wind": {"duration_s": 1.0}, "time": {"until_s": 1.0}}, {}, ADAPTIVE),
+    ("startup", {}, {}, ADAPTIVE),
+    ("turbulent_rated", {"wind": {"duration_s": 1.0}, "time": {"until_s": 1.0},
+                         "section": {"law": "tensegrity"}, "model": {"kinematics": "extensible"}},
+     FIXED, "run the solid section only, not section.law = 'tensegrity'")])
+def test_what_the_compiled_steps_do_not_run_is_refused_before_any_step(name, overrides, options,
+                                                                       allowed):
+    """Adaptive steps (a weather scene's default) and a section law of its own (the
+    loop's T(0) is the solid's linear map) are refused when the solver is built, in one
+    line naming the option and what to give instead."""
+    params = scene.load(name, elements=2, degree=3).replace(**overrides)
+    with pytest.raises(SceneError, match=f"-rawehelix_ts_compiled: the compiled steps {allowed}"):
+        DynamicsSolver(params, MPI.COMM_SELF, options={"ts_compiled": 1, **options})
