@@ -10,8 +10,8 @@ The scheme is TSALPHA2's (same rho_inf, same start, same fixed steps), so a run
 gives TS's numbers to the Newton tolerance (tests/test_compiled_steps.py); the
 TS keeps the state (its solution vectors and time are set after every stretch of
 steps), so the outputs, the states and the failures go through the solver as
-before.  One rank, alpha2 with fixed steps (a moving end's default), the solid
-section (the loop's T(0) is its linear map): anything else is refused before the run.
+before.  One rank, alpha2 with fixed steps (a moving end's default): anything
+else is refused before the run.
 
 The machine and the weather (issues 43, 44) step alike (tests/test_compiled_weather.py):
 the wind in time, the rotor's wind and a start-up's release ramp are Constants the
@@ -32,14 +32,16 @@ from rawehelix.errors import SceneError, SolverError
 OPTION = "-rawehelix_ts_compiled"
 
 
-def refusal(ts_type: str, adapt: str, comm_size: int, end_twist,
-            section_law: str = "solid") -> str | None:
+def loop_tension(params) -> bool:
+    """True if the compiled loop's T(0), the solid's sigma (|D U| - 1)
+    (rod_operator.tension_map), is the section's: not for a law of its own (the
+    tensegrity's N(eps) was 8e-7 off at turbulent_rated's start, N = 8), whose runs take
+    T(0) from the probe after each step (solvers/forced.py)."""
+    return not section_laws.get(params.model.section.law).nonlinear
+
+
+def refusal(ts_type: str, adapt: str, comm_size: int, end_twist) -> str | None:
     """Why the compiled steps cannot run this solver (None: they can)."""
-    if section_laws.get(section_law).nonlinear:
-        # the loop's T(0) is the solid's sigma (|D U| - 1) (rod_operator.tension_map), which
-        # a law's own N(eps) is not: tensegrity, 8e-7 off at turbulent_rated's start, N = 8
-        return (f"run the solid section only, not section.law = {section_law!r}: drop the "
-                f"option, or --set 'section.law=\"solid\"'")
     if comm_size > 1:
         return "run on one rank (drop it, or run without mpirun)"
     if ts_type != "alpha2":
@@ -52,8 +54,7 @@ def refusal(ts_type: str, adapt: str, comm_size: int, end_twist,
     return None
 
 
-def wanted(prefix: str, ts_type: str, comm_size: int, end_twist,
-           section_law: str = "solid") -> bool:
+def wanted(prefix: str, ts_type: str, comm_size: int, end_twist) -> bool:
     """True if the options ask for the compiled steps (``-{prefix}ts_compiled``); a
     SceneError (bad input, exit 2) if they cannot run this solver (:func:`refusal`)."""
     from petsc4py import PETSc
@@ -61,7 +62,7 @@ def wanted(prefix: str, ts_type: str, comm_size: int, end_twist,
     if not options.getBool(prefix + "ts_compiled", False):
         return False
     why = refusal(ts_type, options.getString(prefix + "ts_adapt_type", "basic"), comm_size,
-                  end_twist, section_law)
+                  end_twist)
     if why:
         raise SceneError("PETSc options", OPTION, f"the compiled steps {why}")
     return True

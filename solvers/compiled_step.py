@@ -197,11 +197,15 @@ class CompiledChordAlpha(ChordAlpha):
     chord Newton and tests, on the FFCx kernels (module docstring)."""
 
     def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
-                 rate: float = 0.03, max_it: int = 8, order: int = 2):
+                 rate: float = 0.03, max_it: int = 8, order: int = 2, tension: bool = True):
         if order not in (0, 2):
             raise SolverError(f"compiled steps: predictor order {order} (0 or 2)")
-        super().__init__(params, rho_inf, solver, tol, rate, max_it, order)
+        super().__init__(params, rho_inf, solver, tol, rate, max_it, order, tension_map=tension)
         op = self.op
+        #: the loop's T(0) is the section's (the solid's linear map); False: NaN
+        self.tension_known = tension
+        if not tension:
+            op._D, op._sigma = np.zeros((3, op.n)), math.nan
         self.forms = CompiledForms(op)
         self._Fp, self._Jp = self.forms.pieces()
         sv_slot, sa_slot, rest = self.forms._shift_slots
@@ -298,7 +302,8 @@ class CompiledAdvance:
         # Hairer's test at the orbits' 1e-14, not ChordAlpha's 1e-11: the energy balance
         # of an undamped free vibration is then TS's (2.9e-7 against 3.1e-7 over 2000
         # steps; 1e-11: 4.2e-5, 1e-13: 7.0e-6), for 2.8 iterations a step instead of 2.0
-        self.stepper = CompiledChordAlpha(solver.params, rho_inf, solver=solver, tol=TOL)
+        self.stepper = CompiledChordAlpha(solver.params, rho_inf, solver=solver, tol=TOL,
+                                          tension=compiled_dynamics.loop_tension(solver.params))
         self._last = None  # (t, U) where the last advance ended, with its acceleration
 
     def __call__(self, t_end: float, on_step=None, on_output=None, output_every=None):

@@ -147,8 +147,7 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
         with default_options(PREFIX, ts_defaults), default_options(PREFIX + "ts_", snes_defaults), \
                 temporary_options(PREFIX, options):
             ts_type = PETSc.Options().getString(PREFIX + "ts_type", "alpha2")
-            compiled = compiled_dynamics.wanted(PREFIX, ts_type, comm.size, end_twist,  # issue 46
-                                                params.model.section.law)
+            compiled = compiled_dynamics.wanted(PREFIX, ts_type, comm.size, end_twist)  # issue 46
             if end_twist is not None and ts_type != "alpha2":
                 raise ValueError("end_twist: a prescribed end twist runs with alpha2 only "
                                  "(the first-order form sets its own end conditions)")
