@@ -173,6 +173,18 @@ def markdown(r: dict) -> list[str]:
                f"the smallest member force within {p['member_force_min_N_max_abs']:.2f} N"
                if (p := s.get("points_compared")) else "")
             + " | issue 46: the seeds study before and after |")
+    for law, h in (r.get("dt_half_N8") or {}).items():
+        e = h["against_dt_half"]
+        lines.append(
+            f"| 18. the same 60 s at N = 8, {law} section, against the compiled run at dt/2 = "
+            f"{dt / 2 * 1e3:g} ms (mean power {h['statistics']['power_mean_W']:.3f} W, T(0) max "
+            f"{h['statistics']['tension_s0_max_N']:.3f} N, T(L0) max "
+            f"{h['statistics']['tension_L0_max_N']:.3f} N) | compiled at {dt * 1e3:g} ms "
+            + ", ".join(f"{e['compiled'][k]:+.1e}" for k in ("power_mean_W", "tension_s0_max_N",
+                                                            "tension_L0_max_N"))
+            + "; TS adaptive " + ", ".join(f"{e['ts'][k]:+.1e}" for k in (
+                "power_mean_W", "tension_s0_max_N", "tension_L0_max_N"))
+            + " (mean power, T(0) max, T(L0) max) | the dt of the rows above |")
     for row in r.get("accuracy") or []:
         lines.append(f"| 18. {row['what']} | {row['measured']} | the dt of the rows above |")
     return lines
