@@ -318,7 +318,7 @@ class CompiledAdvance:
             outputs = [t + k * output_every for k in range(1, n + 1)]
             if not outputs or outputs[-1] < t_end - eps:
                 outputs.append(t_end)
-        ends, marks = outputs, set(outputs)
+        ends, marks = outputs, set(outputs if output_every else ())  # advance's outputs
         if on_step is not None or solver.release is not None:
             # every step ends a stretch (a start-up's release latches after each step, as
             # in advance); the outputs stay TS's
