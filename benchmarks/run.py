@@ -56,6 +56,10 @@ sections and keeps the others' last results.
     (median of 3, spread), and the whole seeds study (3 winds x 6 seeds x 10 min) on 2
     ranks, wall.  ``--reduced`` (or RAWEHELIX_BENCH_REDUCED=1) shortens the simulated
     time for a trial of a few minutes; the full size takes hours.
+18. ``compiled_weather``: issue 46 for the weather runs (benchmarks/compiled_weather.py):
+    ``simulate turbulent_rated`` 60 s at N = 8 (tensegrity, solid) and the reduced seeds
+    study on 2 ranks, compiled fixed steps against TS's adaptive ones, whole commands,
+    one run each (the study takes minutes).
 """
 
 from __future__ import annotations
@@ -81,6 +85,7 @@ import network as network_bench  # benchmarks/network.py
 import study as study_bench  # benchmarks/study.py
 import compiled_step as compiled_bench  # benchmarks/compiled_step.py
 import weather as weather_bench  # benchmarks/weather.py
+import compiled_weather as compiled_weather_bench  # benchmarks/compiled_weather.py
 
 HERE = Path(__file__).parent
 ROOT = HERE.parent
@@ -746,7 +751,7 @@ def markdown(r: dict) -> str:
             f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
     for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench),
-                       ("weather", weather_bench)):
+                       ("weather", weather_bench), ("compiled_weather", compiled_weather_bench)):
         if r.get(key):
             lines += bench.markdown(r[key])
     return "\n".join(lines) + "\n"
@@ -754,7 +759,7 @@ def markdown(r: dict) -> str:
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
             "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network",
-            "compiled", "weather")
+            "compiled", "weather", "compiled_weather")
 
 
 def main():
@@ -799,7 +804,8 @@ def main():
                      ("network", lambda: network_bench.bench_network(stats, repeats)),
                      ("compiled", lambda: bench_compiled(repeats)),
                      ("weather", lambda: weather_bench.bench_weather(
-                         repeats, args.reduced or weather_bench.reduced_from_env()))):
+                         repeats, args.reduced or weather_bench.reduced_from_env())),
+                     ("compiled_weather", lambda: compiled_weather_bench.bench())):
         if name not in only:
             continue
         t0 = time.perf_counter()

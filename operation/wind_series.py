@@ -137,7 +137,7 @@ class WindHistory:
     def _at(self, t: float):
         """(i, w): t lies at (1 - w) t_i + w t_{i+1}, clamped to the samples."""
         ts = self.times_s
-        i = int(np.clip(np.searchsorted(ts, t, side="right") - 1, 0, len(ts) - 2))
+        i = min(max(int(np.searchsorted(ts, t, side="right")) - 1, 0), len(ts) - 2)
         w = min(max((t - ts[i]) / (ts[i + 1] - ts[i]), 0.0), 1.0)
         return i, w
 
@@ -184,11 +184,21 @@ class WindHistory:
         return float(self._series(self.reference_m_s, i, w)
                      * self.profile.factor(self.profile.hub_height_m)
                      + self._series(self.gust_m_s, i, w))
+    def hub_u(self, t: float) -> float:
+        """u at the hub at the time ``t`` [m/s]: :meth:`along` at the hub height, the
+        same operations on its scalars (a dynamic run asks it at every step)."""
+        return self.hub_of(*self.parts(t))
+
+    def hub_of(self, reference: float, gust: float, fluct) -> float:
+        """u at the hub [m/s] of a time's :meth:`parts`."""
+        z = self.profile.hub_height_m
+        u = float(reference * self.profile.factor(z) + gust)
+        return u + float(fluct[0, 0] if len(self.heights_m) == 1
+                         else np.interp(z, self.heights_m, fluct[:, 0]))
 
     def hub(self, t) -> np.ndarray:
         """u at the hub at the times ``t`` [m/s]."""
-        z = self.profile.hub_height_m
-        return np.array([float(self.along(float(s), z)) for s in np.atleast_1d(t)])
+        return np.array([self.hub_u(float(s)) for s in np.atleast_1d(t)])
 
 
 def sampled(profile: WindProfile, times_s, reference_m_s=None, gust_m_s=None,

@@ -59,12 +59,13 @@ class ChordAlpha:
     the contraction above which the LU is refreshed; ``max_it``: per step."""
 
     def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
-                 rate: float = 0.03, max_it: int = 8, order: int = 2):
+                 rate: float = 0.03, max_it: int = 8, order: int = 2, tension_map: bool = True):
         self.op = RodOperator(params, MPI.COMM_SELF, solver)
         self.solver = self.op.solver
         self.alpha = AlphaStepper(self.op, rho_inf, tol=tol, rate=rate, max_it=max_it,
                                   order=order)
-        self.op.tension_map()
+        if tension_map:  # T(0) = sigma (|D U| - 1), the solid's (False: a caller without T(0))
+            self.op.tension_map()
 
     # the stepper's counters and its Newton's limit (the sweep's statistics, the tests)
     iterations = property(lambda self: self.alpha.iterations)

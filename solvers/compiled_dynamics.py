@@ -12,13 +12,32 @@ TS keeps the state (its solution vectors and time are set after every stretch of
 steps), so the outputs, the states and the failures go through the solver as
 before.  One rank, alpha2 with fixed steps (a moving end's default): anything
 else is refused before the run.
+
+The machine and the weather (issues 43, 44) step alike (tests/test_compiled_weather.py):
+the wind in time, the rotor's wind and a start-up's release ramp are Constants the
+formulation's set_time sets at each stage time, which the compiled steps read; the
+rotor's and generator's torques, the rotor's spin inertia and a lifted top's terms are
+integrals of the same forms (compiled_forms.py assembles their end facets); the
+per-step work of a run with a machine (the energy account, the rotor's table check, the
+release latch) is the solver's ``on_step``/``_accepted``, called after each step as
+TS calls it.  A weather scene steps adaptively unless asked: the compiled steps need
+``-rawehelix_ts_adapt_type none`` (the step ``time.dt_s``).
 """
 
 from __future__ import annotations
 
+from rawehelix import section_laws
 from rawehelix.errors import SceneError, SolverError
 
 OPTION = "-rawehelix_ts_compiled"
+
+
+def loop_tension(params) -> bool:
+    """True if the compiled loop's T(0), the solid's sigma (|D U| - 1)
+    (rod_operator.tension_map), is the section's: not for a law of its own (the
+    tensegrity's N(eps) was 8e-7 off at turbulent_rated's start, N = 8), whose runs take
+    T(0) from the probe after each step (solvers/forced.py)."""
+    return not section_laws.get(params.model.section.law).nonlinear
 
 
 def refusal(ts_type: str, adapt: str, comm_size: int, end_twist) -> str | None:
@@ -28,8 +47,8 @@ def refusal(ts_type: str, adapt: str, comm_size: int, end_twist) -> str | None:
     if ts_type != "alpha2":
         return f"steps alpha2 only, not -rawehelix_ts_type {ts_type}"
     if adapt != "none":
-        return ("take fixed steps: a scene with a moving upper end (ends.circle_radius_m > 0), "
-                "or -rawehelix_ts_adapt_type none")
+        return ("take fixed steps: add -rawehelix_ts_adapt_type none (the step is time.dt_s; "
+                "a scene with a moving upper end takes them by default)")
     if end_twist is not None:
         return "does not run the prescribed end twist of the torsion test"
     return None

@@ -197,11 +197,15 @@ class CompiledChordAlpha(ChordAlpha):
     chord Newton and tests, on the FFCx kernels (module docstring)."""
 
     def __init__(self, params, rho_inf: float = 0.9, solver=None, tol: float = 1e-11,
-                 rate: float = 0.03, max_it: int = 8, order: int = 2):
+                 rate: float = 0.03, max_it: int = 8, order: int = 2, tension: bool = True):
         if order not in (0, 2):
             raise SolverError(f"compiled steps: predictor order {order} (0 or 2)")
-        super().__init__(params, rho_inf, solver, tol, rate, max_it, order)
+        super().__init__(params, rho_inf, solver, tol, rate, max_it, order, tension_map=tension)
         op = self.op
+        #: the loop's T(0) is the section's (the solid's linear map); False: NaN
+        self.tension_known = tension
+        if not tension:
+            op._D, op._sigma = np.zeros((3, op.n)), math.nan
         self.forms = CompiledForms(op)
         self._Fp, self._Jp = self.forms.pieces()
         sv_slot, sa_slot, rest = self.forms._shift_slots
@@ -276,6 +280,20 @@ class CompiledChordAlpha(ChordAlpha):
         return u, v, tension
 
 
+def _steps_to(t, h0, outputs):
+    """The ends of TS's steps from ``t``: steps of ``h0``, the one that would pass an
+    output time (or leave less than 1e-3 h0 before it) cut to land on it, as
+    DynamicsSolver.advance's prestep cuts them."""
+    ends = []
+    for end in outputs:
+        while t + h0 <= end - 1e-3 * h0:
+            t += h0
+            ends.append(t)
+        ends.append(end)
+        t = end
+    return ends
+
+
 class CompiledAdvance:
     """``DynamicsSolver.advance`` by compiled steps (module docstring)."""
 
@@ -284,7 +302,8 @@ class CompiledAdvance:
         # Hairer's test at the orbits' 1e-14, not ChordAlpha's 1e-11: the energy balance
         # of an undamped free vibration is then TS's (2.9e-7 against 3.1e-7 over 2000
         # steps; 1e-11: 4.2e-5, 1e-13: 7.0e-6), for 2.8 iterations a step instead of 2.0
-        self.stepper = CompiledChordAlpha(solver.params, rho_inf, solver=solver, tol=TOL)
+        self.stepper = CompiledChordAlpha(solver.params, rho_inf, solver=solver, tol=TOL,
+                                          tension=compiled_dynamics.loop_tension(solver.params))
         self._last = None  # (t, U) where the last advance ended, with its acceleration
 
     def __call__(self, t_end: float, on_step=None, on_output=None, output_every=None):
@@ -293,17 +312,17 @@ class CompiledAdvance:
         t = ts.getTime()
         eps = 1e-9 * max(1.0, t_end)
         h0 = ts.getTimeStep()
-        steps = max(1, math.ceil((t_end - t) / h0 - 1e-9))
-        h_end = (t_end - t) / steps
-        if on_step is not None:  # every step is an output
-            ends = [t + k * h_end for k in range(1, steps + 1)]
-        elif output_every:
+        outputs = [t_end]
+        if output_every:
             n = int(math.floor((t_end - t) / output_every + 1e-9))
-            ends = [t + k * output_every for k in range(1, n + 1)]
-            if not ends or ends[-1] < t_end - eps:
-                ends.append(t_end)
-        else:
-            ends = [t_end]
+            outputs = [t + k * output_every for k in range(1, n + 1)]
+            if not outputs or outputs[-1] < t_end - eps:
+                outputs.append(t_end)
+        ends, marks = outputs, set(outputs if output_every else ())  # advance's outputs
+        if on_step is not None or solver.release is not None:
+            # every step ends a stretch (a start-up's release latches after each step, as
+            # in advance); the outputs stay TS's
+            ends = _steps_to(t, h0, outputs)
         U, V = ts.getSolution2()
         u, v = form.u.x.array.copy(), form.v.x.array.copy()
         last = self._last
@@ -329,7 +348,7 @@ class CompiledAdvance:
                 U.array[:] = u
                 V.array[:] = v
                 ts.setTime(t)
-                solver._pending = [t]
+                solver._pending = [t] if t in marks else []
                 solver._accepted(t)
         finally:
             solver.newton_iterations += stepper.iterations - it0

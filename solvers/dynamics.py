@@ -155,10 +155,6 @@ class DynamicsSolver(DynamicsStates, DynamicsOutputs):
             ends = EndTorques.of(self.q, self.machine)  # the rotor's and generator's (issue 43)
             # the wind in time and a start-up's release (issue 44), each set at each time
             self.weather, self.release, ends = weather.install(self.machine, self.q, self.rod, ends)
-            if compiled and (self.machine.active or self.weather is not None):
-                raise errors.SceneError("PETSc options", compiled_dynamics.OPTION,
-                                        "the compiled steps do not step the machine's end "
-                                        "torques or its wind in time: drop the option")
             top = lifted_top.of(params, self.rod, ts_type)  # None: r(1) prescribed
             self.form = (SecondOrder(self.rod, bcs, ends, top) if ts_type == "alpha2"
                          else FirstOrder(self.rod, bcs, ends))

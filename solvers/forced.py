@@ -96,7 +96,8 @@ class FEBackend:
 
     def advance(self, state: RodState, t0: float, t1: float, t_out):
         solver = self.solver
-        if solver.compiled is not None and self.section_sampler is None:
+        if (solver.compiled is not None and self.section_sampler is None
+                and solver.compiled.stepper.tension_known):  # else T(0) by the probe, each step
             return self._advance_compiled(state, t0, t1, t_out)
         restart = self._begin(state, t0)
         ts = solver.ts

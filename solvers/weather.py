@@ -44,6 +44,8 @@ class Weather:
         self._rotor = None
         if machine.rotor is not None:
             self._rotor = (constant(0.0), constant(0.0))  # power_n, lam_per_omega
+            # the two at the machine's V_n: power ~ V_n^3, lam_per_omega ~ 1 / V_n
+            self._scales0 = rotor_scales(machine, q), machine.wind_n_m_s
         self(0.0)
 
     def install(self, c, ends: EndTorques):
@@ -63,9 +65,11 @@ class Weather:
         w.reference.value = reference / self.speed_scale
         w.gust.value = gust / self.speed_scale
         w.fluctuation.value[:] = fluctuation / self.speed_scale
-        if self._rotor is not None:
-            power, lam = rotor_scales(self.machine.at(t_s), self.q)
-            self._rotor[0].value, self._rotor[1].value = power, lam
+        if self._rotor is not None:  # Machine.at(t_s)'s V_n, without a new Machine
+            (power, lam), v0 = self._scales0
+            hub = self.machine.history.hub_of(reference, gust, fluctuation)
+            ratio = hub * self.machine.normal_factor / v0
+            self._rotor[0].value, self._rotor[1].value = power * ratio**3, lam / ratio
 
 
 def of(machine: Machine, q, mesh, steady) -> Weather | None:
