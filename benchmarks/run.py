@@ -55,7 +55,8 @@ sections and keeps the others' last results.
     ``turbulent_rated`` at N = 8, tensegrity against solid section, real-time factor
     (median of 3, spread), and the whole seeds study (3 winds x 6 seeds x 10 min) on 2
     ranks, wall.  ``--reduced`` (or RAWEHELIX_BENCH_REDUCED=1) shortens the simulated
-    time for a trial of a few minutes; the full size takes hours.
+    time for a trial of a few minutes; the full size takes hours.  ``weather_compiled``:
+    the same on the compiled steps (fixed 10 ms steps, issue 46), minutes at full size.
 18. ``compiled_weather``: issue 46 for the weather runs (benchmarks/compiled_weather.py):
     ``simulate turbulent_rated`` 60 s at N = 8 (tensegrity, solid) and the reduced seeds
     study on 2 ranks, compiled fixed steps against TS's adaptive ones, whole commands,
@@ -751,7 +752,8 @@ def markdown(r: dict) -> str:
             f"({c['min']:.3f}-{c['max']:.3f}); peak memory {row['before_peak_MiB']['median']:.0f} -> "
             f"{row['after_peak_MiB']['median']:.0f} MiB | no change beyond noise (issue 42) |")
     for key, bench in (("hb_stability", hb_stability_bench), ("network", network_bench),
-                       ("weather", weather_bench), ("compiled_weather", compiled_weather_bench)):
+                       ("weather", weather_bench), ("weather_compiled", weather_bench),
+                       ("compiled_weather", compiled_weather_bench)):
         if r.get(key):
             lines += bench.markdown(r[key])
     return "\n".join(lines) + "\n"
@@ -759,7 +761,7 @@ def markdown(r: dict) -> str:
 
 SECTIONS = ("step_cost", "section_law", "shearable", "modal", "rtf", "sweep", "levers", "sweep_few", "chord", "study",
             "orbits", "curve", "hb", "operate", "campbell", "hb_stability", "network",
-            "compiled", "weather", "compiled_weather")
+            "compiled", "weather", "weather_compiled", "compiled_weather")
 
 
 def main():
@@ -805,6 +807,8 @@ def main():
                      ("compiled", lambda: bench_compiled(repeats)),
                      ("weather", lambda: weather_bench.bench_weather(
                          repeats, args.reduced or weather_bench.reduced_from_env())),
+                     ("weather_compiled", lambda: weather_bench.bench_weather(
+                         repeats, args.reduced or weather_bench.reduced_from_env(), compiled=True)),
                      ("compiled_weather", lambda: compiled_weather_bench.bench())):
         if name not in only:
             continue

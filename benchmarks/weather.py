@@ -46,20 +46,36 @@ STUDY = ["--vary", "wind.seed=1:6:6", "--vary", "wind.speed_m_s=5:9:3", "--quant
          "power_mean_W,tension_s0_max_N,tension_L0_max_N,member_force_min_N,moment_ratio_max,"
          "twist_max_rad_m,slack_time_fraction"]
 ENV_REDUCED = "RAWEHELIX_BENCH_REDUCED"
+#: the compiled steps' path (``--compiled``, issue 46; benchmarks/compiled_weather.py
+#: measured its accuracy against TS): fixed steps of COMPILED_DT_S [s]
+COMPILED_DT_S = 0.01
+COMPILED_OPTIONS = {"ts_compiled": 1, "ts_adapt_type": "none"}
+
+
+def path_arguments(compiled: bool) -> list[str]:
+    """The command line's extra arguments of the path (none: PETSc TS, adaptive)."""
+    if not compiled:
+        return []
+    return ["--set", f"time.dt_s={COMPILED_DT_S:g}",
+            *[a for k, v in COMPILED_OPTIONS.items() for a in (f"-rawehelix_{k}", str(v))]]
 
 
 def reduced_from_env() -> bool:
     return os.environ.get(ENV_REDUCED, "") not in ("", "0")
 
 
-def real_time_factors(until_s: float, repeats: int, law: dict) -> list[float]:
+def real_time_factors(until_s: float, repeats: int, law: dict,
+                      compiled: bool = False) -> list[float]:
     """simulated / solve time of ``repeats`` runs to ``until_s`` (after a warm-up)."""
     from rawehelix.studies import scene, simulate
     p = scene.load(SCENE, elements=ELEMENTS, overrides=law)
-    simulate.compute(p, until_s=min(until_s, 0.2), progress=False)  # compile
+    options = {}
+    if compiled:
+        p, options = p.replace(time={"dt_s": COMPILED_DT_S}), COMPILED_OPTIONS
+    simulate.compute(p, until_s=min(until_s, 0.2), options=options, progress=False)  # compile
     out = []
     for _ in range(repeats):
-        s = simulate.compute(p, until_s=until_s, progress=False).summary
+        s = simulate.compute(p, until_s=until_s, options=options, progress=False).summary
         out.append(s["simulated_s"] / s["solve_s"])
     return out
 
@@ -71,26 +87,28 @@ def _mpi_free_env() -> dict:
     return {**env, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
 
 
-def study_command(until_s: float, outdir: str) -> list[str]:
+def study_command(until_s: float, outdir: str, compiled: bool = False) -> list[str]:
     exe = os.path.join(os.path.dirname(sys.executable), "rawehelix")
     return ["mpirun", "--oversubscribe", "-n", str(RANKS), exe, "study", SCENE, "--elements",
-            str(ELEMENTS), "--set", f"time.until_s={until_s:g}", *STUDY, "-o", outdir]
+            str(ELEMENTS), "--set", f"time.until_s={until_s:g}", *path_arguments(compiled),
+            *STUDY, "-o", outdir]
 
 
-def shown(until_s: float) -> str:
+def shown(until_s: float, compiled: bool = False) -> str:
     """The study's command line as a user types it."""
-    cmd = study_command(until_s, "DIR")
+    cmd = study_command(until_s, "DIR", compiled)
     return " ".join(["mpirun", "-n", str(RANKS), "rawehelix"] + cmd[5:])
 
 
-def study_wall(until_s: float) -> float:
-    """Wall time [s] of the whole study command on :data:`RANKS` ranks."""
+def study_wall(until_s: float, compiled: bool = False, keep: str | None = None) -> float:
+    """Wall time [s] of the whole study command on :data:`RANKS` ranks (``keep``: its
+    output folder, kept; default a temporary one)."""
     if shutil.which("mpirun") is None:
         raise RuntimeError("mpirun not found: make install puts Open MPI in place")
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        subprocess.run(study_command(until_s, os.path.join(tmp, "s")), check=True,
-                       capture_output=True, env=_mpi_free_env())
+        subprocess.run(study_command(until_s, keep or os.path.join(tmp, "s"), compiled),
+                       check=True, capture_output=True, env=_mpi_free_env())
         return time.perf_counter() - t0
 
 
@@ -99,20 +117,22 @@ def _stats(x) -> dict:
             "runs": len(x), "values": [float(v) for v in x]}
 
 
-def bench_weather(repeats: int = 3, reduced: bool = False) -> dict:
-    """Both parts (the study first: nothing MPI in this process yet)."""
+def bench_weather(repeats: int = 3, reduced: bool = False, compiled: bool = False,
+                  keep: str | None = None) -> dict:
+    """Both parts (the study first: nothing MPI in this process yet); ``compiled``: on
+    the compiled steps (fixed steps of COMPILED_DT_S) instead of PETSc TS."""
     until = REDUCED_S if reduced else FULL_S
     study_until = REDUCED_STUDY_S if reduced else FULL_S
     load0 = os.getloadavg()[0]
-    wall = study_wall(study_until)
-    solid = real_time_factors(until, repeats, SOLID)
-    tens = real_time_factors(until, repeats, TENSEGRITY)
-    return {"reduced": reduced, "elements": ELEMENTS, "until_s": until,
+    wall = study_wall(study_until, compiled, keep)
+    solid = real_time_factors(until, repeats, SOLID, compiled)
+    tens = real_time_factors(until, repeats, TENSEGRITY, compiled)
+    return {"reduced": reduced, "compiled": compiled, "elements": ELEMENTS, "until_s": until,
             "solid_rtf": _stats(solid), "tensegrity_rtf": _stats(tens),
             "ratio": float(np.median(tens) / np.median(solid)),
             "study_until_s": study_until, "study_points": 18 + 3, "study_ranks": RANKS,
             "study_wall_s": wall,
-            "study_command": shown(study_until),
+            "study_command": shown(study_until, compiled),
             "load_average_before": load0, "load_average_after": os.getloadavg()[0]}
 
 
@@ -121,11 +141,13 @@ def markdown(w: dict) -> list[str]:
     f = lambda s: f"{s['median']:.2f} ({s['min']:.2f}-{s['max']:.2f}, {s['runs']} runs)"  # noqa: E731
     size = (f"reduced to {w['until_s']:g} s simulated (`--reduced`; the full size is "
             f"{FULL_S:g} s)" if w["reduced"] else f"{w['until_s']:g} s simulated")
+    path = (f"compiled steps, dt = {COMPILED_DT_S * 1e3:g} ms" if w.get("compiled")
+            else "PETSc TS, adaptive steps")
     load = (f"load average {w['load_average_before']:.1f} before, "
             f"{w['load_average_after']:.1f} after")
     study = (f"reduced to {w['study_until_s']:g} s a point (`--reduced`; the full size is "
              f"{FULL_S:g} s)" if w["reduced"] else f"{w['study_until_s']:g} s a point")
-    return [f"| 17. turbulent_rated, N = {w['elements']}, {size}, real-time factor (simulated / "
+    return [f"| 17. turbulent_rated, N = {w['elements']}, {size}, {path}, real-time factor (simulated / "
             f"solve time), median of {w['solid_rtf']['runs']} | tensegrity {f(w['tensegrity_rtf'])} "
             f"against solid {f(w['solid_rtf'])}: tensegrity/solid {w['ratio']:.2f}; {load} "
             f"| measured (issue 44) |",
@@ -138,9 +160,25 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reduced", action="store_true", help="a trial: the runs shortened")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--compiled", action="store_true",
+                    help="on the compiled steps (fixed 10 ms steps) instead of PETSc TS")
+    ap.add_argument("--keep", help="keep the study's output folder here")
+    ap.add_argument("--write", action="store_true",
+                    help="store the result in benchmarks/results.json as run.py's section "
+                         "weather (weather_compiled with --compiled); `run.py --only none` "
+                         "then writes results.md")
     a = ap.parse_args(argv)
-    w = bench_weather(a.repeats, a.reduced or reduced_from_env())
+    w = bench_weather(a.repeats, a.reduced or reduced_from_env(), a.compiled, a.keep)
     print(json.dumps(w, indent=1))
+    if a.write:
+        path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results.json")
+        with open(path) as f:
+            results = json.load(f)
+        results["weather_compiled" if a.compiled else "weather"] = w
+        results.setdefault("dates", {})["weather_compiled" if a.compiled else "weather"] = \
+            time.strftime("%Y-%m-%d %H:%M")
+        with open(path, "w") as f:
+            f.write(json.dumps(results, indent=2) + "\n")
     print("\n".join(markdown(w)))
 
 
