@@ -5,8 +5,10 @@ nopython mode, on F and J assembled by the FFCx kernels
 (:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting (J's band from the mesh's dofs).
 
 The time data (the forms' constants and the Dirichlet values g at each step's
-stage time) come from the formulation's own ``set_time`` (Python, once per step,
-before the compiled loop): the loop only reads them.  So the numbers are
+stage time) come from the affine map of the forcing laws found on the
+formulation's own ``set_time`` (:mod:`~rawehelix.solvers.compiled_time_data`:
+one set_time a stretch of steps), or from set_time at every step when the form
+has other time data; the loop only reads them.  So the numbers are
 ChordAlpha's to the Newton tolerance (tests/test_compiled_steps.py compares them
 with TS).  Like ChordAlpha it has no line search: a step whose Newton diverges
 with a fresh Jacobian raises; one
@@ -23,6 +25,7 @@ import numpy as np
 from rawehelix.solvers import compiled_dynamics, dynamics
 from rawehelix.solvers.chord import ChordAlpha
 from rawehelix.solvers.compiled_forms import CompiledForms, jacobian, residual
+from rawehelix.solvers.compiled_time_data import TimeDataFit
 from rawehelix.solvers.generalised_alpha import TOL
 from rawehelix.solvers.snes import SolverError
 
@@ -216,23 +219,29 @@ class CompiledChordAlpha(ChordAlpha):
         self._bc_sources = op.form.bc_sources()
         if self._bc_sources is None:
             raise SolverError("compiled steps: a Dirichlet value that is not a function")
+        self._fit = TimeDataFit(op.form, self._sample)
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
     factorisations = property(lambda self: self.alpha.factorisations + int(self._counters[1]))
     steps = property(lambda self: self.alpha.steps + int(self._counters[2]))
 
-    def time_data(self, times):
-        """(constants of F, Dirichlet values) at each stage time, from the form's set_time."""
-        op, forms = self.op, self.forms
+    def _sample(self, t):
+        """(constants of F, Dirichlet values) at t, from the form's set_time."""
+        self.op.set_time(t)
         functions, index = self._bc_sources
-        cF = np.empty((len(times), forms.constants().size))
-        G = np.empty((len(times), self._bc.size))
-        for k, t in enumerate(times):
-            op.set_time(t)
-            cF[k] = forms.constants()
-            G[k] = np.concatenate([f.x.array for f in functions])[index]
-        return cF, G
+        return self.forms.constants(), np.concatenate([f.x.array for f in functions])[index]
+
+    def time_data(self, times, t_end=None):
+        """(constants of F, Dirichlet values) at each stage time: by the fit of the
+        forcing laws (anchored at ``t_end``, where the form is left), or by the form's
+        set_time at each."""
+        if t_end is not None:
+            fitted = self._fit(times, t_end, self.forms.constants().size)
+            if fitted is not None:
+                return fitted
+        rows = [self._sample(t) for t in times]
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
 
     def run(self, t0, h, steps, u, v, a=None):
         """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's); a
@@ -252,7 +261,7 @@ class CompiledChordAlpha(ChordAlpha):
         hist, nhist = self._hist, self._nhist
         scheme = np.array(alpha.scheme)
         sv, sa = alpha.shifts(h)
-        cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h)
+        cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h, t0 + steps * h)
         code, k, size, theta = _steps(
             u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
             G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
