@@ -220,6 +220,7 @@ class CompiledChordAlpha(ChordAlpha):
         if self._bc_sources is None:
             raise SolverError("compiled steps: a Dirichlet value that is not a function")
         self._fit = TimeDataFit(op.form, self._sample)
+        self._cF_size = self.forms.constants().size
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
@@ -237,7 +238,7 @@ class CompiledChordAlpha(ChordAlpha):
         forcing laws (anchored at ``t_end``, where the form is left), or by the form's
         set_time at each."""
         if t_end is not None:
-            fitted = self._fit(times, t_end, self.forms.constants().size)
+            fitted = self._fit(times, t_end, self._cF_size)
             if fitted is not None:
                 return fitted
         rows = [self._sample(t) for t in times]

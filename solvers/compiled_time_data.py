@@ -32,9 +32,12 @@ _CHECK_TIMES = np.array([0.0071, 0.173, 0.77, 4.3, 37.0])
 def features(q, times) -> np.ndarray:
     """(len(times), 5): 1, t, m_N(t) (Eq. 69), cos and sin of the end's phase (Eq. 70)."""
     times = np.asarray(times, dtype=float)
+    out = np.empty((times.size, 5))
+    out[:, 0], out[:, 1] = 1.0, times
+    out[:, 2] = [q.top_torque(t) for t in times.tolist()]
     phase = q.phase(times)
-    ramp = np.fromiter((q.top_torque(t) for t in times), float, times.size)
-    return np.column_stack([np.ones_like(times), times, ramp, np.cos(phase), np.sin(phase)])
+    out[:, 3], out[:, 4] = np.cos(phase), np.sin(phase)
+    return out
 
 
 class TimeDataFit:
@@ -71,7 +74,7 @@ class TimeDataFit:
             self._key, self._map = key, self._fit(float(times[0]))
         if self._map is None:
             return None
-        q = form.rod.q
         end = np.concatenate(self.sample(t_end))
-        values = end + (features(q, times) - features(q, [t_end])) @ self._map
+        phi = features(form.rod.q, np.append(times, t_end))
+        values = end + (phi[:-1] - phi[-1]) @ self._map
         return values[:, :split], values[:, split:]
