@@ -174,6 +174,17 @@ def expression(ufl_expr, V):
     return dolfinx.fem.Expression(ufl_expr, interpolation_points(V))
 
 
+def eval_expression(expr, mesh, cells, values=None):
+    """An Expression's values at its points on ``cells`` (into ``values`` if given)."""
+    if NEW:
+        out = expr.eval(mesh, cells)
+        if values is not None:
+            values[...] = out.reshape(values.shape)
+            return values
+        return out
+    return expr.eval(cells, values)
+
+
 def create_vector(form):
     if NEW:
         try:
