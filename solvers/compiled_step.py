@@ -85,17 +85,18 @@ def _lu_solve(LU, piv, kl, b, x):
 
 
 @numba.njit(cache=True)
-def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, Fp, Jp,
-           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
+def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, Fp, Jp,
+           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters, work):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
-    Dirichlet values.  Returns (code, step, size, theta) and counts iterations and
-    factorisations in ``counters``."""
+    Dirichlet values; ``cj`` (J's constants) and ``work`` (6 n + F's constants)
+    scratch, held by the caller (no allocation a call).  Returns (code, step, size,
+    theta) and counts iterations and factorisations in ``counters``."""
     am, af, g_, b_ = scheme[0], scheme[1], scheme[2], scheme[3]
     n = u.shape[0]
-    X = np.empty(3 * n)
-    R, dz, z = np.empty(n), np.empty(n), np.empty(n)
-    cj = np.empty(cJ.shape[0])
+    X = work[:3 * n]
+    R, dz, z = work[3 * n:4 * n], work[4 * n:5 * n], work[5 * n:6 * n]
+    cf = work[6 * n:]
     for k in range(G.shape[0]):
         # predictor (AlphaStepper.predict): extrapolation, or constant acceleration
         if nhist[0] < order + 1:
@@ -109,6 +110,7 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 z[i] = hist[0, i]
         for j in range(bc.shape[0]):
             z[bc[j]] = G[k, j]
+        cf[:] = cF[k]
         zmax = 0.0
         for i in range(n):
             zmax = max(zmax, abs(z[i]))
@@ -135,7 +137,7 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 has_lu[0] = True
                 counters[1] += 1
                 fresh, last = True, -1.0
-            residual(R, X, cF[k], Fp)
+            residual(R, X, cf, Fp)
             for j in range(bc.shape[0]):
                 R[bc[j]] = 0.0
             _lu_solve(LU, piv, kl, R, dz)
@@ -221,6 +223,7 @@ class CompiledChordAlpha(ChordAlpha):
             raise SolverError("compiled steps: a Dirichlet value that is not a function")
         self._fit = TimeDataFit(op.form, self._sample)
         self._cF_size = self.forms.constants().size
+        self._cj, self._work = np.empty(self._cF_size + 2), np.empty(6 * n + self._cF_size)
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
@@ -264,10 +267,10 @@ class CompiledChordAlpha(ChordAlpha):
         sv, sa = alpha.shifts(h)
         cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h, t0 + steps * h)
         code, k, size, theta = _steps(
-            u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
+            u, v, a, hist, nhist, h, scheme, sv, sa, cF, self._cj, self._slots,
             G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
-            alpha.order, self._counters)
+            alpha.order, self._counters, self._work)
         if code != OK:
             t = t0 + k * h
             self._has_lu[0] = False
