@@ -86,12 +86,15 @@ def _lu_solve(LU, piv, kl, b, x):
 
 @numba.njit(cache=True)
 def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, Fp, Jp,
-           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters, work):
+           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters, work,
+           marks, saved):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
     Dirichlet values; ``cj`` (J's constants) and ``work`` (6 n + F's constants)
-    scratch, held by the caller (no allocation a call).  Returns (code, step, size,
+    scratch, held by the caller (no allocation a call); (u, v, a) after ``marks[i]``
+    steps into ``saved[i]`` (the outputs' states).  Returns (code, step, size,
     theta) and counts iterations and factorisations in ``counters``."""
+    mark = 0
     am, af, g_, b_ = scheme[0], scheme[1], scheme[2], scheme[3]
     n = u.shape[0]
     X = work[:3 * n]
@@ -194,6 +197,9 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, 
                 d += D[c, i] * u[i]
             r2 += d * d
         tension[k] = sigma * (math.sqrt(r2) - 1.0)
+        if mark < marks.shape[0] and marks[mark] == k + 1:
+            saved[mark, 0, :], saved[mark, 1, :], saved[mark, 2, :] = u, v, a
+            mark += 1
     return OK, G.shape[0], 0.0, 0.0
 
 
@@ -247,9 +253,11 @@ class CompiledChordAlpha(ChordAlpha):
         rows = [self._sample(t) for t in times]
         return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
 
-    def run(self, t0, h, steps, u, v, a=None):
+    def run(self, t0, h, steps, u, v, a=None, marks=None):
         """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's); a
-        run continued (``a`` given, the same h) keeps the predictor's history."""
+        run continued (``a`` given, the same h) keeps the predictor's history.
+        ``marks`` (ascending step counts): (u, v, a) after each in ``self.saved``
+        (len(marks), 3, n), and ``self.saved_count`` of them valid, a failure too."""
         alpha = self.alpha
         tension = np.empty(steps + 1)
         tension[0] = self.tension0(u)
@@ -266,11 +274,14 @@ class CompiledChordAlpha(ChordAlpha):
         scheme = np.array(alpha.scheme)
         sv, sa = alpha.shifts(h)
         cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h, t0 + steps * h)
+        marks = np.zeros(0, np.int64) if marks is None else np.asarray(marks, dtype=np.int64)
+        self.saved = np.empty((marks.size, 3, u.size))
         code, k, size, theta = _steps(
             u, v, a, hist, nhist, h, scheme, sv, sa, cF, self._cj, self._slots,
             G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
-            alpha.order, self._counters, self._work)
+            alpha.order, self._counters, self._work, marks, self.saved)
+        self.saved_count = int(np.searchsorted(marks, k, side="right"))
         if code != OK:
             t = t0 + k * h
             self._has_lu[0] = False
@@ -287,6 +298,30 @@ class CompiledChordAlpha(ChordAlpha):
                           f"try a smaller step (time.dt_s)"}[code])
         self.acceleration = a
         return u, v, tension
+
+
+#: the outputs one compiled call steps to at most (their states kept for the outputs
+#: after it): fewer Python calls a step (at 2 ms output, 4 steps an output)
+BATCH = 32
+
+
+def _batches(t, ends, h0):
+    """The output stretches from t to each of ``ends`` by steps of at most h0, as
+    compiled calls: [(start, h, step counts of the outputs, output times)], consecutive
+    stretches of equal steps together (BATCH at most)."""
+    out, key = [], None
+    for end in ends:
+        n = max(1, math.ceil((end - t) / h0 - 1e-9))
+        h = (end - t) / n
+        if key is not None and key[0] == n and abs(key[1] - h) <= 1e-12 * h \
+                and len(out[-1][2]) < BATCH:
+            out[-1][2].append(out[-1][2][-1] + n)
+            out[-1][3].append(end)
+        else:
+            out.append((t, h, [n], [end]))
+            key = (n, h)
+        t = end
+    return out
 
 
 class CompiledAdvance:
@@ -329,25 +364,29 @@ class CompiledAdvance:
             solver._accepted(t, first=True)
         it0, st0 = stepper.iterations, stepper.steps
         try:
-            for end in ends:
-                n = max(1, math.ceil((end - t) / h0 - 1e-9))
+            for t0, h, marks, times in _batches(t, ends, h0):
+                failed = None
                 try:
-                    u, v, _ = stepper.run(t, (end - t) / n, n, u, v, a)
+                    stepper.run(t0, h, marks[-1], u, v, a, marks=marks)
                 except SolverError as err:
+                    failed = err
+                for i in range(stepper.saved_count):  # the outputs, in Python
+                    u, v, a = stepper.saved[i]
+                    t = times[i]
+                    U.array[:] = u
+                    V.array[:] = v
+                    ts.setTime(t)
+                    solver._pending = [t]
+                    solver._accepted(t)
+                if failed is not None:
                     solver._restore_good()
                     t_s = solver.q.time_s(solver._good[0] if solver._good else t)
                     raise SolverError(f"dynamics stopped at t = {float(t_s):.6g} s (simulated): "
-                                      f"{err}; or run without {compiled_dynamics.OPTION}") from None
-                a, t = stepper.acceleration, end
-                U.array[:] = u
-                V.array[:] = v
-                ts.setTime(t)
-                solver._pending = [t]
-                solver._accepted(t)
+                                      f"{failed}; or run without {compiled_dynamics.OPTION}") from None
         finally:
             solver.newton_iterations += stepper.iterations - it0
             solver.steps += stepper.steps - st0
-        self._last = (t, u.copy(), a)
+        self._last = (t, u.copy(), a.copy())
 
 
 dynamics.ADVANCES["compiled"] = CompiledAdvance
