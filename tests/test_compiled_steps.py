@@ -135,3 +135,28 @@ def test_compiled_steps_not_loaded_say_so():
     assert dynamics.ADVANCES["compiled"] is compiled_step.CompiledAdvance
     with pytest.raises(SolverError, match="-rawehelix_ts_compiled: the compiled steps are not loaded"):
         compiled_dynamics.check_loaded({})
+
+
+def test_a_failure_inside_a_batch_runs_the_outputs_before_it(monkeypatch):
+    """Several outputs' stretches run in one compiled call (compiled_step.BATCH); a step
+    failing after the 10th (inside the first call, after the outputs of steps 4 and 8)
+    writes those two outputs from their kept states, then stops there, naming the time
+    of the last good output and the option."""
+    from rawehelix.solvers import compiled_step
+    real = compiled_step._steps
+
+    def fails_after_10(*args):
+        args = list(args)
+        args[9], args[12] = args[9][:10], args[12][:10]  # 10 steps of the stretch's data
+        real(*args)
+        return compiled_step.NO_CONVERGENCE, 10, 1.0, 0.5
+
+    params = scene.load("mobile_end", elements=2, degree=3)
+    full = simulate.compute(params, until_s=0.02, options={"ts_compiled": 1}, progress=False).rows
+    monkeypatch.setattr(compiled_step, "_steps", fails_after_10)
+    with pytest.raises(simulate.SimulationError,
+                       match=r"stopped at t = 0.004 s .*no convergence.*-rawehelix_ts_compiled") as err:
+        simulate.compute(params, until_s=0.02, options={"ts_compiled": 1}, progress=False)
+    rows = err.value.partial.rows
+    assert rows.shape[0] == 3 and np.allclose(rows[:, 0], [0.0, 0.002, 0.004])
+    assert np.array_equal(rows, full[:3])  # the kept states are the outputs' states
