@@ -54,26 +54,30 @@ def _loop_cpu(params, until, options, parts=None):
 
 def floor_us(params, repeats: int = 2000) -> dict:
     """CPU microseconds of a compiled step's parts at the stationary state (a loop of
-    ``repeats`` calls from Python; the call's dispatch, ~1-2 us, included)."""
-    from rawehelix.solvers import compiled_forms
-    from rawehelix.solvers.compiled_step import CompiledChordAlpha, _lu_factor, _lu_solve
+    ``repeats`` calls from Python; the call's dispatch, ~1-2 us, included); the
+    band is J's renumbered (solvers/banded_lu.py)."""
+    from rawehelix.solvers import banded_lu, compiled_forms
+    from rawehelix.solvers.compiled_step import CompiledChordAlpha
     s = CompiledChordAlpha(params)
     op, forms = s.op, s.forms
-    n, kl = op.n, forms.bandwidth
+    n, kl = op.n, s.bandwidth
     X, c = op.X_stationary.copy(), forms.constants()
     h = params.time.dt_s / params.normalised().t_scale
     cj = forms.jacobian_constants(c, *s.alpha.shifts(h))
     Fp, Jp = forms.pieces()
-    R, A, piv, x = np.zeros(n), np.zeros((n, n)), np.zeros(n, np.int64), np.zeros(n)
-    compiled_forms.jacobian(A, X, cj, Jp, s._bc)
-    _lu_factor(A.copy(), piv, kl)
+    R, J, piv, x = np.zeros(n), np.zeros((n, n)), np.zeros(n, np.int64), np.zeros(n)
+    A, LT = np.zeros((n, n)), np.zeros((n, kl))
+    compiled_forms.jacobian(J, X, cj, Jp, s._bc)
+    banded_lu.permute(J, s._perm, A)
     LU = A.copy()
-    _lu_factor(LU, piv, kl)
+    banded_lu.factor(LU, piv, kl, LT)
+    t0 = 0.1
     parts = {"residual F": lambda: compiled_forms.residual(R, X, c, Fp),
-             "banded LU solve": lambda: _lu_solve(LU, piv, kl, R, x),
-             "Jacobian J": lambda: compiled_forms.jacobian(A, X, cj, Jp, s._bc),
-             "banded LU factor": lambda: _lu_factor(A.copy(), piv, kl),
-             "time data (set_time, constants, g)": lambda: s.time_data([0.1])}
+             "banded LU solve": lambda: banded_lu.solve(LU, LT, piv, kl, R, x),
+             "Jacobian J": lambda: compiled_forms.jacobian(J, X, cj, Jp, s._bc),
+             "banded LU factor": lambda: banded_lu.factor(A.copy(), piv, kl, LT),
+             "time data (a 4-step stretch, fitted)": lambda: s.time_data(
+                 t0 + np.arange(4) * h, t0 + 4 * h)}
     out = {}
     for name, f in parts.items():
         m = repeats // 10 if "J" in name or "factor" in name else repeats

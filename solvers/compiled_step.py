@@ -2,7 +2,8 @@
 (:meth:`~rawehelix.solvers.generalised_alpha.AlphaStepper.solve_stage`, its
 predictor, Hairer's test, the LU refresh rule and its failures) in numba's
 nopython mode, on F and J assembled by the FFCx kernels
-(:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting (J's band from the mesh's dofs).
+(:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting
+(:mod:`~rawehelix.solvers.banded_lu`, J renumbered to a narrow band).
 
 The time data (the forms' constants and the Dirichlet values g at each step's
 stage time) come from the affine map of the forcing laws found on the
@@ -22,7 +23,7 @@ import math
 import numba
 import numpy as np
 
-from rawehelix.solvers import compiled_dynamics, dynamics
+from rawehelix.solvers import banded_lu, compiled_dynamics, dynamics
 from rawehelix.solvers.chord import ChordAlpha
 from rawehelix.solvers.compiled_forms import CompiledForms, jacobian, residual
 from rawehelix.solvers.compiled_time_data import TimeDataFit
@@ -34,64 +35,14 @@ OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
 
 
 @numba.njit(cache=True)
-def _lu_factor(A, piv, kl):
-    """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
-    storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
-    in kl rows and U has kl + kl off-diagonals; a swap moves the trailing columns
-    only, so L's column k stays in rows k + 1 .. k + kl (a full-row swap would move
-    its entries further from the diagonal than the solve reads).  Returns the first zero pivot's
-    row + 1 (0: none)."""
-    n = A.shape[0]
-    for k in range(n):
-        last = min(n - 1, k + kl)
-        p, big = k, abs(A[k, k])
-        for i in range(k + 1, last + 1):
-            if abs(A[i, k]) > big:
-                p, big = i, abs(A[i, k])
-        piv[k] = p
-        if big == 0.0:
-            return k + 1
-        right = min(n - 1, k + 2 * kl)
-        if p != k:  # the trailing columns only: L's column j stays where step j put it
-            for j in range(k, right + 1):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-        d = A[k, k]
-        for i in range(k + 1, last + 1):
-            f = A[i, k] / d
-            A[i, k] = f
-            if f != 0.0:
-                for j in range(k + 1, right + 1):
-                    A[i, j] -= f * A[k, j]
-    return 0
-
-
-@numba.njit(cache=True)
-def _lu_solve(LU, piv, kl, b, x):
-    """x = J^-1 b with :func:`_lu_factor`'s factors."""
-    n = LU.shape[0]
-    x[:] = b
-    for k in range(n):  # L (unit diagonal, kl below) with the row swaps in turn (gbtrs)
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
-        xk = x[k]
-        for i in range(k + 1, min(n, k + kl + 1)):
-            x[i] -= LU[i, k] * xk
-    for i in range(n - 1, -1, -1):  # U (2 kl above)
-        s = x[i]
-        for j in range(i + 1, min(n, i + 2 * kl + 1)):
-            s -= LU[i, j] * x[j]
-        x[i] = s / LU[i, i]
-
-
-@numba.njit(cache=True)
 def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, Fp, Jp,
            LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters, work,
-           marks, saved):
+           marks, saved, Jw, LT, perm):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
-    Dirichlet values; ``cj`` (J's constants) and ``work`` (6 n + F's constants)
-    scratch, held by the caller (no allocation a call); (u, v, a) after ``marks[i]``
+    Dirichlet values; ``cj`` (J's constants), ``Jw`` (J) and ``work`` (8 n + F's
+    constants) scratch, held by the caller (no allocation a call); the LU (``LU``,
+    ``LT``, ``piv``: banded_lu) is of J renumbered by ``perm``; (u, v, a) after ``marks[i]``
     steps into ``saved[i]`` (the outputs' states).  Returns (code, step, size,
     theta) and counts iterations and factorisations in ``counters``."""
     mark = 0
@@ -99,7 +50,8 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, 
     n = u.shape[0]
     X = work[:3 * n]
     R, dz, z = work[3 * n:4 * n], work[4 * n:5 * n], work[5 * n:6 * n]
-    cf = work[6 * n:]
+    b, y = work[6 * n:7 * n], work[7 * n:8 * n]  # R and dz renumbered
+    cf = work[8 * n:]
     for k in range(G.shape[0]):
         # predictor (AlphaStepper.predict): extrapolation, or constant acceleration
         if nhist[0] < order + 1:
@@ -134,8 +86,9 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, 
                 for j in range(cF.shape[1]):
                     cj[shift_slots[2 + j]] = cF[k, j]
                 cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
-                jacobian(LU, X, cj, Jp, bc)
-                if _lu_factor(LU, piv, kl) != 0:
+                jacobian(Jw, X, cj, Jp, bc)
+                banded_lu.permute(Jw, perm, LU)
+                if banded_lu.factor(LU, piv, kl, LT) != 0:
                     return SINGULAR, k, 0.0, -1.0
                 has_lu[0] = True
                 counters[1] += 1
@@ -143,7 +96,11 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, 
             residual(R, X, cf, Fp)
             for j in range(bc.shape[0]):
                 R[bc[j]] = 0.0
-            _lu_solve(LU, piv, kl, R, dz)
+            for i in range(n):
+                b[i] = R[perm[i]]
+            banded_lu.solve(LU, LT, piv, kl, b, y)
+            for i in range(n):
+                dz[perm[i]] = y[i]
             size = 0.0
             for i in range(n):
                 size = max(size, abs(dz[i]))
@@ -229,7 +186,11 @@ class CompiledChordAlpha(ChordAlpha):
             raise SolverError("compiled steps: a Dirichlet value that is not a function")
         self._fit = TimeDataFit(op.form, self._sample)
         self._cF_size = self.forms.constants().size
-        self._cj, self._work = np.empty(self._cF_size + 2), np.empty(6 * n + self._cF_size)
+        self._cj, self._work = np.empty(self._cF_size + 2), np.empty(8 * n + self._cF_size)
+        # J's band narrowed by renumbering (banded_lu.ordering), its LU's scratch
+        self._perm, self.bandwidth = banded_lu.ordering(
+            [e.dofs for e in self.forms.J_entities.values()], n)
+        self._Jw, self._LT = np.zeros((n, n)), np.zeros((n, self.bandwidth))
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
@@ -278,9 +239,10 @@ class CompiledChordAlpha(ChordAlpha):
         self.saved = np.empty((marks.size, 3, u.size))
         code, k, size, theta = _steps(
             u, v, a, hist, nhist, h, scheme, sv, sa, cF, self._cj, self._slots,
-            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
+            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
-            alpha.order, self._counters, self._work, marks, self.saved)
+            alpha.order, self._counters, self._work, marks, self.saved, self._Jw, self._LT,
+            self._perm)
         self.saved_count = int(np.searchsorted(marks, k, side="right"))
         if code != OK:
             t = t0 + k * h
