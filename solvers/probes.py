@@ -22,6 +22,12 @@ from rawehelix.models import rod_model
 from rawehelix.solvers import fields as fe_fields
 
 
+def all_cells(mesh) -> np.ndarray:
+    """This rank's cells, ghosts too (what Function.interpolate runs on)."""
+    cells = mesh.topology.index_map(mesh.topology.dim)
+    return np.arange(cells.size_local + cells.num_ghosts, dtype=np.int32)
+
+
 def middle_vertex(mesh) -> tuple[float, np.ndarray]:
     """(s, local vertex indices) of the mesh vertex nearest s = 1/2 (normalised)."""
     x = mesh.geometry.x[:, 0]
@@ -57,6 +63,7 @@ class SectionProbe:
         V = compat.vector_space(mesh, "Lagrange", compat.space_degree(V_s), len(fields))
         self._expr = compat.expression(ufl.as_vector(list(fields.values())), V)
         self._u = dolfinx.fem.Function(V)
+        self._cells = all_cells(mesh)
 
     @classmethod
     def of_rod(cls, rod):
@@ -75,7 +82,7 @@ class SectionProbe:
     def section(self) -> dict | None:
         """The section's state along s (normalised, at the Lagrange nodes of ``V_s``,
         sorted by s): s and the fields by name; rank 0 (None elsewhere).  Collective."""
-        self._u.interpolate(self._expr)
+        compat.interpolate_expression(self._u, self._expr, self._cells)
         s, vals = fe_fields.gather(self._u)
         if s is None:
             return None
@@ -135,7 +142,8 @@ class PointValues:
         if self._cells.size:
             flat = compat.eval_expression(self._expr, self._mesh, self._cells,
                                           self._values).reshape(-1)
-            np.add.at(local, self._owner, self._weight * flat[self._index])
+            local = np.bincount(self._owner, self._weight * flat[self._index],
+                                minlength=len(self.names))
         if self.comm.size > 1:
             local = self.comm.allreduce(local, op=MPI.SUM)
         return dict(zip(self.names, local.tolist()))
@@ -181,6 +189,7 @@ class Probes:
         }
         # the section's state for the limits block (studies/analysis/structure_limits.py)
         self.section_probe = SectionProbe(model, by_role, c, V_s)
+        self._cells = all_cells(mesh)
 
     def values(self) -> dict:
         """Normalised point values (collective; every rank gets them): the forms'
@@ -199,7 +208,7 @@ class Probes:
         """Normalised fields at the Lagrange nodes, sorted by s, on rank 0 (None elsewhere)."""
         out = {}
         for name, (expr, u) in self.field_exprs.items():
-            u.interpolate(expr)
+            compat.interpolate_expression(u, expr, self._cells)
             s, vals = fe_fields.gather(u)
             if s is not None:
                 out["s"] = s

@@ -45,3 +45,23 @@ def test_point_values_equal_the_forms_on_two_ranks():
     if MPI.COMM_WORLD.size == 1:
         pytest.skip("run under mpirun -n 2")
     _point_values_against_forms(MPI.COMM_WORLD, "mobile_end", 8)
+
+
+def test_section_and_fields_equal_function_interpolate():
+    """The section's state and the fields by the C++ interpolation (compat's) equal
+    dolfinx's Function.interpolate of the same expressions, bit for bit."""
+    params = scene.load("mobile_end", elements=3, degree=3)
+    solver = DynamicsSolver.from_stationary(params, MPI.COMM_SELF)
+    solver.form.u.x.array[:] += 1e-2 * np.random.default_rng(4).standard_normal(solver.form.u.x.array.size)
+    probes = solver.probes
+    section, fields = probes.section(), probes.fields()
+    sp = probes.section_probe
+    sp._u.interpolate(sp._expr)
+    assert np.array_equal(sp._u.x.array.reshape(-1, len(sp.names))[:, 4][np.argsort(
+        sp._u.function_space.tabulate_dof_coordinates()[:, 0], kind="stable")], section["tension"])
+    for name, (expr, u) in probes.field_exprs.items():
+        u.interpolate(expr)
+        s = u.function_space.tabulate_dof_coordinates()[:, 0]
+        vals = u.x.array.reshape(s.size, -1)[np.argsort(s, kind="stable")]
+        assert np.array_equal(vals if vals.shape[1] > 1 else vals[:, 0], fields[name]), name
+    assert np.ptp(section["tension"]) > 0
