@@ -126,16 +126,16 @@ def floor_us(params, repeats: int = 2000) -> dict:
     cj = forms.jacobian_constants(c, *s.alpha.shifts(h))
     Fp, Jp = forms.pieces()
     R, J, piv, x = np.zeros(n), np.zeros((n, n)), np.zeros(n, np.int64), np.zeros(n)
-    A, LT = np.zeros((n, n)), np.zeros((n, kl))
+    A, LT, UT = np.zeros((n, n)), np.zeros((n, kl)), np.zeros((n, 2 * kl))
     compiled_forms.jacobian(J, X, cj, Jp, s._bc)
     banded_lu.permute(J, s._perm, A)
     LU = A.copy()
-    banded_lu.factor(LU, piv, kl, LT)
+    banded_lu.factor(LU, piv, kl, LT, UT)
     t0 = 0.1
     parts = {"residual F": lambda: compiled_forms.residual(R, X, c, Fp),
-             "banded LU solve": lambda: banded_lu.solve(LU, LT, piv, kl, R, x),
+             "banded LU solve": lambda: banded_lu.solve(LU, LT, UT, piv, kl, R, x),
              "Jacobian J": lambda: compiled_forms.jacobian(J, X, cj, Jp, s._bc),
-             "banded LU factor": lambda: banded_lu.factor(A.copy(), piv, kl, LT),
+             "banded LU factor": lambda: banded_lu.factor(A.copy(), piv, kl, LT, UT),
              "time data (a 4-step stretch, fitted)": lambda: s.time_data(
                  t0 + np.arange(4) * h, t0 + 4 * h),
              "time data (a 4-step stretch, set_time a step)": lambda: s.time_data(

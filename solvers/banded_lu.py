@@ -1,11 +1,14 @@
 """A banded LU with partial pivoting for the compiled steps (issue 46): LAPACK's
 gbtrf/gbtrs in dense storage, numba's nopython mode, on J renumbered so that its
 band is narrow (:func:`ordering`: reverse Cuthill-McKee of J's pattern, 36 -> 27
-at N = 8, p = 3, 100 unknowns), with L's columns kept as rows for the solve.
+at N = 8, p = 3, 100 unknowns), with L's and U's columns kept as rows for the
+solve (both triangles by column updates, contiguous).
 
 Measured at N = 8, p = 3 (a loop in numba): the solve 8.2 us in the dofs' own
-numbering with L read by columns, 6.0 us with L's columns as rows, then less with
-the narrower band; the factorisation ~ n kl^2.
+numbering with L read by columns, 6.0 us with L's columns as rows, 5.4 us with
+the narrower band, 4.5 us with U by columns too (U by rows: a dot product a row,
+one dependent chain; fast-math reassociation did not help: 5.7 us); the
+factorisation ~ n kl^2.
 """
 
 from __future__ import annotations
@@ -46,13 +49,14 @@ def permute(J, perm, A):
 
 
 @numba.njit(cache=True)
-def factor(A, piv, kl, LT):
+def factor(A, piv, kl, LT, UT):
     """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
     storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
     in kl rows and U has kl + kl off-diagonals; a swap moves the trailing columns
     only, so L's column k stays in rows k + 1 .. k + kl (a full-row swap would move
     its entries further from the diagonal than the solve reads); L's column k also
-    into LT's row k (the solve reads it contiguously).  Returns the first zero
+    into LT's row k and U's column i above the diagonal into UT's row i (UT[i, d] =
+    U[i - 1 - d, i]: the solve reads them contiguously).  Returns the first zero
     pivot's row + 1 (0: none)."""
     n = A.shape[0]
     for k in range(n):
@@ -77,11 +81,14 @@ def factor(A, piv, kl, LT):
                     A[i, j] -= f * A[k, j]
         for j in range(kl):
             LT[k, j] = A[k + 1 + j, k] if k + 1 + j < n else 0.0
+    for i in range(n):
+        for d in range(2 * kl):
+            UT[i, d] = A[i - 1 - d, i] if i - 1 - d >= 0 else 0.0
     return 0
 
 
 @numba.njit(cache=True)
-def solve(LU, LT, piv, kl, b, x):
+def solve(LU, LT, UT, piv, kl, b, x):
     """x = J^-1 b with :func:`factor`'s factors."""
     n = LU.shape[0]
     x[:] = b
@@ -92,8 +99,8 @@ def solve(LU, LT, piv, kl, b, x):
         xk = x[k]
         for j in range(min(kl, n - 1 - k)):
             x[k + 1 + j] -= LT[k, j] * xk
-    for i in range(n - 1, -1, -1):  # U (2 kl above)
-        s = x[i]
-        for j in range(i + 1, min(n, i + 2 * kl + 1)):
-            s -= LU[i, j] * x[j]
-        x[i] = s / LU[i, i]
+    for i in range(n - 1, -1, -1):  # U (2 kl above), by columns
+        x[i] /= LU[i, i]
+        xi = x[i]
+        for d in range(min(2 * kl, i)):
+            x[i - 1 - d] -= UT[i, d] * xi

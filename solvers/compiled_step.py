@@ -37,12 +37,12 @@ OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
 @numba.njit(cache=True)
 def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, Fp, Jp,
            LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters, work,
-           marks, saved, Jw, LT, perm):
+           marks, saved, Jw, LT, UT, perm):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
     Dirichlet values; ``cj`` (J's constants), ``Jw`` (J) and ``work`` (8 n + F's
     constants) scratch, held by the caller (no allocation a call); the LU (``LU``,
-    ``LT``, ``piv``: banded_lu) is of J renumbered by ``perm``; (u, v, a) after ``marks[i]``
+    ``LT``, ``UT``, ``piv``: banded_lu) is of J renumbered by ``perm``; (u, v, a) after ``marks[i]``
     steps into ``saved[i]`` (the outputs' states).  Returns (code, step, size,
     theta) and counts iterations and factorisations in ``counters``."""
     mark = 0
@@ -88,7 +88,7 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, 
                 cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
                 jacobian(Jw, X, cj, Jp, bc)
                 banded_lu.permute(Jw, perm, LU)
-                if banded_lu.factor(LU, piv, kl, LT) != 0:
+                if banded_lu.factor(LU, piv, kl, LT, UT) != 0:
                     return SINGULAR, k, 0.0, -1.0
                 has_lu[0] = True
                 counters[1] += 1
@@ -98,7 +98,7 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, 
                 R[bc[j]] = 0.0
             for i in range(n):
                 b[i] = R[perm[i]]
-            banded_lu.solve(LU, LT, piv, kl, b, y)
+            banded_lu.solve(LU, LT, UT, piv, kl, b, y)
             for i in range(n):
                 dz[perm[i]] = y[i]
             size = 0.0
@@ -191,6 +191,7 @@ class CompiledChordAlpha(ChordAlpha):
         self._perm, self.bandwidth = banded_lu.ordering(
             [e.dofs for e in self.forms.J_entities.values()], n)
         self._Jw, self._LT = np.zeros((n, n)), np.zeros((n, self.bandwidth))
+        self._UT = np.zeros((n, 2 * self.bandwidth))
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
@@ -242,7 +243,7 @@ class CompiledChordAlpha(ChordAlpha):
             G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
             alpha.order, self._counters, self._work, marks, self.saved, self._Jw, self._LT,
-            self._perm)
+            self._UT, self._perm)
         self.saved_count = int(np.searchsorted(marks, k, side="right"))
         if code != OK:
             t = t0 + k * h

@@ -17,10 +17,11 @@ def test_banded_lu_solves_like_numpy_with_pivoting():
             A[i, j] = rng.standard_normal()
         A[i, i] *= 1e-3  # partial pivoting must swap
     b = rng.standard_normal(n)
-    LU, LT, piv, x = A.copy(), np.zeros((n, kl)), np.zeros(n, np.int64), np.zeros(n)
-    assert banded_lu.factor(LU, piv, kl, LT) == 0
+    LU, LT, UT = A.copy(), np.zeros((n, kl)), np.zeros((n, 2 * kl))
+    piv, x = np.zeros(n, np.int64), np.zeros(n)
+    assert banded_lu.factor(LU, piv, kl, LT, UT) == 0
     assert np.any(piv != np.arange(n))
-    banded_lu.solve(LU, LT, piv, kl, b, x)
+    banded_lu.solve(LU, LT, UT, piv, kl, b, x)
     ref = np.linalg.solve(A, b)
     assert np.abs(x - ref).max() <= 1e-12 * np.abs(ref).max()
     perm = rng.permutation(n)
