@@ -174,6 +174,27 @@ def expression(ufl_expr, V):
     return dolfinx.fem.Expression(ufl_expr, interpolation_points(V))
 
 
+def interpolate_expression(u, expr, cells):
+    """u <- an Expression made at u's interpolation points, on ``cells`` (int32): the
+    C++ call of Function.interpolate (0.5's Python wrapper registers four
+    singledispatch functions a call: ~15 us of an output's 30)."""
+    if NEW:
+        u.interpolate(expr, cells)
+    else:
+        u._cpp_object.interpolate(expr._cpp_object, cells)
+
+
+def eval_expression(expr, mesh, cells, values=None):
+    """An Expression's values at its points on ``cells`` (into ``values`` if given)."""
+    if NEW:
+        out = expr.eval(mesh, cells)
+        if values is not None:
+            values[...] = out.reshape(values.shape)
+            return values
+        return out
+    return expr.eval(cells, values)
+
+
 def create_vector(form):
     if NEW:
         try:

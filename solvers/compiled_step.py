@@ -2,11 +2,14 @@
 (:meth:`~rawehelix.solvers.generalised_alpha.AlphaStepper.solve_stage`, its
 predictor, Hairer's test, the LU refresh rule and its failures) in numba's
 nopython mode, on F and J assembled by the FFCx kernels
-(:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting (J's band from the mesh's dofs).
+(:mod:`~rawehelix.solvers.compiled_forms`) and a banded LU with partial pivoting
+(:mod:`~rawehelix.solvers.banded_lu`, J renumbered to a narrow band).
 
 The time data (the forms' constants and the Dirichlet values g at each step's
-stage time) come from the formulation's own ``set_time`` (Python, once per step,
-before the compiled loop): the loop only reads them.  So the numbers are
+stage time) come from the affine map of the forcing laws found on the
+formulation's own ``set_time`` (:mod:`~rawehelix.solvers.compiled_time_data`:
+one set_time a stretch of steps), or from set_time at every step when the form
+has other time data; the loop only reads them.  So the numbers are
 ChordAlpha's to the Newton tolerance (tests/test_compiled_steps.py compares them
 with TS).  Like ChordAlpha it has no line search: a step whose Newton diverges
 with a fresh Jacobian raises; one
@@ -20,9 +23,10 @@ import math
 import numba
 import numpy as np
 
-from rawehelix.solvers import compiled_dynamics, dynamics
+from rawehelix.solvers import banded_lu, compiled_dynamics, dynamics
 from rawehelix.solvers.chord import ChordAlpha
 from rawehelix.solvers.compiled_forms import CompiledForms, jacobian, residual
+from rawehelix.solvers.compiled_time_data import TimeDataFit
 from rawehelix.solvers.generalised_alpha import TOL
 from rawehelix.solvers.snes import SolverError
 
@@ -31,68 +35,23 @@ OK, NON_FINITE, DIVERGES, NO_CONVERGENCE, SINGULAR = 0, 1, 2, 3, 4
 
 
 @numba.njit(cache=True)
-def _lu_factor(A, piv, kl):
-    """A <- its LU factors in place, partial pivoting (LAPACK's gbtrf in dense
-    storage): J's entries lie within ``kl`` of the diagonal, so the pivot is sought
-    in kl rows and U has kl + kl off-diagonals; a swap moves the trailing columns
-    only, so L's column k stays in rows k + 1 .. k + kl (a full-row swap would move
-    its entries further from the diagonal than the solve reads).  Returns the first zero pivot's
-    row + 1 (0: none)."""
-    n = A.shape[0]
-    for k in range(n):
-        last = min(n - 1, k + kl)
-        p, big = k, abs(A[k, k])
-        for i in range(k + 1, last + 1):
-            if abs(A[i, k]) > big:
-                p, big = i, abs(A[i, k])
-        piv[k] = p
-        if big == 0.0:
-            return k + 1
-        right = min(n - 1, k + 2 * kl)
-        if p != k:  # the trailing columns only: L's column j stays where step j put it
-            for j in range(k, right + 1):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-        d = A[k, k]
-        for i in range(k + 1, last + 1):
-            f = A[i, k] / d
-            A[i, k] = f
-            if f != 0.0:
-                for j in range(k + 1, right + 1):
-                    A[i, j] -= f * A[k, j]
-    return 0
-
-
-@numba.njit(cache=True)
-def _lu_solve(LU, piv, kl, b, x):
-    """x = J^-1 b with :func:`_lu_factor`'s factors."""
-    n = LU.shape[0]
-    x[:] = b
-    for k in range(n):  # L (unit diagonal, kl below) with the row swaps in turn (gbtrs)
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
-        xk = x[k]
-        for i in range(k + 1, min(n, k + kl + 1)):
-            x[i] -= LU[i, k] * xk
-    for i in range(n - 1, -1, -1):  # U (2 kl above)
-        s = x[i]
-        for j in range(i + 1, min(n, i + 2 * kl + 1)):
-            s -= LU[i, j] * x[j]
-        x[i] = s / LU[i, i]
-
-
-@numba.njit(cache=True)
-def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, Fp, Jp,
-           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters):
+def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cj, shift_slots, G, bc, Fp, Jp,
+           LU, piv, kl, has_lu, D, sigma, tension, tol, rate, max_it, order, counters, work,
+           marks, saved, Jw, LT, UT, perm):
     """``G.shape[0]`` steps from (u, v, a) in place; ``hist`` the last stage values
     (newest first, ``nhist`` of them), ``cF``/``G`` each step's constants and
-    Dirichlet values.  Returns (code, step, size, theta) and counts iterations and
-    factorisations in ``counters``."""
+    Dirichlet values; ``cj`` (J's constants), ``Jw`` (J) and ``work`` (8 n + F's
+    constants) scratch, held by the caller (no allocation a call); the LU (``LU``,
+    ``LT``, ``UT``, ``piv``: banded_lu) is of J renumbered by ``perm``; (u, v, a) after ``marks[i]``
+    steps into ``saved[i]`` (the outputs' states).  Returns (code, step, size,
+    theta) and counts iterations and factorisations in ``counters``."""
+    mark = 0
     am, af, g_, b_ = scheme[0], scheme[1], scheme[2], scheme[3]
     n = u.shape[0]
-    X = np.empty(3 * n)
-    R, dz, z = np.empty(n), np.empty(n), np.empty(n)
-    cj = np.empty(cJ.shape[0])
+    X = work[:3 * n]
+    R, dz, z = work[3 * n:4 * n], work[4 * n:5 * n], work[5 * n:6 * n]
+    b, y = work[6 * n:7 * n], work[7 * n:8 * n]  # R and dz renumbered
+    cf = work[8 * n:]
     for k in range(G.shape[0]):
         # predictor (AlphaStepper.predict): extrapolation, or constant acceleration
         if nhist[0] < order + 1:
@@ -106,6 +65,7 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 z[i] = hist[0, i]
         for j in range(bc.shape[0]):
             z[bc[j]] = G[k, j]
+        cf[:] = cF[k]
         zmax = 0.0
         for i in range(n):
             zmax = max(zmax, abs(z[i]))
@@ -126,16 +86,21 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 for j in range(cF.shape[1]):
                     cj[shift_slots[2 + j]] = cF[k, j]
                 cj[shift_slots[0]], cj[shift_slots[1]] = sv, sa
-                jacobian(LU, X, cj, Jp, bc)
-                if _lu_factor(LU, piv, kl) != 0:
+                jacobian(Jw, X, cj, Jp, bc)
+                banded_lu.permute(Jw, perm, LU)
+                if banded_lu.factor(LU, piv, kl, LT, UT) != 0:
                     return SINGULAR, k, 0.0, -1.0
                 has_lu[0] = True
                 counters[1] += 1
                 fresh, last = True, -1.0
-            residual(R, X, cF[k], Fp)
+            residual(R, X, cf, Fp)
             for j in range(bc.shape[0]):
                 R[bc[j]] = 0.0
-            _lu_solve(LU, piv, kl, R, dz)
+            for i in range(n):
+                b[i] = R[perm[i]]
+            banded_lu.solve(LU, LT, UT, piv, kl, b, y)
+            for i in range(n):
+                dz[perm[i]] = y[i]
             size = 0.0
             for i in range(n):
                 size = max(size, abs(dz[i]))
@@ -189,6 +154,9 @@ def _steps(u, v, a, hist, nhist, h, scheme, sv, sa, cF, cJ, shift_slots, G, bc, 
                 d += D[c, i] * u[i]
             r2 += d * d
         tension[k] = sigma * (math.sqrt(r2) - 1.0)
+        if mark < marks.shape[0] and marks[mark] == k + 1:
+            saved[mark, 0, :], saved[mark, 1, :], saved[mark, 2, :] = u, v, a
+            mark += 1
     return OK, G.shape[0], 0.0, 0.0
 
 
@@ -220,27 +188,42 @@ class CompiledChordAlpha(ChordAlpha):
         self._bc_sources = op.form.bc_sources()
         if self._bc_sources is None:
             raise SolverError("compiled steps: a Dirichlet value that is not a function")
+        self._fit = TimeDataFit(op.form, self._sample)
+        self._cF_size = self.forms.constants().size
+        self._cj, self._work = np.empty(self._cF_size + 2), np.empty(8 * n + self._cF_size)
+        # J's band narrowed by renumbering (banded_lu.ordering), its LU's scratch
+        self._perm, self.bandwidth = banded_lu.ordering(
+            [e.dofs for e in self.forms.J_entities.values()], n)
+        self._Jw, self._LT = np.zeros((n, n)), np.zeros((n, self.bandwidth))
+        self._UT = np.zeros((n, 2 * self.bandwidth))
 
     # ChordAlpha's counters: the start's (AlphaStepper) and the compiled steps'
     iterations = property(lambda self: self.alpha.iterations + int(self._counters[0]))
     factorisations = property(lambda self: self.alpha.factorisations + int(self._counters[1]))
     steps = property(lambda self: self.alpha.steps + int(self._counters[2]))
 
-    def time_data(self, times):
-        """(constants of F, Dirichlet values) at each stage time, from the form's set_time."""
-        op, forms = self.op, self.forms
+    def _sample(self, t):
+        """(constants of F, Dirichlet values) at t, from the form's set_time."""
+        self.op.set_time(t)
         functions, index = self._bc_sources
-        cF = np.empty((len(times), forms.constants().size))
-        G = np.empty((len(times), self._bc.size))
-        for k, t in enumerate(times):
-            op.set_time(t)
-            cF[k] = forms.constants()
-            G[k] = np.concatenate([f.x.array for f in functions])[index]
-        return cF, G
+        return self.forms.constants(), np.concatenate([f.x.array for f in functions])[index]
 
-    def run(self, t0, h, steps, u, v, a=None):
+    def time_data(self, times, t_end=None):
+        """(constants of F, Dirichlet values) at each stage time: by the fit of the
+        forcing laws (anchored at ``t_end``, where the form is left), or by the form's
+        set_time at each."""
+        if t_end is not None:
+            fitted = self._fit(times, t_end, self._cF_size)
+            if fitted is not None:
+                return fitted
+        rows = [self._sample(t) for t in times]
+        return np.array([r[0] for r in rows]), np.array([r[1] for r in rows])
+
+    def run(self, t0, h, steps, u, v, a=None, marks=None):
         """ChordAlpha.run, the steps compiled (the start, if any, by ChordAlpha's); a
-        run continued (``a`` given, the same h) keeps the predictor's history."""
+        run continued (``a`` given, the same h) keeps the predictor's history.
+        ``marks`` (ascending step counts): (u, v, a) after each in ``self.saved``
+        (len(marks), 3, n), and ``self.saved_count`` of them valid, a failure too."""
         alpha = self.alpha
         tension = np.empty(steps + 1)
         tension[0] = self.tension0(u)
@@ -256,12 +239,16 @@ class CompiledChordAlpha(ChordAlpha):
         hist, nhist = self._hist, self._nhist
         scheme = np.array(alpha.scheme)
         sv, sa = alpha.shifts(h)
-        cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h)
+        cF, G = self.time_data(t0 + (np.arange(steps) + alpha.alpha_f) * h, t0 + steps * h)
+        marks = np.zeros(0, np.int64) if marks is None else np.asarray(marks, dtype=np.int64)
+        self.saved = np.empty((marks.size, 3, u.size))
         code, k, size, theta = _steps(
-            u, v, a, hist, nhist, h, scheme, sv, sa, cF, np.empty(cF.shape[1] + 2), self._slots,
-            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.forms.bandwidth, self._has_lu, self.op._D,
+            u, v, a, hist, nhist, h, scheme, sv, sa, cF, self._cj, self._slots,
+            G, self._bc, self._Fp, self._Jp, self._LU, self._piv, self.bandwidth, self._has_lu, self.op._D,
             self.op._sigma, tension[1:], alpha.tol, alpha.rate, alpha.max_it,
-            alpha.order, self._counters)
+            alpha.order, self._counters, self._work, marks, self.saved, self._Jw, self._LT,
+            self._UT, self._perm)
+        self.saved_count = int(np.searchsorted(marks, k, side="right"))
         if code != OK:
             t = t0 + k * h
             self._has_lu[0] = False
@@ -294,6 +281,30 @@ def _steps_to(t, h0, outputs):
     return ends
 
 
+#: the outputs one compiled call steps to at most (their states kept for the outputs
+#: after it): fewer Python calls a step (at 2 ms output, 4 steps an output)
+BATCH = 32
+
+
+def _batches(t, ends, h0, batch=BATCH):
+    """The output stretches from t to each of ``ends`` by steps of at most h0, as
+    compiled calls: [(start, h, step counts of the outputs, output times)], consecutive
+    stretches of equal steps together (``batch`` at most)."""
+    out, key = [], None
+    for end in ends:
+        n = max(1, math.ceil((end - t) / h0 - 1e-9))
+        h = (end - t) / n
+        if key is not None and key[0] == n and abs(key[1] - h) <= 1e-12 * h \
+                and len(out[-1][2]) < batch:
+            out[-1][2].append(out[-1][2][-1] + n)
+            out[-1][3].append(end)
+        else:
+            out.append((t, h, [n], [end]))
+            key = (n, h)
+        t = end
+    return out
+
+
 class CompiledAdvance:
     """``DynamicsSolver.advance`` by compiled steps (module docstring)."""
 
@@ -319,10 +330,13 @@ class CompiledAdvance:
             if not outputs or outputs[-1] < t_end - eps:
                 outputs.append(t_end)
         ends, marks = outputs, set(outputs if output_every else ())  # advance's outputs
+        batch = BATCH
         if on_step is not None or solver.release is not None:
             # every step ends a stretch (a start-up's release latches after each step, as
-            # in advance); the outputs stay TS's
+            # in advance: one step a compiled call then); the outputs stay TS's
             ends = _steps_to(t, h0, outputs)
+            if solver.release is not None:
+                batch = 1
         U, V = ts.getSolution2()
         u, v = form.u.x.array.copy(), form.v.x.array.copy()
         last = self._last
@@ -335,25 +349,29 @@ class CompiledAdvance:
             solver._accepted(t, first=True)
         it0, st0 = stepper.iterations, stepper.steps
         try:
-            for end in ends:
-                n = max(1, math.ceil((end - t) / h0 - 1e-9))
+            for t0, h, counts, times in _batches(t, ends, h0, batch):
+                failed = None
                 try:
-                    u, v, _ = stepper.run(t, (end - t) / n, n, u, v, a)
+                    stepper.run(t0, h, counts[-1], u, v, a, marks=counts)
                 except SolverError as err:
+                    failed = err
+                for i in range(stepper.saved_count):  # the stretches' ends, in Python
+                    u, v, a = stepper.saved[i]
+                    t = times[i]
+                    U.array[:] = u
+                    V.array[:] = v
+                    ts.setTime(t)
+                    solver._pending = [t] if t in marks else []
+                    solver._accepted(t)
+                if failed is not None:
                     solver._restore_good()
                     t_s = solver.q.time_s(solver._good[0] if solver._good else t)
                     raise SolverError(f"dynamics stopped at t = {float(t_s):.6g} s (simulated): "
-                                      f"{err}; or run without {compiled_dynamics.OPTION}") from None
-                a, t = stepper.acceleration, end
-                U.array[:] = u
-                V.array[:] = v
-                ts.setTime(t)
-                solver._pending = [t] if t in marks else []
-                solver._accepted(t)
+                                      f"{failed}; or run without {compiled_dynamics.OPTION}") from None
         finally:
             solver.newton_iterations += stepper.iterations - it0
             solver.steps += stepper.steps - st0
-        self._last = (t, u.copy(), a)
+        self._last = (t, u.copy(), a.copy())
 
 
 dynamics.ADVANCES["compiled"] = CompiledAdvance

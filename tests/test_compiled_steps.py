@@ -29,6 +29,46 @@ def test_compiled_forms_equal_dolfinx_assembly():
     assert np.abs(op.residual() - R).max() > 1e-9 * np.abs(R).max()
 
 
+@pytest.mark.parametrize("scene_name, changes", [
+    ("mobile_end", {}),  # the circle (70) and the torque ramp (69)
+    ("mobile_end", {"circle_frequency_Hz": 3.0}),  # another circle
+    ("example", {}),  # a fixed top, the ramp only
+])
+def test_fitted_time_data_equal_set_time(scene_name, changes):
+    """The stretch's time data by the fit of the forcing laws (solvers/compiled_time_data.py)
+    equal the formulation's set_time at every stage time to round-off (measured: 2.5e-16
+    relative), at a sweep's frequency and phase too (a new q: a new fit), and the form is
+    left at the stretch's end."""
+    from rawehelix.solvers.compiled_step import CompiledChordAlpha
+    params = scene.load(scene_name, elements=2, degree=3)
+    params = params.replace(ends=changes) if changes else params
+    stepper = CompiledChordAlpha(params)
+    op = stepper.op
+    for q in (op.form.rod.q, op.form.rod.q.at_frequency(7.0, t_start=0.9)):
+        op.form.rod.q = q
+        times = 0.37 + np.arange(60) * 0.0137
+        fitted = stepper.time_data(times, 1.2)
+        assert stepper._fit._map is not None and op.form.time.value == 1.2
+        exact = stepper.time_data(times)
+        for a, b in zip(fitted, exact):
+            assert np.abs(a - b).max() <= 1e-14 * max(1.0, np.abs(b).max())
+
+
+def test_time_data_not_the_forcing_laws_are_not_fitted():
+    """Other time data (a hook: weather, release, end twist) or data that no affine map of
+    the forcing laws gives are refused: the caller falls back to set_time."""
+    from rawehelix.solvers.compiled_step import CompiledChordAlpha
+    from rawehelix.solvers.compiled_time_data import TimeDataFit
+    stepper = CompiledChordAlpha(scene.load("mobile_end", elements=2, degree=3))
+    times = np.linspace(0.1, 0.2, 5)
+    assert stepper._fit(times, 0.2, stepper.forms.constants().size) is not None
+    stepper.op.form.time_data.append(lambda t: None)
+    assert stepper._fit(times, 0.2, stepper.forms.constants().size) is None
+    square = TimeDataFit(stepper.op.form, lambda t: (np.array([t * t]), np.zeros(0)))
+    stepper.op.form.time_data.clear()
+    assert square(times, 0.2, 1) is None
+
+
 def test_compiled_steps_equal_petsc_alpha2():
     """200 steps at 10 Hz (N = 4, p = 3, dt = 0.5 ms) from the stationary state
     through the sweep's backend: TSALPHA2 with full Newton against the compiled
@@ -95,3 +135,28 @@ def test_compiled_steps_not_loaded_say_so():
     assert dynamics.ADVANCES["compiled"] is compiled_step.CompiledAdvance
     with pytest.raises(SolverError, match="-rawehelix_ts_compiled: the compiled steps are not loaded"):
         compiled_dynamics.check_loaded({})
+
+
+def test_a_failure_inside_a_batch_runs_the_outputs_before_it(monkeypatch):
+    """Several outputs' stretches run in one compiled call (compiled_step.BATCH); a step
+    failing after the 10th (inside the first call, after the outputs of steps 4 and 8)
+    writes those two outputs from their kept states, then stops there, naming the time
+    of the last good output and the option."""
+    from rawehelix.solvers import compiled_step
+    real = compiled_step._steps
+
+    def fails_after_10(*args):
+        args = list(args)
+        args[9], args[12] = args[9][:10], args[12][:10]  # 10 steps of the stretch's data
+        real(*args)
+        return compiled_step.NO_CONVERGENCE, 10, 1.0, 0.5
+
+    params = scene.load("mobile_end", elements=2, degree=3)
+    full = simulate.compute(params, until_s=0.02, options={"ts_compiled": 1}, progress=False).rows
+    monkeypatch.setattr(compiled_step, "_steps", fails_after_10)
+    with pytest.raises(simulate.SimulationError,
+                       match=r"stopped at t = 0.004 s .*no convergence.*-rawehelix_ts_compiled") as err:
+        simulate.compute(params, until_s=0.02, options={"ts_compiled": 1}, progress=False)
+    rows = err.value.partial.rows
+    assert rows.shape[0] == 3 and np.allclose(rows[:, 0], [0.0, 0.002, 0.004])
+    assert np.array_equal(rows, full[:3])  # the kept states are the outputs' states
