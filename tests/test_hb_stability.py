@@ -10,7 +10,7 @@ import pytest
 import rawehelix as rh
 from rawehelix.solvers.harmonic_balance.problem import HarmonicBalance
 from rawehelix.solvers.harmonic_balance.stability import (
-    D_MAX, EVERY_POINT, FOLD_GUARD, GUARDED, K_TOP, SAFETY, HillPoint, Track, log_moduli)
+    D_MAX, EVERY_POINT, GUARDED, K_TOP, SAFETY, HillPoint, Track, log_moduli)
 
 F1 = 10.0  # Hz
 X7 = np.zeros(7)  # one unknown at H = 3
@@ -60,14 +60,6 @@ def test_hill_is_due_where_the_next_step_may_be_natural():
     track = _track([-0.01], [STILL])
     assert not GUARDED.due(track, 0.01, False, False)
     assert GUARDED.due(track, 0.01, False, True)
-
-
-def test_hill_is_due_near_a_fold():
-    for mu in (1.0 + FOLD_GUARD / 2, 1.0 - FOLD_GUARD / 2):
-        near = Track(HillPoint(np.array([mu, 0.5]), F1, X7, 3), since=1, secants=(STILL,))
-        assert GUARDED.due(near, 1e-6, False, False)
-    far = Track(HillPoint(np.array([1.3, 0.5]), F1, X7, 3), since=1, secants=(STILL,))
-    assert not GUARDED.due(far, 1e-6, False, False)  # a saddle's multiplier, no fold near
 
 
 def test_the_secants_of_the_last_three_solves():

@@ -94,6 +94,7 @@ class HarmonicBalance(PeriodicOrbitProblem):
         self._deferring = False  # inside a trace that calls stability() (deferred_stability)
         self._track = None  # the last Hill solve, the points since, the drift (.stability)
         self._natural = None  # the last natural step's orbit (predicted_orbit)
+        self._its = 0  # the Newton iterations of the last point stability() saw
         self._pending = None  # (X, f1, H, tangents) of the last carried finish
         self.X_stationary = self.embed(op.X_stationary[:self.n], self.H)
 
@@ -377,7 +378,7 @@ class HarmonicBalance(PeriodicOrbitProblem):
         if not self.stability_step.carries:
             yield
             return
-        self._deferring = True
+        self._deferring, self._its = True, last.newton_iterations
         self._track = Track(HillPoint(last.multipliers, last.f1_Hz, last.X, last.steps))
         try:
             yield
@@ -388,9 +389,10 @@ class HarmonicBalance(PeriodicOrbitProblem):
         if not (self._deferring and "hill_f1_Hz" in orbit.accuracy):
             return
         self._track.since += 1
-        # the next step may be natural (continuation.py: after a slow corrector, or after
-        # a natural step): it reads this point's multipliers
-        natural = orbit is self._natural or orbit.newton_iterations >= SLOW
+        # the next step may be natural (continuation.py: after a natural step, or two slow
+        # correctors in a row): it reads this point's multipliers
+        natural = orbit is self._natural or min(orbit.newton_iterations, self._its) >= SLOW
+        self._its = orbit.newton_iterations
         if not self.stability_step.due(self._track, self._distance(orbit), event, natural):
             return
         X, f1, H, tangents = self._pending or (None, None, None, None)

@@ -43,7 +43,6 @@ import numpy as np
 from rawehelix.periodic_orbits.bifurcations import REAL_TOL
 from rawehelix.registry import Registry
 
-FOLD_GUARD = 0.05  # |mu - 1| of a real positive multiplier below which Hill is due
 K_TOP = 3  # the largest moduli off the positive real axis tracked
 SAFETY = 2.0  # x the drift predicted to a point that its distance to the circle must exceed
 D_MAX = 0.5  # the distance from the last Hill solve (Track.distance) at which one is due
@@ -148,9 +147,6 @@ class Guarded(StabilityStep):
 
     def due(self, track, distance, event, natural) -> bool:
         if track is None or event or natural:
-            return True
-        mu = np.asarray(track.last.multipliers, dtype=complex)
-        if np.any(np.abs(mu[_fold_kind(mu)] - 1.0) < FOLD_GUARD):
             return True
         if distance >= D_MAX:
             return True
