@@ -1,37 +1,36 @@
 """Harmonic balance's stability step: when an orbit of a continued branch gets a full
-Hill solve (:mod:`.hill`, 0.5 s of a 0.65 s point at N = 8, 3.7 s at N = 32) and when it
+Hill solve (:mod:`.hill`, 0.45 s of a 0.6 s point at N = 8, 3.7 s at N = 32) and when it
 carries the multipliers of the last one.
 
 * :data:`EVERY_POINT`: Hill's method at every point (the reference);
 * :data:`GUARDED`: Hill's method where the verdict can change, the last Hill's
   multipliers carried elsewhere.  The verdict (max |mu| < 1) changes where a real
-  multiplier passes +1 (a fold: the continuation's test function, the sign of
-  df1/ds, equivalently of det dG/dX: on the Fig. 8 curve at N = 8 the sign of det dG/dX
-  matched the parity of the real multipliers above 1 at all 135 points), or where one
-  off the positive real axis passes the unit circle (period doubling, Neimark-Sacker),
-  i.e. where the real part of its Floquet exponent, Re lambda = f1 ln|mu| [1/s]
-  (|mu| = exp(Re lambda T), T = 1/f1), passes zero.  That real part is a mode's decay
-  rate: it does not scale with the period as |mu| does, and on the Fig. 8 curve the
-  least damped ones stay constant to 1e-12 from 15 to 6.7 Hz (the ones near the unit
-  circle at N = 32, |mu| = 0.9984, among them).  So the step predicts them: it keeps
-  the drift of the K_TOP largest real parts (sorted) per unit distance along the branch
-  between the last two Hill solves (the larger of the last two secants, at least
-  |Re lambda| / (SAFETY D_MAX)), and Hill is due at a point where one of them could
-  have reached zero: |Re lambda| <= SAFETY x drift x the point's distance from the last
-  Hill solve (:meth:`Track.distance`; before a second solve, the floor alone).  Hill is
-  also due at a branch's first point, at the first point past a fold, at the window's
-  end, at a bisection's probe, where the continuation's next step may be a natural one
-  (its corrector slow, or this point a natural step's: a natural step at fixed f1 is
-  taken only where no multiplier is near +1, and a real one appears there abruptly,
-  out of a complex pair, 0.15 Hz before the fold at N = 2), and while the last Hill had
-  a real positive multiplier within FOLD_GUARD of +1.  A carried point says so in its ``accuracy["stability"]``, with the f1
-  of the Hill solve it carries (``hill_f1_Hz``).
+  multiplier passes +1 (a fold: the continuation's test function, the sign of df1/ds,
+  equivalently of det dG/dX: on the Fig. 8 curve at N = 8 the sign of det dG/dX matched
+  the parity of the real multipliers above 1 at all 135 points), or where one off the
+  positive real axis passes the unit circle (period doubling, Neimark-Sacker): where
+  its ln|mu| = Re lambda T passes zero.  The step predicts those from their drift, not
+  their distance: ln|mu| of the K_TOP largest (sorted), their secants per unit
+  distance along the branch (:meth:`Track.distance`) between the last three Hill
+  solves, and Hill is due where one's predicted distance to the circle (|ln|mu||
+  less its fastest approach of the two secants x the distance) is no longer above
+  SAFETY x its predicted drift (the larger |secant| x the distance), or the distance
+  reaches D_MAX.  On the Fig. 8 curve the least damped exponents' real parts stay
+  constant to 1e-12 from 15 to 6.7 Hz, so a multiplier 0.0016 from the circle (N = 32)
+  is carried as safely as one 0.0063 from it (N = 8).  Hill is also due at a branch's
+  first point, at the first point past a fold, at the window's end, at a bisection's
+  probe, and where the continuation's next step may be natural (a natural step's point,
+  or two slow correctors in a row: periodic_orbits/continuation.py), which reads the
+  multipliers: a natural step at fixed f1 is taken only where none is near +1, and a
+  real one appears out of a complex pair 0.15 Hz before the fold at N = 2.  A carried
+  point says so in its ``accuracy["stability"]``, with the f1 of the Hill solve it
+  carries (``hill_f1_Hz``).
 
 Limitation: Hill's shift-invert finds the exponents near its shifts only (0, i w / 2 and
-the averaged system's least damped), so an exponent that enters that set between two
-solves is first seen at the next one (at most D_MAX away: the drift's floor); a period
-doubling or Neimark-Sacker whose prediction a sudden change beats is seen late, at the
-next Hill solve, and bisected between that point and the one before.
+the averaged system's least damped), so one that enters that set between two solves is
+first seen at the next (at most D_MAX away); a period doubling or Neimark-Sacker faster
+than its prediction is seen late, at the next Hill solve, and bisected between that
+point and the one before.
 """
 
 from __future__ import annotations
