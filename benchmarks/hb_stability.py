@@ -162,6 +162,14 @@ PROTOTYPES = (
     "| 15. the HB LU's floor at N = 8 (700 unknowns, 193648 non-zeros: 40 % dense), "
     "factor and two solves | MUMPS 23.0 ms, SuperLU MMD_AT_PLUS_A 20.5 ms, COLAMD 30.2 ms, "
     "NATURAL 26.1 ms, dense LAPACK 55.7 ms (solutions equal to 4e-10) | MUMPS kept |",
+    "| 15. the guard from drift at N = 32 against Hill at every point, each run once in turn "
+    "(`hb_stability_floors/every_point.py 32`, in-process CPU) | 144.5 s (20 Hill solves of 136 "
+    "points, Hill 70.8 s, the rest 73.7 s) against 584.5 s (136 Hill solves, 511.6 s, the rest "
+    "72.9 s): ratio 0.25; folds [11.971035420998335, 12.699628112213686] Hz in both (0.0 Hz "
+    "apart); Hill at every point changes its verdict only at the folds, and every guarded "
+    "point's verdict is that of its branch segment; own Hill at the 6 carried points nearest "
+    "the folds and in the tail (max |mu| 0.99950 at 11.978 Hz): 0 differ | <= 150 s (issue 46): "
+    "met |",
 )
 
 
