@@ -170,6 +170,13 @@ PROTOTYPES = (
     "point's verdict is that of its branch segment; own Hill at the 6 carried points nearest "
     "the folds and in the tail (max |mu| 0.99950 at 11.978 Hz): 0 differ | <= 150 s (issue 46): "
     "met |",
+    "| 15. (d) the guard from drift replayed on Hill at every point at N = 32 "
+    "(`hb_stability_floors/drift.py`, 136 points) | SAFETY 1 / 2 / 3 / 5 at D_MAX 0.5: 9 / 21 "
+    "/ 14 / 18 Hill solves, 0 verdicts differing; of SAFETY 2's 21, 12 lie in the tail from "
+    "6.7 to 3.6 Hz, where Hill's shift-invert finds a multiplier at ln|mu| = -0.0012 at "
+    "alternate points only (the set near its shifts changes), so the sorted secants jump; a "
+    "secant on matched multipliers, or shifts held along a branch, would spare most of "
+    "them (about 40 s at N = 32) | measured, not built |",
 )
 
 
