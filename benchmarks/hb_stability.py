@@ -111,7 +111,7 @@ def bench_sizes() -> dict:
 
 
 #: the prototypes' floors, measured once (benchmarks/hb_stability_floors/, 2026-12-05,
-#: the machine at a load of 4-7 on 2 cores), kept as the record of the paths not taken
+#: the machine at a load of 4-8 on 2 cores), kept as the record of the paths taken or not
 PROTOTYPES = (
     "| 15. today, the Fig. 8 curve by HB, Hill at every point, in-process CPU "
     "(`hb_stability_floors/today.py N`) | N = 8: 135 points, 85.0 s, of which Hill 65.7 s "
@@ -141,6 +141,42 @@ PROTOTYPES = (
     "| 15. Hill's floor by SuperLU ordering, one shift at N = 8 (1316 unknowns, 104067 "
     "non-zeros) | COLAMD 57 ms a factorisation (fill x3.7), MMD_ATA 138 ms, NATURAL 251 ms, "
     "MMD_AT_PLUS_A 649 ms; node-major order no better: today's COLAMD kept | measured |",
+    "| 15. (d) the guard from drift replayed offline on Hill at every point, N = 8 "
+    "(`hb_stability_floors/drift.py`, 135 points) | the three largest multipliers off the "
+    "positive real axis have Re lambda constant to 1e-12 from 15 to 6.7 Hz (N = 8 and 16: "
+    "their |mu| = exp(Re lambda / f1) drifts only with the period), below 6 Hz one rises to "
+    "ln|mu| = -0.018 at 0.5 Hz at nearly constant |mu|: ln|mu| tracked, signed secants; "
+    "SAFETY 1 / 2 / 3 / 5 at D_MAX 0.5: 9 / 10 / 11 / 14 Hill solves, D_MAX 0.25 / 1 at "
+    "SAFETY 2: 13 / 9; 0 verdicts differing in each | SAFETY 2, D_MAX 0.5 kept |",
+    "| 15. (d) the guard from drift in the continuation, N = 2 s-curve and N = 8 curve | carried "
+    "multipliers let the continuation take natural (fixed-f1) steps into the fold at "
+    "12.738 Hz at N = 2 (a real multiplier appears out of a complex pair 0.15 Hz before it) "
+    "and fail: Hill where the next step may be natural (a natural step's point, two slow "
+    "correctors in a row); the fold guard (|mu - 1| < 0.05), whose only reader was that "
+    "choice, dropped: N = 8 Hill solves 16 -> 11 -> 8 of 145, CPU 27.8 -> 26.3 -> 24.8 s | kept |",
+    "| 15. the rest of the N = 8 curve by part (guarded, 13 Hill solves, 27.0 s, in-process "
+    "CPU, inclusive) | correctors 7.1 s (144), Hill 6.3 s, tangents 3.9 s (their dG/df1 by "
+    "central differences 0.9 s), the branch limits' sections (128 samples a point) 3.3 s, "
+    "finish (the tangents at the samples, dG/dX) 2.5 s; PETSc LU (MUMPS) 3.8 s of 15.9 s "
+    "over the first 82 points | measured |",
+    "| 15. the HB LU's floor at N = 8 (700 unknowns, 193648 non-zeros: 40 % dense), "
+    "factor and two solves | MUMPS 23.0 ms, SuperLU MMD_AT_PLUS_A 20.5 ms, COLAMD 30.2 ms, "
+    "NATURAL 26.1 ms, dense LAPACK 55.7 ms (solutions equal to 4e-10) | MUMPS kept |",
+    "| 15. the guard from drift at N = 32 against Hill at every point, each run once in turn "
+    "(`hb_stability_floors/every_point.py 32`, in-process CPU) | 144.5 s (20 Hill solves of 136 "
+    "points, Hill 70.8 s, the rest 73.7 s) against 584.5 s (136 Hill solves, 511.6 s, the rest "
+    "72.9 s): ratio 0.25; folds [11.971035420998335, 12.699628112213686] Hz in both (0.0 Hz "
+    "apart); Hill at every point changes its verdict only at the folds, and every guarded "
+    "point's verdict is that of its branch segment; own Hill at the 6 carried points nearest "
+    "the folds and in the tail (max |mu| 0.99950 at 11.978 Hz): 0 differ | <= 150 s (issue 46): "
+    "met |",
+    "| 15. (d) the guard from drift replayed on Hill at every point at N = 32 "
+    "(`hb_stability_floors/drift.py`, 136 points) | SAFETY 1 / 2 / 3 / 5 at D_MAX 0.5: 9 / 21 "
+    "/ 14 / 18 Hill solves, 0 verdicts differing; of SAFETY 2's 21, 12 lie in the tail from "
+    "6.7 to 3.6 Hz, where Hill's shift-invert finds a multiplier at ln|mu| = -0.0012 at "
+    "alternate points only (the set near its shifts changes), so the sorted secants jump; a "
+    "secant on matched multipliers, or shifts held along a branch, would spare most of "
+    "them (about 40 s at N = 32) | measured, not built |",
 )
 
 

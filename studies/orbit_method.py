@@ -79,8 +79,9 @@ class HarmonicBalanceMethod(OrbitMethod):
     steps_in_time = False
     reported = True
     #: when a continued point gets a full Hill solve (solvers/harmonic_balance/stability.py):
-    #: the guarded step gave the same folds and the same verdict at all 135 points of the
-    #: Fig. 8 curve at N = 8 as Hill at every point (benchmarks/results.md, item 15); the
+    #: the guard from drift gave the same folds (to 0.0 Hz) and the same verdicts as Hill at
+    #: every point on the Fig. 8 curve at N = 8 (8 Hill solves of 145 points) and N = 32
+    #: (20 of 136: 144.5 s of CPU against 584.5 s) (benchmarks/results.md, item 15); the
     #: envelope asks for every point (``every_point``): its PD / NS curves start on its
     #: branches' bands, 0.25 Hz wide on the tensegrity (tests/test_envelope.py)
     stability = GUARDED

@@ -41,10 +41,12 @@ import numpy as np
 from mpi4py import MPI
 
 from rawehelix.parameters import Parameters
+from rawehelix.periodic_orbits.continuation import SLOW
 from rawehelix.periodic_orbits.problem import Orbit, PeriodicOrbitProblem
 from rawehelix.solvers.dynamics import DynamicsSolver
 from rawehelix.solvers.harmonic_balance import harmonics, hill, newton
-from rawehelix.solvers.harmonic_balance.stability import EVERY_POINT, StabilityStep
+from rawehelix.solvers.harmonic_balance.stability import (EVERY_POINT, HillPoint, StabilityStep,
+                                                          Track)
 from rawehelix.solvers.harmonic_balance.newton import Diverged
 from rawehelix.solvers.harmonic_balance.scope import H_MAX, H_START, cannot
 from rawehelix.solvers.harmonic_balance.sparse_lu import LU
@@ -90,8 +92,9 @@ class HarmonicBalance(PeriodicOrbitProblem):
         self._cache = {}  # H -> (Basis, BlockPattern); (f1, H) -> g^ at the bc dofs
         self.stability_step = stability  # when a continued point gets a Hill solve (.stability)
         self._deferring = False  # inside a trace that calls stability() (deferred_stability)
-        self._last_hill = None  # (multipliers, f1 [Hz]) of the last Hill solve
-        self._since = 0  # accepted points since it
+        self._track = None  # the last Hill solve, the points since, the drift (.stability)
+        self._natural = None  # the last natural step's orbit (predicted_orbit)
+        self._its = 0  # the Newton iterations of the last point stability() saw
         self._pending = None  # (X, f1, H, tangents) of the last carried finish
         self.X_stationary = self.embed(op.X_stationary[:self.n], self.H)
 
@@ -337,7 +340,7 @@ class HarmonicBalance(PeriodicOrbitProblem):
                       wall_s=time.perf_counter() - start, G=G, jacobian=J,
                       accuracy={"H": H, "samples": basis.N,
                                 "tail": basis.tail(self.coefficients(X, H))})
-        if self._deferring and self._last_hill is not None:  # stability() decides
+        if self._deferring and self._track is not None:  # stability() decides
             self._carry(orbit)
             self._pending = (X, f1_Hz, H, tangents)
         else:
@@ -352,16 +355,21 @@ class HarmonicBalance(PeriodicOrbitProblem):
                                        f"the {SHIFTS} least damped of the averaged system, "
                                        f"not the whole spectrum")
         orbit.accuracy.pop("hill_f1_Hz", None)
-        self._last_hill, self._since = (floquet.multipliers, orbit.f1_Hz), 0
+        point = HillPoint(floquet.multipliers, orbit.f1_Hz, orbit.X, orbit.steps)
+        if self._track is None:
+            self._track = Track(point)
+        else:
+            self._track.hill(point, self._distance(orbit))
 
     def _carry(self, orbit: Orbit) -> None:
         """The last Hill solve's multipliers, said so (the guarded stability step)."""
-        mu, f1 = self._last_hill
-        orbit.multipliers = mu.copy()
-        orbit.accuracy["stability"] = (f"carried from the Hill solve at f1 = {f1:.6g} Hz (no "
-                                       f"fold since; guarded stability step, "
+        last = self._track.last
+        orbit.multipliers = last.multipliers.copy()
+        orbit.accuracy["stability"] = (f"carried from the Hill solve at f1 = {last.f1_Hz:.6g} "
+                                       f"Hz (no fold since, no exponent predicted to cross; "
+                                       f"guarded stability step, "
                                        f"docs/explanation/harmonic_balance.md)")
-        orbit.accuracy["hill_f1_Hz"] = f1
+        orbit.accuracy["hill_f1_Hz"] = last.f1_Hz
 
     @contextlib.contextmanager
     def deferred_stability(self, last: Orbit):
@@ -370,7 +378,8 @@ class HarmonicBalance(PeriodicOrbitProblem):
         if not self.stability_step.carries:
             yield
             return
-        self._deferring, self._last_hill, self._since = True, (last.multipliers, last.f1_Hz), 0
+        self._deferring, self._its = True, last.newton_iterations
+        self._track = Track(HillPoint(last.multipliers, last.f1_Hz, last.X, last.steps))
         try:
             yield
         finally:
@@ -379,13 +388,25 @@ class HarmonicBalance(PeriodicOrbitProblem):
     def stability(self, orbit: Orbit, event: bool) -> None:
         if not (self._deferring and "hill_f1_Hz" in orbit.accuracy):
             return
-        self._since += 1
-        if not self.stability_step.due(self._last_hill[0], self._since, event):
+        self._track.since += 1
+        # the next step may be natural (continuation.py: after a natural step, or two slow
+        # correctors in a row): it reads this point's multipliers
+        natural = orbit is self._natural or min(orbit.newton_iterations, self._its) >= SLOW
+        self._its = orbit.newton_iterations
+        if not self.stability_step.due(self._track, self._distance(orbit), event, natural):
             return
         X, f1, H, tangents = self._pending or (None, None, None, None)
         if X is not orbit.X or f1 != orbit.f1_Hz or H != orbit.steps:
             tangents = self.sampled(orbit.X, orbit.f1_Hz, resolution=orbit.steps)[2]
         self._floquet(orbit, tangents)
+
+    def predicted_orbit(self, X, f1_Hz: float, tol: float, max_it: int) -> Orbit:
+        self._natural = super().predicted_orbit(X, f1_Hz, tol, max_it)
+        return self._natural
+
+    def _distance(self, orbit: Orbit) -> float:
+        """``orbit``'s distance from the last Hill solve (stability.Track.distance)."""
+        return self._track.distance(orbit.X, orbit.f1_Hz, orbit.steps, self.embed)
 
     def hill(self, f1_Hz: float, H: int, tangents):
         """Hill's exponents from the tangents at the AFT's samples (:meth:`sampled`)."""
