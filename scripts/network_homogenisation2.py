@@ -121,6 +121,37 @@ def spinup(rings_list, fe_dir, times=(1.0, 2.0, 5.0)):
                   f"{100 * (T5 / fe_at[times[-1]][1] - 1):+.3f} % | {wall:.1f} |", flush=True)
 
 
+def forced_base(fe_elements=8):
+    """mobile_end as shipped with the fitted section, lead-in 2 s, the FE at N = fe_elements."""
+    return scene.load("mobile_end", elements=fe_elements, degree=3).replace(
+        model={"kinematics": "extensible"}, section=SECTION, sweep={"lead_in_s": 2.0})
+
+
+def sweep_points(p, f1_list, cache=None):
+    """The sweep's points of ``p`` at f1_list (entries with their limits block), each
+    f1 kept in ``cache`` (a directory: one JSON per scheme, rings and f1) once computed."""
+    import json
+    import os
+    from mpi4py import MPI
+    from rawehelix.studies import sweep
+    out = {}
+    for f in f1_list:
+        key = (f"{p.discretisation.scheme}-{p.model.section.rings if p.discretisation.scheme == 'network' else p.discretisation.elements}"
+               f"-{f:g}.json")
+        path = os.path.join(cache, key) if cache else None
+        if path and os.path.exists(path):
+            with open(path) as fh:
+                out[f] = json.load(fh)
+            continue
+        r = sweep.compute(p, [f], comm=MPI.COMM_SELF, track=True, log=lambda m: None)
+        out[f] = r.points[0]
+        if path:
+            os.makedirs(cache, exist_ok=True)
+            with open(path, "w") as fh:
+                json.dump(out[f], fh, default=float)
+    return out
+
+
 def forced(rings_list, f1_list, fe_elements=8):
     """Sec. 5.3's sweep points (mobile_end, the fitted section, lead-in 2 s): T max and
     T min at s = 0 over the recorded periods, network against the FE at N = fe_elements."""
@@ -148,15 +179,52 @@ def forced(rings_list, f1_list, fe_elements=8):
         print(f"| {rings} | {base.helix.length_m / (rings - 1):.4g} | {cells} |", flush=True)
 
 
+def modes53(rings_list):
+    """The Sec. 5.3 helix at rest (mobile_end, the fitted section, torque and controller
+    off, the top at its circle's phase 0): the lowest mode of each family, network
+    against the FE continuum (N = 16, p = 3), and the network's own convergence."""
+    from network_homogenisation import FAMILIES, _self_convergence, continuum, network
+    p = scene.load("mobile_end", elements=16, degree=3).replace(
+        model={"kinematics": "extensible"}, section=SECTION,
+        controller={"target_rpm": 0.0}, torque={"top_Nm": 0.0})
+    c = continuum(p)
+    print(f"continuum (FE N = 16, p = 3): sag {c['sag_m']:.5f} m, T(0) {c['T0_N']:.3f} N; "
+          + ", ".join(f"{k} {v:.4f} Hz" for k, v in c["modes"].items()), flush=True)
+    rows = {n: network(p, n) for n in rings_list}
+    rows_J = {n: network(p, n, continuum_inertia=True) for n in rings_list}
+    print("| rings | l [m] | sag [m] | gap | " + " | ".join(f"{f} [Hz] | gap" for f in FAMILIES) + " |")
+    print("|" + "---|" * (4 + 2 * len(FAMILIES)))
+    for n in rings_list:
+        r = rows[n]
+        cells = [f"{n}", f"{p.helix.length_m / (n - 1):.4g}", f"{r['sag_m']:.5f}",
+                 f"{100 * (r['sag_m'] / c['sag_m'] - 1):+.2f} %"]
+        for f in FAMILIES:
+            mine = (rows_J if f == "torsional" else rows)[n]["modes"].get(f)
+            ref = c["modes"].get(f)
+            cells += [f"{mine:.4f}" if mine else "-",
+                      f"{100 * (mine / ref - 1):+.2f} %" if mine and ref else "-"]
+        print("| " + " | ".join(cells) + " |")
+    print("(torsional: each ring's polar inertia the continuum's 2 (M/L0) EI/EA l; with the "
+          "hoop's: " + ", ".join(f"{n} rings {rows[n]['modes'].get('torsional', float('nan')):.4f} Hz"
+                                 for n in rings_list) + ")")
+    for key, name in (("sag_m", "sag [m]"),):
+        _self_convergence(name, [rows[n][key] for n in rings_list], c[key])
+    for f in FAMILIES:
+        _self_convergence(f + " [Hz]", [(rows_J if f == "torsional" else rows)[n]["modes"][f]
+                                        for n in rings_list], c["modes"][f])
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("part", choices=("torque", "spinup", "forced"))
+    ap.add_argument("part", choices=("torque", "spinup", "forced", "modes53"))
     ap.add_argument("--f1", default="2,4,6")
     ap.add_argument("--rings", default=None)
     ap.add_argument("--fe", default=None)
     a = ap.parse_args()
     if a.part == "torque":
         torque([int(x) for x in (a.rings or "5,9,17,33,65").split(",")])
+    elif a.part == "modes53":
+        modes53([int(x) for x in (a.rings or "5,9,17,33,65").split(",")])
     elif a.part == "forced":
         forced([int(x) for x in (a.rings or "5,9").split(",")], [float(x) for x in a.f1.split(",")])
     else:
