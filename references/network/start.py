@@ -35,3 +35,31 @@ def start(params):
         mo.L[1:-1] = (polar * omega)[:, None] * st.state.R[1:-1, :, 2]
         mo.top_spin = mo.ground_spin = omega
     return net, st, drive, mo
+
+
+def operating_state(params, iterations: int = 20) -> dict:
+    """The network's relative equilibrium at the scene's wind, as ``rawehelix operate``
+    defines it (docs/explanation/operate.md): V_n = V_hub |t . i_E| with t the top's
+    tangent in the solved state (here the last bay's chord), Omega the stable root of
+    Q(Omega, V_n) = tau(Omega) (machine.operating_point), and the stationary network
+    under Q(Omega) at the top; a fixed point on a = V_n / V_hub (from the chord's),
+    to 1e-12.  SI: rpm, torque, power, both ends' axial forces, a."""
+    ends = machine.ends_of(params)
+    rotor, generator = ends["rotor"], ends.get("generator")
+    a, state = rotor.normal, None
+    for _ in range(iterations):
+        here = machine.RotorEnd(rotor.law, rotor.density_kg_m3, a, rotor.hub_m_s)
+        omega = machine.operating_point(here, generator)
+        Q = here.torque(omega, 0.0)[0]
+        r = solve(Network.from_parameters(params, end_torque_Nm=Q), state=state)
+        state = r.state
+        t = r.state.X[-1] - r.state.X[-2]
+        new = float(rotor.law.normal_speed(1.0, t / np.linalg.norm(t)))
+        if abs(new - a) <= 1e-12:
+            break
+        a = new
+    T = r.tension_N()
+    return {"rotor_rpm": omega * 30 / np.pi, "torque_Nm": Q, "power_W": Q * omega,
+            "tension_ground_N": float(T[0]), "tension_top_N": float(T[-1]), "axis_factor": a,
+            "hub_wind_m_s": rotor.hub_m_s(0.0), "smallest_tether_force_N": r.smallest_tether_force[0],
+            "sag_m": r.sag_m(), "twist_deg": float(np.degrees(r.state.theta))}
