@@ -79,3 +79,12 @@ def test_the_angular_momentum_about_the_chord_is_the_torques_impulse():
     # the splitting's half-kicks take the end torques at the spins the trapezoid
     # samples: the balance is exact to round-off (3e-14 measured)
     assert H(mo) - H0 == pytest.approx(impulse, rel=1e-9)
+
+
+def test_a_torque_the_network_cannot_hold_fails_with_advice():
+    """At 40 m/s the operating point's torque (915 N m) is past what the 5-ring helix
+    holds: a NetworkError (exit 1) naming the torque and what to change."""
+    from rawehelix.references.network import NetworkError
+    with pytest.raises(NetworkError, match="cannot hold the rotor's torque .* lower "
+                                           "wind.speed_m_s or give more rings"):
+        start(rotor_scene().replace(wind={"speed_m_s": 40.0}))

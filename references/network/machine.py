@@ -31,6 +31,7 @@ from rawehelix.operation import generator as generator_laws
 from rawehelix.operation import rotor as rotor_laws
 from rawehelix.operation import wind, wind_series
 from rawehelix.parameters import end_components
+from rawehelix.parameters.checks import ParameterError
 from rawehelix.references.network.network import NetworkError
 
 #: the relative step of the torques' derivatives by central differences
@@ -145,10 +146,11 @@ def operating_point(rotor: RotorEnd, generator: GeneratorEnd | None, t: float = 
     omegas = np.linspace(lo, hi, SAMPLES)
     values = balance(omegas)
     falling = np.nonzero((values[:-1] > 0) & (values[1:] <= 0))[0]  # stable: Q - tau falls
-    if not falling.size:
-        raise NetworkError(f"the rotor has no stable operating point at a hub wind of "
-                           f"{rotor.hub_m_s(t):.4g} m/s inside its table: choose a wind.speed_m_s "
-                           "whose operating point the table covers")
+    if not falling.size:  # the scene asks for what its rotor cannot do: bad input
+        raise ParameterError("wind.speed_m_s", rotor.hub_m_s(t),
+                             "the rotor has no stable operating point at this hub wind inside "
+                             "its table against the generator: choose a wind speed (or a "
+                             "generator law) whose operating point the table covers")
     i = falling[-1]
     return float(brentq(lambda w: float(balance(w)), omegas[i], omegas[i + 1], xtol=1e-14,
                         rtol=1e-15))

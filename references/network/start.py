@@ -7,7 +7,7 @@ import numpy as np
 
 from rawehelix.references.network import dynamics as dy
 from rawehelix.references.network import machine
-from rawehelix.references.network.network import Network
+from rawehelix.references.network.network import Network, NetworkError
 from rawehelix.references.network.stationary import solve
 
 
@@ -28,7 +28,15 @@ def start(params):
     torque = (rotor.torque(omega, 0.0)[0] + (drive.top_torque(0.0) if drive.top_torque else 0.0)
               if omega > 0 else 0.0)
     net = Network.from_parameters(params, end_torque_Nm=torque)
-    st = solve(net)
+    try:
+        st = solve(net)
+    except NetworkError as err:
+        if omega == 0:
+            raise
+        raise NetworkError(
+            f"the network cannot hold the rotor's torque {torque:.4g} N m at its operating "
+            f"point ({omega * 30 / np.pi:.4g} rpm): its twisted helix buckles or its bays "
+            "collapse; run a lower wind.speed_m_s or give more rings (section.rings)") from err
     mo = dy.at_rest(st.state, 0.0, drive)
     if omega > 0:
         polar = np.array([r.polar_kgm2 for r in net.rings])[1:-1]
