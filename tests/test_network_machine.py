@@ -88,3 +88,29 @@ def test_a_torque_the_network_cannot_hold_fails_with_advice():
     with pytest.raises(NetworkError, match="cannot hold the rotor's torque .* lower "
                                            "wind.speed_m_s or give more rings"):
         start(rotor_scene().replace(wind={"speed_m_s": 40.0}))
+
+
+def test_a_start_up_runs_the_rotor_unloaded_until_the_release():
+    """startup (a table from tsr 0, the generator released at 60 rpm): the run starts at
+    rest, the rotor's torque at rest is its law's limit Q(Omega -> 0) (operation/rotor.py
+    at 1e-6 rad/s), and in the first 0.2 s, far below 60 rpm, the ground carries no
+    torque and the helix's angular momentum is the rotor's impulse alone."""
+    p = scene.load("startup").replace(model={"kinematics": "extensible", "gravity": False,
+                                             "drag": False}, section=SECTION)
+    net, st, drive, mo = start(p)
+    assert mo.top_spin == 0 and mo.ground_spin == 0
+    v_n = 6.6131 * np.cos(np.radians(45.0))
+    law = rotor_laws.from_params(p)
+    assert drive.rotor.torque(0.0, 0.0)[0] == pytest.approx(float(law.torque(1e-6, v_n, 1.225)),
+                                                             rel=1e-5)
+    integ = dy.Integrator(net, drive, dy.default_step(net, st.state))
+    e3, impulse, before = net.frame[:, 2], 0.0, drive.rotor.torque(0.0, 0.0)[0]
+    for _ in range(150):
+        integ.step(mo)
+        assert integ.ground_torque_Nm(mo) == 0.0
+        after = drive.rotor.torque(mo.top_spin, mo.t)[0]
+        impulse += integ.dt * (before + after) / 2
+        before = after
+    H = (mo.L[1:-1] @ e3).sum() + integ.Jp[0] * mo.ground_spin + integ.Jp[-1] * mo.top_spin
+    assert 0 < mo.top_spin < 60 * RPM and integ.released_at is None
+    assert H == pytest.approx(impulse, rel=1e-9)
