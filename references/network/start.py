@@ -52,12 +52,13 @@ def operating_state(params, iterations: int = 20) -> dict:
     Q(Omega, V_n) = tau(Omega) (machine.operating_point), and the stationary network
     under Q(Omega) at the top; a fixed point on a = V_n / V_hub (from the chord's),
     to 1e-12.  SI: rpm, torque, power, both ends' axial forces, a."""
-    ends = machine.ends_of(params)
-    rotor, generator = ends["rotor"], ends.get("generator")
+    drive = dy.Drive.from_parameters(params)
+    rotor, generator, ctl = drive.rotor, drive.generator, drive.controller
+    holds = ctl.target_rad_s if generator is None and ctl is not None and ctl.k1_Nm > 0 else None
     a, state = rotor.normal, None
     for _ in range(iterations):
         here = machine.RotorEnd(rotor.law, rotor.density_kg_m3, a, rotor.hub_m_s)
-        omega = machine.operating_point(here, generator)
+        omega = machine.operating_point(here, generator, 0.0, holds)
         Q = here.torque(omega, 0.0)[0]
         r = solve(Network.from_parameters(params, end_torque_Nm=Q), state=state)
         state = r.state
