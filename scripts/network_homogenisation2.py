@@ -5,7 +5,10 @@ several ring spacings.  Prints the tables of docs/explanation/network.md.
 
     .venv/bin/python scripts/network_homogenisation2.py torque [--rings 5,9,17,33,65]
     .venv/bin/python scripts/network_homogenisation2.py spinup --fe DIR [--rings 5,9,17]
-    .venv/bin/python scripts/network_homogenisation2.py forced [--rings 5,9] [--f1 2,4,6]
+    .venv/bin/python scripts/network_homogenisation2.py forced [--rings 5,9] [--f1 2,4,6] [--cache DIR]
+    .venv/bin/python scripts/network_homogenisation2.py modes53 [--rings 5,9,17,33,65]
+    .venv/bin/python scripts/network_homogenisation2.py operating --fe DIR [--rings 5,9,17,33]
+    .venv/bin/python scripts/network_homogenisation2.py step --fe DIR --net DIR
 
 ``spinup`` reads the FE run's time_series.csv from DIR, made by
 ``rawehelix simulate nominal_operation --until 5 -o DIR`` with the SECTION keys below
@@ -121,43 +124,195 @@ def spinup(rings_list, fe_dir, times=(1.0, 2.0, 5.0)):
                   f"{100 * (T5 / fe_at[times[-1]][1] - 1):+.3f} % | {wall:.1f} |", flush=True)
 
 
-def forced(rings_list, f1_list, fe_elements=8):
-    """Sec. 5.3's sweep points (mobile_end, the fitted section, lead-in 2 s): T max and
-    T min at s = 0 over the recorded periods, network against the FE at N = fe_elements."""
-    from mpi4py import MPI
-    from rawehelix.studies import sweep
-    base = scene.load("mobile_end", elements=fe_elements, degree=3).replace(
+def forced_base(fe_elements=8):
+    """mobile_end as shipped with the fitted section, lead-in 2 s, the FE at N = fe_elements."""
+    return scene.load("mobile_end", elements=fe_elements, degree=3).replace(
         model={"kinematics": "extensible"}, section=SECTION, sweep={"lead_in_s": 2.0})
 
-    def points(p):
-        r = sweep.compute(p, f1_list, comm=MPI.COMM_SELF, track=False, log=lambda m: None)
-        return {x["f1_Hz"]: x for x in r.points}
 
-    fe = points(base)
-    print(f"continuum (FE N = {fe_elements}, p = 3): " + ", ".join(
-        f"{f:g} Hz: T {fe[f]['tension_min_N']:.2f}-{fe[f]['tension_max_N']:.2f} N" for f in f1_list))
-    print("| rings | l [m] | " + " | ".join(f"T max at {f:g} Hz [N] | gap | T min | gap" for f in f1_list)
-          + " |")
-    print("|---" * (2 + 4 * len(f1_list)) + "|")
-    for rings in rings_list:
-        net = points(base.replace(discretisation={"scheme": "network"}, section={"rings": rings}))
-        cells = " | ".join(
-            f"{net[f]['tension_max_N']:.2f} | {100 * (net[f]['tension_max_N'] / fe[f]['tension_max_N'] - 1):+.2f} % | "
-            f"{net[f]['tension_min_N']:.2f} | {100 * (net[f]['tension_min_N'] / fe[f]['tension_min_N'] - 1):+.2f} %"
-            for f in f1_list)
-        print(f"| {rings} | {base.helix.length_m / (rings - 1):.4g} | {cells} |", flush=True)
+def sweep_points(p, f1_list, cache=None):
+    """The sweep's points of ``p`` at f1_list (entries with their limits block), each
+    f1 kept in ``cache`` (a directory: one JSON per scheme, rings and f1) once computed."""
+    import json
+    import os
+    from mpi4py import MPI
+    from rawehelix.studies import sweep
+    out = {}
+    for f in f1_list:
+        key = (f"{p.discretisation.scheme}-{p.model.section.rings if p.discretisation.scheme == 'network' else p.discretisation.elements}"
+               f"-{f:g}.json")
+        path = os.path.join(cache, key) if cache else None
+        if path and os.path.exists(path):
+            with open(path) as fh:
+                out[f] = json.load(fh)
+            continue
+        r = sweep.compute(p, [f], comm=MPI.COMM_SELF, track=True, log=lambda m: None)
+        out[f] = r.points[0]
+        if path:
+            os.makedirs(cache, exist_ok=True)
+            with open(path, "w") as fh:
+                json.dump(out[f], fh, default=float)
+    return out
+
+
+def _slack(point):
+    """The first slack tether of a point's block: 't = T s (phase P of the period), s = S m',
+    or the smallest member force when none goes slack."""
+    b = point["limits"]
+    first = (b.get("first_by_kind") or {}).get("slack")
+    if first:
+        phase = (first["t_s"] * point["f1_Hz"]) % 1.0
+        return f"t = {first['t_s']:.3f} s (phase {phase:.2f}), s = {first['s_m']:.2f} m"
+    f = b.get("min_member_force_N") or {}
+    return f"none (min {f.get('value', float('nan')):.0f} N at s = {f.get('s_m', float('nan')):.2f} m)"
+
+
+def forced(rings_list, f1_list, fe_elements=8, cache=None):
+    """Sec. 5.3's sweep points (mobile_end as shipped, the fitted section, lead-in 2 s):
+    T max and T min at s = 0 over the recorded periods, the first slack member and the
+    largest moment ratio |M| / (N R) (each model's limits block from its own members),
+    network against the FE at N = fe_elements; the gap in T max against l and its
+    observed order.  ``cache``: a directory that keeps each point (sweep_points)."""
+    base = forced_base(fe_elements)
+    fe = sweep_points(base, f1_list, cache)
+    nets = {r: sweep_points(base.replace(discretisation={"scheme": "network"},
+                                         section={"rings": r}), f1_list, cache)
+            for r in rings_list}
+    print("| f1 [Hz] | model | T max [N] | gap | T min [N] | gap | first slack | "
+          "max \\|M\\|/(N R) | gap |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for f in f1_list:
+        c = fe[f]
+        rows = [(f"FE N = {fe_elements}", c)] + [
+            (f"network {r} rings (l = {base.helix.length_m / (r - 1):.3g} m)", nets[r][f])
+            for r in rings_list]
+        for label, x in rows:
+            gap = "" if x is c else f"{100 * (x['tension_max_N'] / c['tension_max_N'] - 1):+.1f} %"
+            gmin = "" if x is c else f"{100 * (x['tension_min_N'] / c['tension_min_N'] - 1):+.1f} %"
+            mr = x.get("moment_ratio_max")
+            gmr = "" if x is c or not mr else f"{100 * (mr / c['moment_ratio_max'] - 1):+.0f} %"
+            print(f"| {f:g} | {label} | {x['tension_max_N']:.2f} | {gap} | {x['tension_min_N']:.2f} | "
+                  f"{gmin} | {_slack(x)} | {mr:.3f} | {gmr} |" if mr is not None else
+                  f"| {f:g} | {label} | {x['tension_max_N']:.2f} | {gap} | {x['tension_min_N']:.2f} | "
+                  f"{gmin} | {_slack(x)} | - | |")
+    ls = [base.helix.length_m / (r - 1) for r in rings_list]
+    print("\nthe T max gap against l, and its observed order between successive spacings:")
+    for f in f1_list:
+        gaps = [nets[r][f]["tension_max_N"] / fe[f]["tension_max_N"] - 1 for r in rings_list]
+        diffs = [nets[a][f]["tension_max_N"] - nets[b][f]["tension_max_N"]
+                 for a, b in zip(rings_list, rings_list[1:])]
+        print(f"  {f:g} Hz: gaps " + ", ".join(f"{100 * g:+.2f} %" for g in gaps)
+              + "; network's own differences " + ", ".join(f"{d:+.3f} N" for d in diffs))
+
+
+def modes53(rings_list):
+    """The Sec. 5.3 helix at rest (mobile_end, the fitted section, torque and controller
+    off, the top at its circle's phase 0): the lowest mode of each family, network
+    against the FE continuum (N = 16, p = 3), and the network's own convergence."""
+    from network_homogenisation import FAMILIES, _self_convergence, continuum, network
+    p = scene.load("mobile_end", elements=16, degree=3).replace(
+        model={"kinematics": "extensible"}, section=SECTION,
+        controller={"target_rpm": 0.0}, torque={"top_Nm": 0.0})
+    c = continuum(p)
+    print(f"continuum (FE N = 16, p = 3): sag {c['sag_m']:.5f} m, T(0) {c['T0_N']:.3f} N; "
+          + ", ".join(f"{k} {v:.4f} Hz" for k, v in c["modes"].items()), flush=True)
+    rows = {n: network(p, n) for n in rings_list}
+    rows_J = {n: network(p, n, continuum_inertia=True) for n in rings_list}
+    print("| rings | l [m] | sag [m] | gap | " + " | ".join(f"{f} [Hz] | gap" for f in FAMILIES) + " |")
+    print("|" + "---|" * (4 + 2 * len(FAMILIES)))
+    for n in rings_list:
+        r = rows[n]
+        cells = [f"{n}", f"{p.helix.length_m / (n - 1):.4g}", f"{r['sag_m']:.5f}",
+                 f"{100 * (r['sag_m'] / c['sag_m'] - 1):+.2f} %"]
+        for f in FAMILIES:
+            mine = (rows_J if f == "torsional" else rows)[n]["modes"].get(f)
+            ref = c["modes"].get(f)
+            cells += [f"{mine:.4f}" if mine else "-",
+                      f"{100 * (mine / ref - 1):+.2f} %" if mine and ref else "-"]
+        print("| " + " | ".join(cells) + " |")
+    print("(torsional: each ring's polar inertia the continuum's 2 (M/L0) EI/EA l; with the "
+          "hoop's: " + ", ".join(f"{n} rings {rows[n]['modes'].get('torsional', float('nan')):.4f} Hz"
+                                 for n in rings_list) + ")")
+    for key, name in (("sag_m", "sag [m]"),):
+        _self_convergence(name, [rows[n][key] for n in rings_list], c[key])
+    for f in FAMILIES:
+        _self_convergence(f + " [Hz]", [(rows_J if f == "torsional" else rows)[n]["modes"][f]
+                                        for n in rings_list], c["modes"][f])
+
+
+def operating(rings_list, fe_dir):
+    """The machine's relative equilibrium (rotor_example, the fitted section) at each wind
+    of the FE's ``rawehelix operate ... -o fe_dir``: the network's rotor rpm, power,
+    both ends' axial forces and twist against the FE's (references/network/start.py)."""
+    import json
+    from rawehelix.references.network.start import operating_state
+    with open(f"{fe_dir}/summary.json") as fh:
+        fe = json.load(fh)
+    details = {d["wind_m_s"]: d for d in fe["details"]}
+    print("| wind [m/s] | model | rotor [rpm] | gap | power [W] | gap | T(0) [N] | gap | "
+          "T(L0) [N] | twist [deg] | gap | V_n / V |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for e in fe["points"]:
+        V, d = e["wind_m_s"], details[e["wind_m_s"]]
+        T0 = d["tension_ground_N"]
+        print(f"| {V:g} | FE N = {fe['elements'] if 'elements' in fe else '16'} | {e['rotor_rpm']:.3f} | | "
+              f"{e['power_W']:.2f} | | {T0:.2f} | | {e['tension_min_N']:.2f}-{e['tension_max_N']:.2f} | "
+              f"{e['twist_deg']:.2f} | | {d['v_n_m_s'] / d['hub_wind_m_s']:.5f} |")
+        for rings in rings_list:
+            p = scene.load("rotor_example").replace(model={"kinematics": "extensible"},
+                                                    section={**SECTION, "rings": rings},
+                                                    wind={"speed_m_s": V})
+            n = operating_state(p)
+            print(f"| {V:g} | network {rings} rings | {n['rotor_rpm']:.3f} | "
+                  f"{100 * (n['rotor_rpm'] / e['rotor_rpm'] - 1):+.3f} % | {n['power_W']:.2f} | "
+                  f"{100 * (n['power_W'] / e['power_W'] - 1):+.3f} % | {n['tension_ground_N']:.2f} | "
+                  f"{100 * (n['tension_ground_N'] / T0 - 1):+.2f} % | {n['tension_top_N']:.2f} | "
+                  f"{n['twist_deg']:.2f} | {100 * (n['twist_deg'] / e['twist_deg'] - 1):+.2f} % | "
+                  f"{n['axis_factor']:.5f} |", flush=True)
+
+
+def stepped(fe_dir, net_dir, times=(0.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0)):
+    """The wind step of step_rated: the rotor's (top ring's) spin [rpm] of the network's
+    ``simulate`` run against the FE's (their time_series.csv), at ``times``."""
+    def read(d):
+        with open(f"{d}/time_series.csv") as fh:
+            rows = list(csv.reader(fh))
+        head = rows[0]
+        data = np.array([[float(x) for x in r] for r in rows[1:]])
+        return head, data
+    hf, fe = read(fe_dir)
+    hn, net = read(net_dir)
+    col = "spin_L0_rpm"
+    top_f, top_n = fe[:, hf.index(col)], net[:, hn.index(col)]
+    print("| t [s] | FE rotor [rpm] | network [rpm] | gap |")
+    print("|---|---|---|---|")
+    for t in times:
+        a, b = np.interp(t, fe[:, 0], top_f), np.interp(t, net[:, 0], top_n)
+        print(f"| {t:g} | {a:.3f} | {b:.3f} | {100 * (b / a - 1):+.3f} % |")
+    common = np.linspace(0.0, min(fe[-1, 0], net[-1, 0]), 2001)
+    gap = np.interp(common, net[:, 0], top_n) - np.interp(common, fe[:, 0], top_f)
+    print(f"largest |gap| {np.max(np.abs(gap)):.3f} rpm at t = {common[np.argmax(np.abs(gap))]:.2f} s")
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
-    ap.add_argument("part", choices=("torque", "spinup", "forced"))
+    ap.add_argument("part", choices=("torque", "spinup", "forced", "modes53", "operating", "step"))
+    ap.add_argument("--net", default=None, help="step: the network's simulate folder")
     ap.add_argument("--f1", default="2,4,6")
     ap.add_argument("--rings", default=None)
     ap.add_argument("--fe", default=None)
+    ap.add_argument("--cache", default=None, help="forced: a directory keeping each point")
     a = ap.parse_args()
     if a.part == "torque":
         torque([int(x) for x in (a.rings or "5,9,17,33,65").split(",")])
+    elif a.part == "operating":
+        operating([int(x) for x in (a.rings or "5,9,17,33").split(",")], a.fe)
+    elif a.part == "step":
+        stepped(a.fe, a.net)
+    elif a.part == "modes53":
+        modes53([int(x) for x in (a.rings or "5,9,17,33,65").split(",")])
     elif a.part == "forced":
-        forced([int(x) for x in (a.rings or "5,9").split(",")], [float(x) for x in a.f1.split(",")])
+        forced([int(x) for x in (a.rings or "5,9").split(",")], [float(x) for x in a.f1.split(",")],
+               cache=a.cache)
     else:
         spinup([int(x) for x in (a.rings or "5,9,17").split(",")], a.fe)

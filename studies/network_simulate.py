@@ -13,11 +13,14 @@ import time
 
 import numpy as np
 
+from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.normalised import RPM
-from rawehelix.references.network import Network, NetworkError, solve
+from rawehelix.references.network import NetworkError
 from rawehelix.references.network import dynamics as dy
+from rawehelix.references.network import start as network_start
 from rawehelix.references.network import energy as en
 from rawehelix.studies.analysis import metrics
+from rawehelix.studies.scene import SceneError
 
 
 def compute(params, until_s: float):
@@ -25,11 +28,11 @@ def compute(params, until_s: float):
     summary, why it stopped early or None), which studies/simulate.py makes its
     TimeSeries (or its SimulationError)."""
     start = time.perf_counter()
-    net = Network.from_parameters(params, end_torque_Nm=0.0)  # the ramp starts at 0
-    st = solve(net)
-    drive = dy.Drive.from_parameters(params)
+    try:
+        net, st, drive, mo = network_start.start(params)  # at rest, or a rotor's operating point
+    except ParameterError as err:  # a wind the rotor has no operating point at: exit 2
+        raise SceneError(params.name, err.key, f"{err.value!r}: {err.allowed}") from None
     integ = dy.Integrator(net, drive, dy.default_step(net, st.state, params.time.dt_s))
-    mo = dy.at_rest(st.state, 0.0, drive)
     mid, e = net.count // 2, net.chord_m / np.linalg.norm(net.chord_m)
     x_mid0 = st.state.X[mid].copy()
     rows, watch = [], {"smallest_N": np.inf, "first_slack_s": None}

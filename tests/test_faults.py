@@ -76,6 +76,11 @@ FAULTS = [
       "section.lay_angle_deg=16.8"], 2, "past Tulloch's collapse angle"),
     (["orbits", "mobile_end", "--scheme", "network", "--set", "section.rings=5", "--f1", "3"], 2,
      "'network' runs 'stationary', 'modes', 'section', 'simulate', 'sweep' only, not 'orbits'"),
+    # the network's rotor (references/network/machine.py): a generator the rotor cannot
+    # meet inside its table at the scene's wind
+    (["simulate", "rotor_example", "--scheme", "network", "--set", "section.rings=5",
+      "--set", "generator.mppt_gain_Nms2=50", "--until", "0.01"], 2,
+     "wind.speed_m_s: 6.6131: the rotor has no stable operating point"),
     (["extremes", "nosuchcase"], 2, "unknown case(s)"),
     (["study", "stationary_table2", "--vary", "helix.EI_Nm2=1:2:3", "--quantity", "tension"], 2,
      "--quantity: tension: unknown quantity"),

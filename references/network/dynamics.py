@@ -42,6 +42,8 @@ import scipy.linalg as sla
 from scipy.spatial.transform import Rotation
 
 from rawehelix.references.network import energy as en
+from rawehelix.references.network import machine
+from rawehelix.operation.generator import RELEASE_RAMP_S
 from rawehelix.references.network.network import Network, NetworkError
 
 #: the step as a share of the stability bound 2 / omega_max (:func:`stable_step`)
@@ -77,6 +79,10 @@ class Drive:
     top_velocity: Callable[[float], np.ndarray] | None = None  # its velocity [m/s]
     top_torque: Callable[[float], float] | None = None  # M_N(t) about the chord [N m]
     controller: Controller | None = None  # the ground's turn by Eq. (40)
+    rotor: machine.RotorEnd | None = None  # Q(Omega, t) and J on the top ring (machine.py)
+    generator: machine.GeneratorEnd | None = None  # tau(Omega) on the ground ring
+    #: t [s] -> the wind at the rings (rings, 3) [m/s], a history; None: the network's steady one
+    wind: Callable[[float], np.ndarray] | None = None
 
     def __post_init__(self):
         if (self.top_position is None) != (self.top_velocity is None):
@@ -87,7 +93,8 @@ class Drive:
         """A scene's ends as the FE runs them: the torque ramp of Eq. (69) at the top,
         the controller of Eq. (40) at the ground when it is active (else the ground's
         turn held), the top on the circle of Eq. (70) when it moves (at ``f1_Hz``
-        when given, at phase 0 at ``t_start_s``, as a sweep restarts it)."""
+        when given, at phase 0 at ``t_start_s``, as a sweep restarts it); the rotor
+        and the generator where the scene has them, and its wind in time (machine.py)."""
         q = params.normalised()
         if f1_Hz is not None:
             q = q.at_frequency(f1_Hz, t_start_s / q.t_scale)
@@ -99,8 +106,10 @@ class Drive:
         ctl = params.controller
         controller = (Controller(ctl.k1 * Mt, ctl.k2 * Mt * ts, q.spin_target / ts)
                       if ctl.active else None)
+        heights = np.linspace(0.0, -L0 * q.top_position(0.0)[2],
+                              params.model.section.ring_count(L0))  # the rings' z [m], up
         return cls(top_torque=lambda t: Mt * q.top_torque(t / ts), controller=controller,
-                   **top)
+                   wind=machine.wind_of(params, heights), **machine.ends_of(params), **top)
 
 
 @dataclass
@@ -140,18 +149,28 @@ class Integrator:
         m, J = net.mass_matrix_blocks(np.broadcast_to(np.eye(3), (net.count, 3, 3)))
         self.m = m  # [kg]
         self.Jd = J[:, 0, 0]  # diametral [kg m^2]
-        self.Jp = J[:, 2, 2]  # polar [kg m^2]
+        self.Jp = J[:, 2, 2].copy()  # polar [kg m^2]
+        if drive.rotor is not None:
+            self.Jp[-1] += drive.rotor.inertia_kgm2  # the rotor spins with the top ring
         self.e3 = net.frame[:, 2]
-        self.drag0 = self._drag(np.zeros((net.count, 3)))  # in the dead loads already
+        self.drag0 = self._drag(np.zeros((net.count, 3)), None)  # in the dead loads already
+        self.top_turns = drive.top_torque is not None or drive.rotor is not None
+        self.ground_turns = drive.controller is not None or drive.generator is not None
+        self.released_at = None  # a generator's release [s] (machine.py), None before it
         self.steps = 0
         self._g = None  # (motion, t, forces) at its configuration: one gradient per step
 
     # -- forces ------------------------------------------------------------------
-    def _drag(self, V: np.ndarray) -> np.ndarray:
-        """-c |v_A| v_A (rings, 3) [N], v_A = V - wind (Eq. 28)."""
+    def _air(self, t: float | None) -> np.ndarray:
+        """The wind at the rings at t [s] (the drive's history), or the network's steady one."""
+        w = self.net.wind_m_s if t is None or self.drive.wind is None else self.drive.wind(t)
+        return np.broadcast_to(w, (self.net.count, 3))
+
+    def _drag(self, V: np.ndarray, t: float | None) -> np.ndarray:
+        """-c |v_A| v_A (rings, 3) [N], v_A = V - wind at t (Eq. 28; None: the steady one)."""
         if self.net.drag_kg_m is None:
             return np.zeros_like(V)
-        vA = V - self.net.wind_m_s
+        vA = V - self._air(t)
         return -self.net.drag_kg_m[:, None] * np.linalg.norm(vA, axis=1)[:, None] * vA
 
     def _forces(self, s: en.State):
@@ -172,12 +191,24 @@ class Integrator:
         """The torque held at the ground about the chord [N m]: the controller's, or
         (its turn held) the tethers' moment on the ground ring."""
         d = self.drive
+        if d.generator is not None:
+            return self._engaged(mo.t) * d.generator.torque(mo.ground_spin)[0]
         if d.controller is None:
             return float(self._forces(mo.state)[1][0] @ self.e3)
         return d.controller.torque_Nm(mo.ground_turn, mo.ground_spin, mo.t, self._top(mo.t))
 
     def _top(self, t: float) -> float:
         return 0.0 if self.drive.top_torque is None else self.drive.top_torque(t)
+
+    def _engaged(self, t: float) -> float:
+        """The generator's share 0..1: 1 without a release speed, else 0 until the
+        ground first spins at it and a linear ramp over RELEASE_RAMP_S after."""
+        g = self.drive.generator
+        if g is None or g.release_rad_s is None:
+            return 1.0
+        if self.released_at is None:
+            return 0.0
+        return float(np.clip((t - self.released_at) / RELEASE_RAMP_S, 0.0, 1.0))
 
     # -- the splitting -----------------------------------------------------------
     def _kick(self, mo: Motion, h: float, implicit: bool):
@@ -188,14 +219,25 @@ class Integrator:
         F, T = self._g[2]
         inner = slice(1, self.net.count - 1)
         m = self.m[inner, None]
-        V = mo.V[inner] + h * (F[inner] + self._drag(mo.V)[inner] - self.drag0[inner]) / m
+        V = mo.V[inner] + h * (F[inner] + self._drag(mo.V, mo.t)[inner] - self.drag0[inner]) / m
         if implicit:  # Newton from the explicit kick
-            V = self._implicit_drag(mo.V[inner], F[inner], h, V)
+            V = self._implicit_drag(mo.V[inner], F[inner], h, V, mo.t)
         mo.V[inner] = V
         mo.L[inner] += h * T[inner]
-        if self.drive.top_torque is not None:
+        rotor, generator, t = self.drive.rotor, self.drive.generator, mo.t
+        if rotor is not None:  # Q(Omega) at the top's spin (machine.py), Eq. (39)
+            Tz = T[-1] @ self.e3 + self._top(t)
+            mo.top_spin = machine.spin_kick(
+                mo.top_spin, self.Jp[-1], h,
+                lambda s: (lambda q: (Tz + q[0], q[1]))(rotor.torque(s, t)), implicit)
+        elif self.drive.top_torque is not None:
             mo.top_spin += h * (T[-1] @ self.e3 + self._top(mo.t)) / self.Jp[-1]
-        c = self.drive.controller
+        if generator is not None:  # tau(Omega) at the ground's spin, Eq. (38)
+            Tz, e = T[0] @ self.e3, self._engaged(t)
+            mo.ground_spin = machine.spin_kick(
+                mo.ground_spin, self.Jp[0], h,
+                lambda s: (lambda g: (Tz - e * g[0], -e * g[1]))(generator.torque(s)), implicit)
+        c = self.drive.controller if generator is None else None  # the generator's instead
         if c is not None:
             t, J, Tz = mo.t, self.Jp[0], T[0] @ self.e3
             rest = Tz - c.torque_Nm(mo.ground_turn, 0.0, t, self._top(t))  # less k2 spin
@@ -204,15 +246,16 @@ class Integrator:
             else:
                 mo.ground_spin += h * (rest - c.k2_Nms * mo.ground_spin) / J
 
-    def _implicit_drag(self, V0, F, h, V):
+    def _implicit_drag(self, V0, F, h, V, t):
         """V = V0 + h (F + D(V) - D(0)) / m on the interior rings, Newton from V."""
         net = self.net
         if net.drag_kg_m is None or not np.any(net.drag_kg_m):
             return V
         inner = slice(1, net.count - 1)
         c, m = net.drag_kg_m[inner, None], self.m[inner, None]
+        air = self._air(t)[inner]
         for _ in range(KICK_ITERATIONS):
-            vA = V - net.wind_m_s
+            vA = V - air
             a = np.linalg.norm(vA, axis=1)[:, None]
             r = V - V0 - h * (F - c * a * vA - self.drag0[inner]) / m
             # dD/dV = -c (|v_A| I + v_A v_A^T / |v_A|)
@@ -236,10 +279,10 @@ class Integrator:
         c = Pi3 * (1 / self.Jp[inner] - 1 / self.Jd[inner])
         body = _rotations(np.outer(h * c, [0.0, 0.0, 1.0]))
         s.R[inner] = _rotations(h * L / self.Jd[inner, None]) @ R @ body
-        if self.drive.top_torque is not None:
+        if self.top_turns:
             s.R[-1] = _rotations((h * mo.top_spin * self.e3)[None])[0] @ s.R[-1]
             s.theta += h * mo.top_spin
-        if self.drive.controller is not None:
+        if self.ground_turns:
             s.R[0] = _rotations((h * mo.ground_spin * self.e3)[None])[0] @ s.R[0]
             mo.ground_turn += h * mo.ground_spin
         mo.t += h
@@ -255,6 +298,10 @@ class Integrator:
             self._drift(mo, h)
             self._kick(mo, h / 2, implicit=True)
         self.steps += 1
+        g = self.drive.generator
+        if (g is not None and g.release_rad_s is not None and self.released_at is None
+                and mo.ground_spin >= g.release_rad_s):
+            self.released_at = mo.t
         if not (np.all(np.isfinite(mo.state.X)) and np.all(np.isfinite(mo.L))):
             raise NetworkError(
                 f"the network's motion diverged at t = {mo.t:.4g} s (step {self.steps}): the "
@@ -296,7 +343,7 @@ class Integrator:
 
     def drag_power_W(self, mo: Motion) -> float:
         """The drag's power beyond its value at rest (which the potential holds) [W]."""
-        return float(np.sum((self._drag(mo.V) - self.drag0)[1:-1] * mo.V[1:-1]))
+        return float(np.sum((self._drag(mo.V, mo.t) - self.drag0)[1:-1] * mo.V[1:-1]))
 
 
 def bay_tension_N(net: Network, s: en.State, bay: int = 0) -> float:

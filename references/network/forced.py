@@ -9,6 +9,7 @@ import numpy as np
 
 from rawehelix.references.network import dynamics as dy
 from rawehelix.references.network import energy as en
+from rawehelix.references.network.limits import Sampler
 from rawehelix.references.network.network import Network
 from rawehelix.references.network.stationary import solve
 
@@ -18,7 +19,10 @@ class NetworkBackend:
     section_sampler = None  # no fields along s to sample (solvers/periodic.py)
 
     def track_sections(self) -> None:
-        """Nothing to track: the network's members are not the continuum's sections."""
+        """Sample the network's members at the output times (limits.py: the first slack
+        tether, the moment ratio), for the sweep point's limits block."""
+        members = self.params.model.section.members(self.params.helix)
+        self.section_sampler = Sampler(self.net, members.saturation, members.breaking_N)
 
     def __init__(self, params):
         self.params, self.q = params, params.normalised()
@@ -49,8 +53,11 @@ class NetworkBackend:
         drive = integ.drive
         if drive.top_position is not None:  # the end's velocity jumps to the circle's
             mo.state.X[-1], mo.V[-1] = drive.top_position(t0 * ts), drive.top_velocity(t0 * ts)
-        tension = []
-        for target in list(np.asarray(t_out, dtype=float)) + [t1]:
+        tension, sampler = [], self.section_sampler
+        if sampler is not None:
+            sampler.expect()
+        outputs = list(np.asarray(t_out, dtype=float))
+        for k, target in enumerate(outputs + [t1]):
             span = target * ts - mo.t
             if span > 1e-12 * max(1.0, mo.t):
                 n = int(np.ceil(span / integ.dt * (1 - 1e-12)))
@@ -59,7 +66,17 @@ class NetworkBackend:
             self.smallest_tether_N = min(self.smallest_tether_N,
                                          float(en.tether_forces(self.net, mo.state).min()))
             tension.append(dy.bay_tension_N(self.net, mo.state) / self.q.force_scale)
+            if sampler is not None and k < len(outputs):
+                sampler.keep(mo.t, mo.state)
         return mo, np.array(tension[:-1])
+
+    def parts(self, mo: dy.Motion) -> dict:
+        """The motion's parts whose change over a period says what still moves
+        (solvers/periodic.py's ``unsettled``), normalised as the FE's: the rings'
+        centres (L0) and velocities (L0 / t_scale)."""
+        q = self.q
+        return {"the ring centres": mo.state.X / q.L0,
+                "the ring centres' velocity": mo.V * q.t_scale / q.L0}
 
     @staticmethod
     def pack(mo: dy.Motion) -> dict:

@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rawehelix.errors import SolverError
+from rawehelix.operation import wind
 from rawehelix.parameters.checks import ParameterError
 from rawehelix.parameters.section import check_network_rings
 
@@ -103,7 +104,8 @@ class Network:
     #: each ring's drag c_i [kg/m], its force -c_i |v_A| v_A at the apparent wind
     #: v_A = x_t - wind (Eq. 28 over its length of helix); None: no drag in time
     drag_kg_m: np.ndarray | None = None
-    wind_m_s: np.ndarray = field(default_factory=lambda: np.zeros(3))  # the air's velocity [m/s]
+    #: the air's velocity at each ring (rings, 3), or one for all (3,) [m/s]
+    wind_m_s: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self):
         if self.n < 3 or len(self.rings) < 2:
@@ -187,12 +189,16 @@ class Network:
                                sec.ring_diametral_inertia_kgm2 or m * R * R / 2) for m in masses)
         g = env.g_m_s2 * float(model.gravity)
         c = float(model.drag) * env.air_density_kg_m3 * h.drag_length_m * h.drag_coefficient / 2
-        q = c * env.wind_speed_m_s * abs(env.wind_speed_m_s)  # Eq. (14) [N/m], along -i_E
+        # the wind at each ring's height on the straight chord (z up = -k_E): the scene's
+        # [wind] profile at t = 0, else environment.wind_speed_m_s (operation/wind.py)
+        V = np.asarray(wind.from_params(params).speed_at(np.linspace(0.0, -chord[2], N)), float)
+        V = np.broadcast_to(V, (N,))
+        q = c * V * np.abs(V)  # Eq. (14) [N/m], along -i_E
         loads = np.outer(masses * g, [0.0, 0.0, 1.0]) + np.outer(share * q, [-1.0, 0.0, 0.0])
         if end_torque_Nm is None and params.torque.top_Nm != 0:
             end_torque_Nm = params.torque.top_Nm
         return cls(n=n, radius_m=R, k_N=k, l0_m=l_t / (1 + P0 / k), chord_m=chord, lay_rad=lay,
                    rings=ring_list, loads_N=loads, bar_EA_N=bar_EA, bar_l0_m=bar_l0,
                    end_twist_rad=end_twist_rad, end_torque_Nm=end_torque_Nm, spacing_m=l,
-                   drag_kg_m=c * share, wind_m_s=np.array([-env.wind_speed_m_s, 0.0, 0.0]))
+                   drag_kg_m=c * share, wind_m_s=np.outer(-V, [1.0, 0.0, 0.0]))
 

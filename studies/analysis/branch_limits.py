@@ -25,6 +25,7 @@ past it, and its f1 is only an upper bound.  :func:`first_lines` prints them and
 from __future__ import annotations
 
 from rawehelix.members import CRITERIA
+from rawehelix.references.network.limits import Record as MembersRecord
 from rawehelix.studies.analysis import structure_limits
 
 #: why a point has no block (its ``status``)
@@ -43,10 +44,13 @@ def absent(status: str) -> dict:
 
 
 def point_block(params, sections) -> dict:
-    """The block over ``sections`` ([(t, Probes.section() dict)], normalised), or the
-    absent block when ``sections`` is None (a scheme without fields along s)."""
+    """The block over ``sections`` ([(t, Probes.section() dict)], normalised; or the
+    network's record of its members, references/network/limits.py), or the absent block
+    when ``sections`` is None (a scheme without fields along s)."""
     if sections is None:
         return absent(NOT_AVAILABLE)
+    if isinstance(sections, MembersRecord):  # the network's own members (its sampler's)
+        return sections.block()
     tracker = structure_limits.of_params(params)
     q = params.normalised()
     for t, section in sections:
