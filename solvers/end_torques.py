@@ -60,10 +60,16 @@ class Machine:
     def at(self, t_s: float) -> "Machine":
         """The machine in the wind at the time ``t_s`` [s]: V at the hub and V_n = V
         normal_factor (the along-wind component u of the history at the hub; its
-        lateral and vertical parts load the helix's drag only)."""
+        lateral and vertical parts load the helix's drag only).  A rotor's wind along
+        its axis at or below zero (turbulence reversing it) is :class:`WindBelowRotor`."""
         if self.history is None:
             return self
         v = float(self.history.hub(t_s)[0])
+        if self.rotor is not None and not v * self.normal_factor > 0:
+            raise WindBelowRotor(
+                f"the wind along the rotor's axis is {v * self.normal_factor:.3g} m/s at the hub "
+                f"(V = {v:.3g} m/s): the rotor's table (tip-speed ratio Omega R / V_n) has no "
+                f"such wind")
         return dataclasses.replace(self, wind_hub_m_s=v, wind_n_m_s=v * self.normal_factor)
 
     def thrust_N(self, omega_rad_s: float) -> float:
@@ -72,6 +78,10 @@ class Machine:
         if self.rotor is None:
             return 0.0
         return float(self.rotor.thrust(omega_rad_s, self.wind_n_m_s, self.air_density_kg_m3))
+
+
+class WindBelowRotor(ValueError):
+    """The wind along the rotor's axis at the hub fell to zero or reversed in a run."""
 
 
 def rotor_scales(machine: Machine, q) -> tuple[float, float]:

@@ -28,6 +28,10 @@ from rawehelix.solvers import release
 from rawehelix.solvers.end_torques import EndTorques, Machine, rotor_scales
 
 
+#: V_n / V_n(0) for a wind along the rotor's axis at or below zero [-]
+NO_WIND = 1e-9
+
+
 class Weather:
     """The wind's Constants of one formulation and how to set them at a time."""
 
@@ -68,7 +72,10 @@ class Weather:
         if self._rotor is not None:  # Machine.at(t_s)'s V_n, without a new Machine
             (power, lam), v0 = self._scales0
             hub = self.machine.history.hub_of(reference, gust, fluctuation)
-            ratio = hub * self.machine.normal_factor / v0
+            # the wind along the axis at or below zero (turbulence reversing it): the
+            # step runs with no wind on the rotor (lambda -> infinity, past the table's
+            # end) and studies/machine.py's check after it stops the run with its time
+            ratio = max(hub * self.machine.normal_factor / v0, NO_WIND)
             self._rotor[0].value, self._rotor[1].value = power * ratio**3, lam / ratio
 
 

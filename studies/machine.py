@@ -16,7 +16,7 @@ import numpy as np
 from rawehelix.operation import generator
 from rawehelix.operation.rigid_shaft import operating_points
 from rawehelix.operation.rotor import RPM, OutOfTable  # RPM: rad/s per rpm
-from rawehelix.solvers.end_torques import Machine, machine_of
+from rawehelix.solvers.end_torques import Machine, WindBelowRotor, machine_of
 from rawehelix.solvers.snes import SolverError
 from rawehelix.studies.scene import SceneError
 
@@ -112,7 +112,7 @@ def startup(machine: Machine, release, rows) -> dict:
     block["operating_rpm"] = block["reached_at_s"] = None
     if not len(rows) or machine.rotor is None:
         return block
-    now = machine.at(float(rows[-1, 0]))
+    now = at(machine, float(rows[-1, 0]))
     points = [p for p in operating_points(now.rotor, now.generator, now.wind_n_m_s,
                                           now.air_density_kg_m3) if p.stable]
     if not points:
@@ -176,9 +176,24 @@ def lifter_line(block: dict | None) -> str:
 def row(machine: Machine, t_s: float, spin0_rpm: float, spin1_rpm: float,
         ground_torque_Nm: float) -> tuple:
     """The :data:`COLUMNS` at an output time (SI), in the wind of that time."""
-    now = machine.at(t_s)
+    now = at(machine, t_s)
     return (spin1_rpm, ground_torque_Nm * spin0_rpm * RPM,
             thrust(now, spin1_rpm * RPM, t_s), now.wind_hub_m_s)
+
+
+def stopped(why, t_s: float) -> SolverError:
+    """The run's stop at ``t_s`` [s] for ``why`` (exit 1, the series kept)."""
+    return SolverError(f"{why}; the run stopped at t = {t_s:.4g} s (simulated), its series "
+                       f"kept up to there")
+
+
+def at(machine: Machine, t_s: float) -> Machine:
+    """``machine.at(t_s)``; the wind along the rotor's axis at or below zero stops the
+    run with its time (a rotor's table knows no such wind: never a silent number)."""
+    try:
+        return machine.at(t_s)
+    except WindBelowRotor as err:
+        raise stopped(err, t_s) from None
 
 
 def thrust(machine: Machine, omega_rad_s: float, t_s: float) -> float:
@@ -187,8 +202,7 @@ def thrust(machine: Machine, omega_rad_s: float, t_s: float) -> float:
     try:
         return machine.thrust_N(omega_rad_s)
     except OutOfTable as err:
-        raise SolverError(f"{err}; the run stopped at t = {t_s:.4g} s (simulated), its series "
-                          f"kept up to there") from None
+        raise stopped(err, t_s) from None
 
 
 def check_step(machine: Machine, solver) -> None:
@@ -196,7 +210,7 @@ def check_step(machine: Machine, solver) -> None:
     if machine.rotor is not None:
         q = solver.q
         t_s = float(q.time_s(solver.t))
-        thrust(machine.at(t_s), float(solver.probes.value("spin1")) / q.t_scale, t_s)
+        thrust(at(machine, t_s), float(solver.probes.value("spin1")) / q.t_scale, t_s)
 
 
 __all__ = ["COLUMNS", "check_step", "lifter_block", "lifter_line", "of", "row", "solver",

@@ -138,3 +138,24 @@ def test_operate_logs_its_points_on_rank_0_only(caplog):
     lines = [r.getMessage() for r in caplog.records if r.getMessage().startswith("operate: 6 m/s")]
     counts = comm.allgather(len(lines))
     assert counts == [1] + [0] * (comm.size - 1), counts
+
+
+def test_a_wind_reversed_along_the_rotor_stops_the_run_with_its_time():
+    """The full-size seeds study (turbulent_rated, 10 min, 5 m/s, seed 4): the wind along
+    the rotor's axis reached -7.4e-5 m/s at the hub and the point failed with a bare
+    ValueError and no time.  Now a history whose hub wind crosses zero gives a
+    SimulationError-class stop naming the wind and the simulated time."""
+    import dataclasses
+    from rawehelix.operation.wind import WindProfile
+    from rawehelix.operation.wind_series import sampled
+    from rawehelix.solvers.end_torques import WindBelowRotor, machine_of
+    from rawehelix.solvers.snes import SolverError
+    from rawehelix.studies import machine as studies_machine
+    machine = machine_of(scene.load("rotor_example", elements=2))
+    history = sampled(WindProfile(6.6131), [0.0, 1.0, 2.0], reference_m_s=[6.0, 1.0, -1.0])
+    moving = dataclasses.replace(machine, history=history)
+    assert moving.at(0.5).wind_hub_m_s == pytest.approx(3.5)  # inside: the wind of 0.5 s
+    with pytest.raises(WindBelowRotor, match=r"wind along the rotor's axis is -0\.\d+ m/s"):
+        moving.at(1.9)
+    with pytest.raises(SolverError, match=r"has no such wind; the run stopped at t = 1\.9 s"):
+        studies_machine.at(moving, 1.9)
