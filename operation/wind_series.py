@@ -181,9 +181,13 @@ class WindHistory:
         """u at the hub at the time ``t`` without the turbulence's fluctuation u':
         V_ref(t) f(z_hub) + G(t), the wind a turbulent record fluctuates about [m/s]."""
         i, w = self._at(t)
-        return float(self._series(self.reference_m_s, i, w)
-                     * self.profile.factor(self.profile.hub_height_m)
-                     + self._series(self.gust_m_s, i, w))
+        return self._hub_mean(self._series(self.reference_m_s, i, w),
+                              self._series(self.gust_m_s, i, w))
+
+    def _hub_mean(self, reference: float, gust: float) -> float:
+        """V_ref f(z_hub) + G [m/s] of a time's reference speed and gust."""
+        return float(reference * self.profile.factor(self.profile.hub_height_m) + gust)
+
     def hub_u(self, t: float) -> float:
         """u at the hub at the time ``t`` [m/s]: :meth:`along` at the hub height, the
         same operations on its scalars (a dynamic run asks it at every step)."""
@@ -192,9 +196,8 @@ class WindHistory:
     def hub_of(self, reference: float, gust: float, fluct) -> float:
         """u at the hub [m/s] of a time's :meth:`parts`."""
         z = self.profile.hub_height_m
-        u = float(reference * self.profile.factor(z) + gust)
-        return u + float(fluct[0, 0] if len(self.heights_m) == 1
-                         else np.interp(z, self.heights_m, fluct[:, 0]))
+        return self._hub_mean(reference, gust) + float(
+            fluct[0, 0] if len(self.heights_m) == 1 else np.interp(z, self.heights_m, fluct[:, 0]))
 
     def hub(self, t) -> np.ndarray:
         """u at the hub at the times ``t`` [m/s]."""

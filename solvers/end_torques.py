@@ -31,6 +31,10 @@ from rawehelix.operation import generator as generator_laws, rotor as rotor_laws
 from rawehelix.parameters import end_components
 
 
+class WindBelowRotor(ValueError):
+    """The wind along the rotor's axis at the hub fell to zero or reversed in a run."""
+
+
 @dataclass(frozen=True)
 class Machine:
     """The rotor and the generator of a run, as numpy laws (operation/) and the hub's
@@ -48,8 +52,10 @@ class Machine:
 
     def __post_init__(self):
         if self.rotor is not None and not (self.wind_n_m_s > 0 and math.isfinite(self.wind_n_m_s)):
-            raise ValueError(f"Machine: the hub's wind V_n = {self.wind_n_m_s!r} m/s must be > 0 "
-                             f"with a rotor")
+            raise WindBelowRotor(
+                f"the wind along the rotor's axis is {self.wind_n_m_s:.3g} m/s at the hub "
+                f"(V = {self.wind_hub_m_s:.3g} m/s): the rotor's table (tip-speed ratio "
+                f"Omega R / V_n) has no such wind")
         if not self.air_density_kg_m3 > 0:
             raise ValueError(f"Machine: air density {self.air_density_kg_m3!r} must be > 0")
 
@@ -57,20 +63,18 @@ class Machine:
     def active(self) -> bool:
         return self.rotor is not None or self.generator is not None
 
+    def in_wind(self, v_m_s: float) -> "Machine":
+        """The machine with V = ``v_m_s`` [m/s] at the hub and V_n = V normal_factor; a
+        rotor's V_n at or below zero is :class:`WindBelowRotor` (__post_init__)."""
+        return dataclasses.replace(self, wind_hub_m_s=v_m_s, wind_n_m_s=v_m_s * self.normal_factor)
+
     def at(self, t_s: float) -> "Machine":
-        """The machine in the wind at the time ``t_s`` [s]: V at the hub and V_n = V
-        normal_factor (the along-wind component u of the history at the hub; its
-        lateral and vertical parts load the helix's drag only).  A rotor's wind along
-        its axis at or below zero (turbulence reversing it) is :class:`WindBelowRotor`."""
+        """The machine in the wind at the time ``t_s`` [s] (:meth:`in_wind`): the
+        along-wind component u of the history at the hub (its lateral and vertical parts
+        load the helix's drag only); turbulence reversing it is :class:`WindBelowRotor`."""
         if self.history is None:
             return self
-        v = float(self.history.hub(t_s)[0])
-        if self.rotor is not None and not v * self.normal_factor > 0:
-            raise WindBelowRotor(
-                f"the wind along the rotor's axis is {v * self.normal_factor:.3g} m/s at the hub "
-                f"(V = {v:.3g} m/s): the rotor's table (tip-speed ratio Omega R / V_n) has no "
-                f"such wind")
-        return dataclasses.replace(self, wind_hub_m_s=v, wind_n_m_s=v * self.normal_factor)
+        return self.in_wind(self.history.hub_u(t_s))
 
     def thrust_N(self, omega_rad_s: float) -> float:
         """The rotor's thrust at Omega [N] (0 without a rotor); its tip-speed ratio out of
@@ -78,10 +82,6 @@ class Machine:
         if self.rotor is None:
             return 0.0
         return float(self.rotor.thrust(omega_rad_s, self.wind_n_m_s, self.air_density_kg_m3))
-
-
-class WindBelowRotor(ValueError):
-    """The wind along the rotor's axis at the hub fell to zero or reversed in a run."""
 
 
 def rotor_scales(machine: Machine, q) -> tuple[float, float]:

@@ -9,8 +9,6 @@ settles back to after a gust.  Its time series gains :data:`COLUMNS`, its summar
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
 from rawehelix.operation import generator
@@ -40,8 +38,7 @@ def start_wind(machine: Machine) -> Machine:
     step, gust or file wind is unchanged (no fluctuation)."""
     if machine.history is None:
         return machine
-    v = machine.history.mean_hub(0.0)  # [m/s]
-    return dataclasses.replace(machine, wind_hub_m_s=v, wind_n_m_s=v * machine.normal_factor)
+    return machine.in_wind(machine.history.mean_hub(0.0))
 
 
 def start_point(params, machine: Machine):
