@@ -64,7 +64,7 @@ def _simulate(rh, params, args, outdir, comm) -> int:
         result = simulate.compute(params, until_s=args.until, comm=comm, checkpoint=checkpoint)
     except simulate.SimulationError as err:
         err.partial.write(outdir, pictures=False)
-        raise rh.SolverError(f"{err} The series and the last good state are in "
+        raise rh.SolverError(f"{str(err).rstrip('.')}. The series and the last good state are in "
                              f"{outdir}/ (time_series.csv, state.npz).") from None
     result.write(outdir, gif=not args.no_gif)
     say(comm, simulate.report(result) + f"\n  wrote {outdir}/")
