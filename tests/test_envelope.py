@@ -170,6 +170,8 @@ def params_at(elongation, sets):
                          overrides={**sets, "ends.elongation": elongation})
 
 
+@pytest.mark.long  # 8.4 s, make test's 12-minute budget (2026-12-05: 733 s); make test keeps
+# envelope's other tick and window tests
 def test_a_tick_reports_only_its_window():
     """The continuation's last step leaves the window (here to 12.158 and 12.906 Hz for
     --f1 12.2:12.9): the envelope's ticks, their folds and limits hold points in [LO, HI]

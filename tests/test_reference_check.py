@@ -101,6 +101,8 @@ def test_the_residual_at_shooting_is_printed_against_a_stated_scale(N):
     assert "FE residual at shooting = " not in text
 
 
+@pytest.mark.long  # 5.2 s, make test's budget (2026-12-05: 733 s); make test keeps the
+# check's report in test_a_scene_it_models_is_compared and its neighbours
 def test_converge_on_a_scene_off_the_plane_reports_the_check(tmp_path):
     """converge mobile_end --quantity tension_s0 used to raise 'the shooting reference is
     planar' after writing runs/: now the runs' table, and the reference 'not applicable'."""

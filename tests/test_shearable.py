@@ -281,6 +281,8 @@ def energy_record(p, dt):
     return energy_balance(solver, 52 * period, dt)
 
 
+@pytest.mark.long  # 5.5 s, make test's budget (2026-12-05: 733 s); make test keeps the
+# energy balances of test_dynamics.py and the shearable rod's dynamics in test_same_on_one_and_two_ranks
 def test_energy_is_conserved():
     """Undamped, unforced free vibration of Sec. 5.2's helix (no torque, no controller,
     no drag) with GA = 3.9e3 N and the rotary inertia, alpha2 with spectral radius 1, as
